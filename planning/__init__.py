@@ -1,0 +1,1 @@
+"""The motion: motion laws, the press cycle, the optimizer, verification, outputs, CLI."""

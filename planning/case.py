@@ -1,0 +1,248 @@
+"""A press job as read from a case file: pydantic models in engineering units, and their checks.
+
+Field names carry their units (``crank_radius_mm``, ``transfer_time_s``). Unknown keys, wrong types,
+NaN and infinities are rejected by pydantic; the checks that need more than one field (rod longer
+than crank, angles in cycle order, safety height met at theta1 and theta4, heights within the stroke,
+a given draw speed within the speed limits) are in :func:`cross_checks`. Every problem is reported as
+a :class:`CaseError` naming the dotted field.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from typing import Annotated, Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
+
+from press.kinematics import CrankSlider
+
+RPM = 2.0 * math.pi / 60.0  # [rad/s] per rpm
+
+
+class CaseError(ValueError):
+    """A problem with a case: ``field`` (dotted path), ``message``, and the offending ``value``."""
+
+    def __init__(self, field: str, message: str, value: Any = None, has_value: bool = True):
+        self.field = field
+        self.message = message
+        self.value = value
+        self.has_value = has_value
+        super().__init__(self.line())
+
+    def line(self, file: str | None = None) -> str:
+        """One line ``FILE: field: message (got VALUE)``."""
+        parts = [p for p in (file, self.field) if p]
+        got = f" (got {_show(self.value)})" if self.has_value else ""
+        return ": ".join(parts + [f"{self.message}{got}"])
+
+
+def _show(value: Any) -> str:
+    text = repr(value) if isinstance(value, str) else str(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False, frozen=True)
+
+
+Positive = Annotated[float, Field(gt=0)]
+NonNegative = Annotated[float, Field(ge=0)]
+Angle = Annotated[float, Field(ge=0, lt=360)]
+
+
+class PressModel(_Model):
+    """The machine: ``crank_radius_mm`` [mm], ``rod_length_mm`` [mm]."""
+
+    crank_radius_mm: Positive
+    rod_length_mm: Positive
+
+
+class KeyPointsModel(_Model):
+    """The four key crank angles [deg from TDC]."""
+
+    closing_deg: Angle
+    draw_start_deg: Angle
+    draw_end_deg: Angle
+    opening_deg: Angle
+
+
+class ProcessModel(_Model):
+    """``safety_height_mm`` [mm above BDC], ``transfer_time_s`` [s], ``draw_speed_rpm`` [rpm] or None."""
+
+    safety_height_mm: Positive
+    transfer_time_s: Positive
+    draw_speed_rpm: Positive | None = None
+
+
+class LimitsModel(_Model):
+    """Process and machine limits; ``min_crank_speed_rpm`` keeps the crank turning forward."""
+
+    draw_start_speed_mm_s: Positive
+    die_height_mm: NonNegative
+    die_speed_mm_s: Positive
+    slider_accel_mm_s2: Positive
+    min_crank_speed_rpm: Positive = 1.0
+
+
+class PlannerModel(_Model):
+    """``motion_law`` and ``placement`` of the key points (free | published)."""
+
+    motion_law: Literal["improved-s-curve"] = "improved-s-curve"
+    placement: Literal["free", "published"] = "free"
+
+
+class PublishedKeyPoint(_Model):
+    """A published key point: ``height_mm`` [mm], ``slider_speed_mm_s`` [mm/s] (magnitude)."""
+
+    height_mm: float | None = None
+    slider_speed_mm_s: float | None = None
+
+
+class PublishedKeyPoints(_Model):
+    closing: PublishedKeyPoint | None = None
+    draw_start: PublishedKeyPoint | None = None
+    draw_end: PublishedKeyPoint | None = None
+    opening: PublishedKeyPoint | None = None
+
+
+class PublishedSolution(_Model):
+    """The paper's X = [x1..x5, wm1, wm2, T1, T5, T9, T10, T14, J]: times [s], speeds [rpm], J [rpm/s^2]."""
+
+    x1_s: float
+    x2_s: float
+    x3_s: float
+    x4_s: float
+    x5_s: float
+    wm1_rpm: float
+    wm2_rpm: float
+    T1_s: float
+    T5_s: float
+    T9_s: float
+    T10_s: float
+    T14_s: float
+    J_rpm_s2: float
+
+
+class PublishedModel(_Model):
+    """The source's own numbers, kept for comparison only (never read by the solver)."""
+
+    spm: Positive | None = None
+    key_points: PublishedKeyPoints | None = None
+    solution: PublishedSolution | None = None
+
+
+class Case(_Model):
+    """A whole case file."""
+
+    name: Annotated[str, Field(min_length=1, max_length=100)]
+    title: str = ""
+    source: str = ""
+    press: PressModel
+    key_points: KeyPointsModel
+    process: ProcessModel
+    limits: LimitsModel
+    planner: PlannerModel = PlannerModel()
+    published: PublishedModel | None = None
+
+    # ---- derived quantities in inside units ----
+    @property
+    def machine(self) -> CrankSlider:
+        """The crank-slider of the case (exact geometry)."""
+        return CrankSlider(self.press.crank_radius_mm, self.press.rod_length_mm)
+
+    @property
+    def key_angles(self) -> np.ndarray:
+        """theta1..theta4 [rad]."""
+        k = self.key_points
+        return np.radians([k.closing_deg, k.draw_start_deg, k.draw_end_deg, k.opening_deg])
+
+
+KEY_POINT_NAMES = ("closing", "draw_start", "draw_end", "opening")
+KEY_POINT_FIELDS = ("closing_deg", "draw_start_deg", "draw_end_deg", "opening_deg")
+
+
+def draw_speed_bounds(case: Case) -> dict[str, float]:
+    """The highest draw speed [rad/s] each limit allows during the constant-speed draw.
+
+    Keys: ``draw_start_speed`` (|v| at theta2), ``die_speed`` (|v| where the slider is at or below
+    the die height inside the draw), ``slider_accel`` (|a| = |d2h/dtheta2| w^2 over the draw).
+    """
+    m = case.machine
+    _, th2, th3, _ = case.key_angles
+    d1_2 = abs(float(m.derivatives(th2)[0]))
+    out = {"draw_start_speed": case.limits.draw_start_speed_mm_s / d1_2 if d1_2 > 0 else math.inf}
+    grid = np.linspace(th2, th3, 4001)
+    d1, d2, _ = m.derivatives(grid)
+    die = m.height(grid) <= case.limits.die_height_mm
+    lo, hi = m.angles_at_height(min(case.limits.die_height_mm, m.stroke))
+    edges = [a for a in (float(lo), float(hi)) if th2 <= a <= th3]  # |dh/dtheta| peaks at the crossings
+    slopes = np.abs(np.concatenate([d1[die], m.derivatives(np.array(edges))[0]])) if (die.any() or edges) else []
+    peak = float(np.max(slopes)) if len(slopes) else 0.0
+    out["die_speed"] = case.limits.die_speed_mm_s / peak if peak > 0 else math.inf
+    curv = float(np.max(np.abs(d2)))
+    out["slider_accel"] = math.sqrt(case.limits.slider_accel_mm_s2 / curv) if curv > 0 else math.inf
+    return out
+
+
+def cross_checks(case: Case) -> None:
+    """Checks that need several fields; raises :class:`CaseError` naming the first bad field."""
+    R, L = case.press.crank_radius_mm, case.press.rod_length_mm
+    if not L > R:
+        raise CaseError("press.rod_length_mm", f"must be longer than the crank radius {R:g} mm", L)
+    angles = [getattr(case.key_points, f) for f in KEY_POINT_FIELDS]
+    for i in range(1, 4):
+        if not angles[i] > angles[i - 1]:
+            raise CaseError(
+                f"key_points.{KEY_POINT_FIELDS[i]}",
+                f"must be greater than key_points.{KEY_POINT_FIELDS[i - 1]} = {angles[i - 1]:g} deg (cycle order)",
+                angles[i],
+            )
+    m = case.machine
+    stroke = m.stroke
+    safety = case.process.safety_height_mm
+    if safety > stroke:
+        raise CaseError("process.safety_height_mm", f"is above the stroke {stroke:g} mm", safety)
+    for field in ("closing_deg", "opening_deg"):
+        deg = getattr(case.key_points, field)
+        h = float(m.height(math.radians(deg)))
+        if h < safety:
+            raise CaseError(
+                f"key_points.{field}",
+                f"slider is at {h:.1f} mm there, below process.safety_height_mm = {safety:g}",
+                deg,
+            )
+    if case.limits.die_height_mm > stroke:
+        raise CaseError("limits.die_height_mm", f"is above the stroke {stroke:g} mm", case.limits.die_height_mm)
+    h2 = float(m.height(math.radians(case.key_points.draw_start_deg)))
+    if case.limits.die_height_mm >= h2:
+        raise CaseError(
+            "limits.die_height_mm",
+            f"must be below the slider height at the draw start ({h2:.1f} mm)",
+            case.limits.die_height_mm,
+        )
+    if case.process.draw_speed_rpm is not None:
+        bounds = draw_speed_bounds(case)
+        limit_fields = {"draw_start_speed": "limits.draw_start_speed_mm_s", "die_speed": "limits.die_speed_mm_s"}
+        for key, field in limit_fields.items():
+            if case.process.draw_speed_rpm * RPM > bounds[key] * (1 + 1e-12):
+                raise CaseError(
+                    "process.draw_speed_rpm",
+                    f"is above the {bounds[key] / RPM:.3f} rpm that {field} allows",
+                    case.process.draw_speed_rpm,
+                )
+        if case.process.draw_speed_rpm < case.limits.min_crank_speed_rpm:
+            raise CaseError(
+                "process.draw_speed_rpm",
+                f"is below limits.min_crank_speed_rpm = {case.limits.min_crank_speed_rpm:g}",
+                case.process.draw_speed_rpm,
+            )
+
+
+_SLUG = re.compile(r"[^A-Za-z0-9._-]+")
+
+
+def output_name(case: Case) -> str:
+    """A folder-safe version of the case name."""
+    return _SLUG.sub("-", case.name).strip("-.") or "case"

@@ -1,0 +1,232 @@
+"""The CasADi nonlinear program of one improved-S-curve press cycle (all CasADi lives here).
+
+Built once per placement structure and reused: every number of a case enters as a parameter, so a
+sweep or a multi-start only calls the compiled solver again. Decision variables are scaled to O(1).
+
+Time 0 of the NLP is the end of the draw (theta3); the stages follow as in ``planning.cycle``. The
+crank angle at any time t before the draw is evaluated in closed form as
+``theta(t) = theta3 + sum_k D_k(clip(t - s_k, 0, T_k))``, with ``D_k`` the angle swept ``tau`` into
+segment k. The clip makes theta(t) continuously differentiable in t and in every segment variable
+(the kink of one term is cancelled by the next), so a key point may move across knots inside one
+smooth NLP: that is the ``free`` placement. The ``published`` placement fixes the key points where
+the relations under the paper's Fig. 6 put them: t1 = x1 + T1 (one sub-segment into the feed
+acceleration), t4 = x3 + 3 T14 (three sub-segments into the return deceleration).
+
+Constraints: speed continuity of both S-curves (Eq. 19), the cycle closes at 2 pi, the key angles
+theta1 and theta4 are met, time(theta4 -> theta1) >= transfer time, |slider acceleration| <= limit at
+sample points of every segment (with a small back-off so that the dense verification holds between
+samples), slider speed at the die-height crossings outside the draw, draw speed within its bounds,
+crank speed >= the minimum crank speed (the S-curve halves are monotone for J >= 0).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cache
+from typing import Literal
+
+import casadi as ca
+import numpy as np
+
+from planning.cycle import CycleParameters, cycle_segments
+from planning.laws import improved_scurve as sc
+from planning.profile import advance, knot_states
+from press.kinematics import height_derivatives
+
+Placement = Literal["free", "published"]
+
+# Decision variables: name, scale (physical = scale * scaled)
+VARIABLES: tuple[tuple[str, float], ...] = (
+    ("transfer_speed", 1.0),  # w1 [rad/s]
+    ("draw_speed", 1.0),  # w2 [rad/s]
+    ("feed_jerk", 30.0),  # J_f [rad/s^3]
+    ("feed_accel_time", 0.1),  # [s]
+    ("feed_decel_time", 0.1),
+    ("return_jerk", 30.0),
+    ("return_accel_time", 0.1),
+    ("return_decel_time", 0.1),
+    ("transfer_dwell", 1.0),  # [s]
+    ("closing_time", 1.0),  # t1 from the end of the draw [s]
+    ("opening_time", 1.0),  # t4
+    ("die_down_time", 1.0),  # time of the descending die-height crossing
+    ("die_up_time", 1.0),  # time of the ascending die-height crossing
+)
+VARIABLE_INDEX = {name: i for i, (name, _) in enumerate(VARIABLES)}
+SCALES = np.array([s for _, s in VARIABLES])
+
+# Parameters of a case, in inside units
+PARAMETERS: tuple[str, ...] = (
+    "R",  # crank radius [mm]
+    "L",  # rod length [mm]
+    "theta1",  # closing [rad]
+    "theta2",  # draw start
+    "theta3",  # draw end
+    "theta4",  # opening
+    "transfer_time",  # [s]
+    "accel_limit",  # slider acceleration limit incl. back-off [mm/s^2]
+    "die_speed",  # [mm/s]
+    "die_down_angle",  # target angle of the descending crossing [rad] (theta2 when inside the draw)
+    "die_down_slope",  # |dh/dtheta| there [mm/rad], 0 when the crossing lies in the draw
+    "die_up_angle",
+    "die_up_slope",
+)
+PARAMETER_INDEX = {name: i for i, name in enumerate(PARAMETERS)}
+
+SAMPLES_PER_SUBSEGMENT = 6
+SAMPLES_CONSTANT = 24
+
+
+@dataclass(frozen=True)
+class ConstraintBlock:
+    """Name and row range of a group of NLP constraints (for reading multipliers and violations)."""
+
+    name: str
+    start: int
+    stop: int
+
+
+def _angle_at(t: ca.SX, starts: list, durations: list, states: list, segs: list) -> tuple[ca.SX, ca.SX]:
+    """Closed-form crank angle and speed at time ``t`` [s] over the segments (clip formulation)."""
+    theta = states[0][0]
+    omega = states[0][1]
+    for s_k, T_k, st, seg in zip(starts, durations, states, segs, strict=False):
+        tau = ca.fmin(ca.fmax(t - s_k, 0), T_k)
+        th, om, _, _ = advance(0.0, st[1], st[2], seg.j0, seg.j1, tau)
+        theta = theta + th
+        omega = omega + (om - st[1])
+    return theta, omega
+
+
+@dataclass
+class CycleNLP:
+    """A compiled NLP for one placement structure; see the module docstring."""
+
+    placement: Placement
+    solver: ca.Function
+    lbg: np.ndarray
+    ubg: np.ndarray
+    blocks: tuple[ConstraintBlock, ...]
+    sample_fn: ca.Function  # (x, p) -> slider acceleration at the samples [mm/s^2]
+
+
+def _build(placement: Placement) -> CycleNLP:
+    x = ca.SX.sym("x", len(VARIABLES))
+    p = ca.SX.sym("p", len(PARAMETERS))
+    v = {name: x[i] * scale for i, (name, scale) in enumerate(VARIABLES)}
+    q = {name: p[i] for i, name in enumerate(PARAMETERS)}
+
+    params = CycleParameters(
+        transfer_speed=v["transfer_speed"],
+        draw_speed=v["draw_speed"],
+        feed_jerk=v["feed_jerk"],
+        feed_accel_time=v["feed_accel_time"],
+        feed_decel_time=v["feed_decel_time"],
+        return_jerk=v["return_jerk"],
+        return_accel_time=v["return_accel_time"],
+        return_decel_time=v["return_decel_time"],
+        transfer_dwell=v["transfer_dwell"],
+        draw_start=q["theta2"],
+        draw_end=q["theta3"],
+    )
+    segs = cycle_segments(params)
+    states = knot_states(q["theta3"], params.draw_speed, 0.0, segs)
+    durations = [s.duration for s in segs]
+    starts = [0.0]
+    for T in durations[:-1]:
+        starts.append(starts[-1] + T)
+    before_draw = segs[:-1]  # the 17 segments from theta3 to theta2
+
+    blocks: list[ConstraintBlock] = []
+    g: list = []
+    lb: list = []
+    ub: list = []
+
+    def add(name: str, expr: ca.SX, lo, hi) -> None:
+        expr = ca.vec(expr)
+        n = expr.shape[0]
+        blocks.append(ConstraintBlock(name, len(lb), len(lb) + n))
+        g.append(expr)
+        lb.extend(np.broadcast_to(lo, (n,)).tolist())
+        ub.extend(np.broadcast_to(hi, (n,)).tolist())
+
+    w1, w2 = params.transfer_speed, params.draw_speed
+    # Eq. 19 for each S-curve: the speeds meet
+    add(
+        "feed speed continuity",
+        w1
+        + sc.speed_change(params.feed_jerk, params.feed_accel_time)
+        - sc.speed_change(params.feed_jerk, params.feed_decel_time)
+        - w2,
+        0.0,
+        0.0,
+    )
+    add(
+        "return speed continuity",
+        w2
+        + sc.speed_change(params.return_jerk, params.return_accel_time)
+        - sc.speed_change(params.return_jerk, params.return_decel_time)
+        - w1,
+        0.0,
+        0.0,
+    )
+    # the cycle closes: theta at the draw start is theta2 + 2 pi
+    add("cycle closes", states[len(before_draw)][0] - (q["theta2"] + 2 * np.pi), 0.0, 0.0)
+
+    n_ret = 2 * sc.SUBSEGMENTS
+    if placement == "published":
+        t4 = starts[sc.SUBSEGMENTS] + 3 * params.return_decel_time
+        t1 = starts[n_ret + 1] + params.feed_accel_time
+    else:
+        t4, t1 = v["opening_time"], v["closing_time"]
+    sel = slice(0, len(before_draw))
+    th4, _ = _angle_at(t4, starts[sel], durations[sel], states[sel], before_draw)
+    th1, _ = _angle_at(t1, starts[sel], durations[sel], states[sel], before_draw)
+    add("opening angle", th4 - q["theta4"], 0.0, 0.0)
+    add("closing angle", th1 - (q["theta1"] + 2 * np.pi), 0.0, 0.0)
+    add("transfer time", t1 - t4 - q["transfer_time"], 0.0, np.inf)
+    if placement == "free":
+        t_end_feed = starts[len(before_draw)]
+        add("key points in order", ca.vertcat(t4, t1 - t4, t_end_feed - t1), 0.0, np.inf)
+
+    # die-height crossings outside the draw
+    thd, omd = _angle_at(v["die_down_time"], starts[sel], durations[sel], states[sel], before_draw)
+    thu, omu = _angle_at(v["die_up_time"], starts[sel], durations[sel], states[sel], before_draw)
+    add("die crossing angles", ca.vertcat(thd - (q["die_down_angle"] + 2 * np.pi), thu - q["die_up_angle"]), 0.0, 0.0)
+    add(
+        "die-height speed",
+        ca.vertcat(q["die_down_slope"] * omd, q["die_up_slope"] * omu) / q["die_speed"],
+        -np.inf,
+        1.0,
+    )
+
+    # slider acceleration at sample points of every segment
+    acc = []
+    for seg, st in zip(segs, states[:-1], strict=True):
+        n = SAMPLES_CONSTANT if seg.name in ("transfer:dwell", "draw:constant") else SAMPLES_PER_SUBSEGMENT
+        for f in np.linspace(0.0, 1.0, n + 1)[:-1] if seg.name != "draw:constant" else np.linspace(0, 1, n + 1):
+            th, om, al, _ = advance(st[0], st[1], st[2], seg.j0, seg.j1, f * seg.duration)
+            d1, d2, _ = height_derivatives(th, q["R"], q["L"])
+            acc.append(d2 * om**2 + d1 * al)
+    acc = ca.vertcat(*acc)
+    add("slider acceleration", acc / q["accel_limit"], -1.0, 1.0)
+
+    period = params.period
+    nlp = {"x": x, "p": p, "f": period, "g": ca.vertcat(*g)}
+    opts = {
+        "ipopt.print_level": 0,
+        "print_time": False,
+        "ipopt.sb": "yes",
+        "ipopt.tol": 1e-10,
+        "ipopt.constr_viol_tol": 1e-10,
+        "ipopt.max_iter": 1000,
+        "ipopt.mu_strategy": "adaptive",
+    }
+    solver = ca.nlpsol(f"cycle_{placement}", "ipopt", nlp, opts)
+    sample_fn = ca.Function("slider_accel_samples", [x, p], [acc])
+    return CycleNLP(placement, solver, np.array(lb), np.array(ub), tuple(blocks), sample_fn)
+
+
+@cache
+def cycle_nlp(placement: Placement) -> CycleNLP:
+    """The compiled NLP for ``placement`` (built on first use, then reused)."""
+    return _build(placement)

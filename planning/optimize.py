@@ -1,0 +1,269 @@
+"""The orchestrator: case -> NLP parameters -> multi-start IPOPT solves -> verified plan.
+
+Initial guesses are built from the case alone (never from published numbers): a transfer speed,
+peak speeds near the constant-speed acceleration bound, and sub-segment lengths that sweep the
+angles between the key points. ``free`` placement starts also from the ``published`` placement's
+solution, so it is never worse than that structure, and keeps the best plan that verifies.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from planning.case import RPM, Case, draw_speed_bounds
+from planning.laws import improved_scurve as sc
+from planning.nlp import PARAMETER_INDEX, PARAMETERS, SCALES, VARIABLE_INDEX, VARIABLES, CycleNLP, cycle_nlp
+from planning.plan import Plan, SolverInfo, params_from_numbers, profile_from_tdc
+from planning.verify import ACCEL_CHECK, Verification, verify
+
+Placement = Literal["free", "published"]
+ACCEL_BACKOFF = 5e-4  # the NLP keeps |slider acceleration| <= (1 - backoff) * limit at its samples
+MIN_SUBSEGMENT_S = 1e-3  # [s] lower bound on an S-curve sub-segment
+MAX_TIME_S = 600.0  # [s] upper bound on any time variable
+REFINEMENTS = 3  # re-solves with a lowered sampled acceleration limit
+
+
+class PlanningError(Exception):
+    """No verified plan. ``kind`` is ``infeasible`` (limits cannot be met) or ``unverified``."""
+
+    def __init__(self, kind: str, reason: str):
+        self.kind = kind
+        self.reason = reason
+        super().__init__(f"{kind}: {reason}")
+
+
+@dataclass(frozen=True)
+class Solution:
+    """A verified plan and its verification."""
+
+    plan: Plan
+    verification: Verification
+
+
+def precheck(case: Case) -> tuple[float, float]:
+    """Cheap necessary conditions before any NLP; returns the draw-speed bounds ``(lo, hi)`` [rad/s].
+
+    Raises :class:`PlanningError` (infeasible) naming the limit that makes the case impossible.
+    """
+    bounds = draw_speed_bounds(case)
+    w_min = case.limits.min_crank_speed_rpm * RPM
+    w_given = case.process.draw_speed_rpm
+    if w_given is not None:
+        w2 = w_given * RPM
+        if w2 > bounds["slider_accel"] * (1 + 1e-12):
+            a_draw = case.limits.slider_accel_mm_s2 * (w2 / bounds["slider_accel"]) ** 2
+            raise PlanningError(
+                "infeasible",
+                f"at the draw speed {w_given:g} rpm the slider acceleration in the draw reaches "
+                f"{a_draw:.0f} mm/s^2 > slider_accel_mm_s2 = {case.limits.slider_accel_mm_s2:g}",
+            )
+        return w2, w2
+    hi = min(bounds.values())
+    if hi < w_min:
+        name = min(bounds, key=bounds.get)
+        raise PlanningError(
+            "infeasible",
+            f"the {name.replace('_', ' ')} limit allows a draw speed of at most {hi / RPM:.3f} rpm, "
+            f"below min_crank_speed_rpm = {case.limits.min_crank_speed_rpm:g}",
+        )
+    return w_min, hi
+
+
+def nlp_parameters(case: Case) -> np.ndarray:
+    """The parameter vector of the NLP for ``case`` (inside units)."""
+    m = case.machine
+    th1, th2, th3, th4 = case.key_angles
+    down, up = (float(a) for a in m.angles_at_height(case.limits.die_height_mm))
+    values = {
+        "R": case.press.crank_radius_mm,
+        "L": case.press.rod_length_mm,
+        "theta1": th1,
+        "theta2": th2,
+        "theta3": th3,
+        "theta4": th4,
+        "transfer_time": case.process.transfer_time_s,
+        "accel_limit": case.limits.slider_accel_mm_s2 * (1 - ACCEL_BACKOFF),
+        "die_speed": case.limits.die_speed_mm_s,
+        # a crossing inside the draw is covered by the draw-speed bound; then a harmless target
+        "die_down_angle": down if down < th2 else 0.5 * (th1 + th2),
+        "die_down_slope": abs(float(m.derivatives(down)[0])) if down < th2 else 0.0,
+        "die_up_angle": up if up > th3 else 0.5 * (th3 + th4),
+        "die_up_slope": abs(float(m.derivatives(up)[0])) if up > th3 else 0.0,
+    }
+    return np.array([values[k] for k in PARAMETERS], dtype=float)
+
+
+def _guess(case: Case, w2: float, w1: float, peak_share: float, inside: float) -> dict[str, float]:
+    """A rough start: S-curves that sweep the key-point angles, peak speeds ``peak_share`` of the
+    constant-speed acceleration bound, key points ``inside`` sub-segments into the S-curves."""
+    R, L = case.press.crank_radius_mm, case.press.rod_length_mm
+    th1, th2, th3, th4 = case.key_angles
+    w_acc = math.sqrt(case.limits.slider_accel_mm_s2 / (R + R**2 / L))  # |d2h/dtheta2| peaks at BDC
+    wm = max(peak_share * w_acc, 1.2 * max(w1, w2))
+
+    def halves(angle: float, w_from: float, w_to: float) -> tuple[float, float, float]:
+        ratio = math.sqrt((wm - w_to) / (wm - w_from))  # one jerk for both halves (Eq. 14)
+        T_a = angle / (2 * (w_from + wm) + 2 * ratio * (wm + w_to))
+        J = (wm - w_from) / (sc.SPEED_GAIN * T_a**2)
+        return T_a, ratio * T_a, J
+
+    T_fa, T_fd, J_f = halves(th2 - th1, w1, w2)
+    T_ra, T_rd, J_r = halves(th4 - th3, w2, w1)
+    T_c = (th1 + 2 * math.pi - th4) / w1
+    t4 = 4 * T_ra + (4 - inside) * T_rd
+    t1 = 4 * T_ra + 4 * T_rd + T_c + inside * T_fa
+    t_feed_end = t1 - inside * T_fa + 4 * T_fa + 4 * T_fd
+    return {
+        "transfer_speed": w1,
+        "draw_speed": w2,
+        "feed_jerk": J_f,
+        "feed_accel_time": T_fa,
+        "feed_decel_time": T_fd,
+        "return_jerk": J_r,
+        "return_accel_time": T_ra,
+        "return_decel_time": T_rd,
+        "transfer_dwell": T_c,
+        "closing_time": t1,
+        "opening_time": t4,
+        "die_down_time": 0.5 * (t1 + t_feed_end),
+        "die_up_time": 0.5 * t4,
+    }
+
+
+def _bounds(case: Case, w2_lo: float, w2_hi: float, placement: Placement) -> tuple[np.ndarray, np.ndarray]:
+    lo = np.zeros(len(VARIABLES))
+    hi = np.full(len(VARIABLES), MAX_TIME_S)
+    w_min = case.limits.min_crank_speed_rpm * RPM
+    i = VARIABLE_INDEX
+    lo[i["transfer_speed"]], hi[i["transfer_speed"]] = w_min, 1e3
+    lo[i["draw_speed"]], hi[i["draw_speed"]] = w2_lo, w2_hi
+    for k in ("feed_jerk", "return_jerk"):
+        lo[i[k]], hi[i[k]] = 0.0, 1e6
+    for k in ("feed_accel_time", "feed_decel_time", "return_accel_time", "return_decel_time"):
+        lo[i[k]] = MIN_SUBSEGMENT_S
+    if placement == "published":
+        for k in ("closing_time", "opening_time"):
+            lo[i[k]] = hi[i[k]] = 0.0
+    return lo / SCALES, hi / SCALES
+
+
+def _run(nlp: CycleNLP, x0: dict[str, float], p: np.ndarray, lbx: np.ndarray, ubx: np.ndarray):
+    x0v = np.clip(np.array([x0[k] for k, _ in VARIABLES]) / SCALES, lbx, ubx)
+    res = nlp.solver(x0=x0v, p=p, lbx=lbx, ubx=ubx, lbg=nlp.lbg, ubg=nlp.ubg)
+    stats = nlp.solver.stats()
+    x = np.array(res["x"]).ravel() * SCALES
+    g = np.array(res["g"]).ravel()
+    return {k: float(x[j]) for j, (k, _) in enumerate(VARIABLES)}, g, stats
+
+
+def _plan(case: Case, values: dict[str, float], placement: Placement, info: SolverInfo) -> Plan:
+    th = case.key_angles
+    params = params_from_numbers(values, float(th[1]), float(th[2]))
+    profile = profile_from_tdc(params)
+    plan = Plan(params, profile, tuple(float(a) for a in th), placement, info)
+    t = plan.key_times()
+    structure = {"closing": plan.segment_at(float(t[0])), "opening": plan.segment_at(float(t[3]))}
+    return Plan(params, profile, plan.key_angles, placement, info, structure=structure)
+
+
+def _violation(nlp: CycleNLP, g: np.ndarray) -> tuple[str, float]:
+    """The constraint block with the largest violation at the last iterate."""
+    viol = np.maximum(nlp.lbg - g, 0) + np.maximum(g - nlp.ubg, 0)
+    worst = max(nlp.blocks, key=lambda b: float(np.max(viol[b.start : b.stop], initial=0.0)))
+    return worst.name, float(np.max(viol[worst.start : worst.stop], initial=0.0))
+
+
+def solve(case: Case, placement: Placement | None = None) -> Solution:
+    """The fastest verified cycle for ``case``; raises :class:`PlanningError` when there is none."""
+    placement = placement or case.planner.placement
+    t_start = time.perf_counter()
+    w2_lo, w2_hi = precheck(case)
+    p = nlp_parameters(case)
+    w2 = w2_hi
+    th1, _, _, th4 = case.key_angles
+    w_min = case.limits.min_crank_speed_rpm * RPM
+    w_transfer = max((th1 + 2 * math.pi - th4) / case.process.transfer_time_s, 1.5 * w_min)
+
+    best: Solution | None = None
+    failures: list[str] = []
+    iterations = 0
+    starts = 0
+
+    def attempt(nlp: CycleNLP, x0: dict[str, float], lbx, ubx, as_placement: Placement):
+        """Solve from ``x0``; if only the dense slider-acceleration check fails, lower the NLP's
+        sampled limit by the measured overshoot and re-solve warm (at most ``REFINEMENTS`` times)."""
+        nonlocal best, iterations, starts
+        q = p.copy()
+        values = x0
+        starts += 1
+        for _ in range(REFINEMENTS + 1):
+            values, g, stats = _run(nlp, values, q, lbx, ubx)
+            iterations += int(stats["iter_count"])
+            status = str(stats["return_status"])
+            if status not in ("Solve_Succeeded", "Solved_To_Acceptable_Level"):
+                name, amount = _violation(nlp, g)
+                failures.append(f"solver stopped ({status}); worst constraint: {name} (violated by {amount:.3g})")
+                return None
+            info = SolverInfo(iterations, time.perf_counter() - t_start, starts, status)
+            plan = _plan(case, values, as_placement, info)
+            check = verify(plan, case)
+            if check.passed:
+                if best is None or plan.period < best.plan.period - 1e-9:
+                    best = Solution(plan, check)
+                return values
+            bad = check.failures()
+            failures.append(
+                f"verification failed: {bad[0].name} = {bad[0].value:.6g} {bad[0].unit} (limit {bad[0].limit:.6g})"
+            )
+            if [c.name for c in bad] != [ACCEL_CHECK]:
+                return None
+            q[PARAMETER_INDEX["accel_limit"]] *= (bad[0].limit / bad[0].value) * (1 - 1e-5)
+        return None
+
+    pub = cycle_nlp("published")
+    lbx, ubx = _bounds(case, w2_lo, w2_hi, "published")
+    guesses = [_guess(case, w2, w_transfer, 0.9, 1.0), _guess(case, w2, w_transfer, 0.6, 1.0)]
+    pub_values = None
+    for x0 in guesses:
+        values = attempt(pub, x0, lbx, ubx, "published")
+        if values is not None:
+            pub_values = values
+            break
+    if placement == "free":
+        free = cycle_nlp("free")
+        lbx, ubx = _bounds(case, w2_lo, w2_hi, "free")
+        free_starts = []
+        if pub_values is not None:
+            v = dict(pub_values)
+            v["opening_time"] = 4 * v["return_accel_time"] + 3 * v["return_decel_time"]
+            v["closing_time"] = (
+                4 * (v["return_accel_time"] + v["return_decel_time"]) + v["transfer_dwell"] + v["feed_accel_time"]
+            )
+            free_starts.append(v)
+        free_starts.append(_guess(case, w2, 2 * w_min, 0.95, 2.0))
+        free_starts.append(_guess(case, w2, w_transfer, 0.9, 1.5))
+        for x0 in free_starts:
+            attempt(free, x0, lbx, ubx, "free")
+        if best is not None and best.plan.placement == "published":
+            # the published structure is one of the free structures: report it as the free answer
+            plan = best.plan
+            best = Solution(
+                Plan(
+                    plan.parameters, plan.profile, plan.key_angles, "free", plan.solver, plan.motion_law, plan.structure
+                ),
+                best.verification,
+            )
+    if best is None:
+        raise PlanningError(
+            "infeasible" if not any(f.startswith("verification") for f in failures) else "unverified",
+            "no plan meets the limits: " + (failures[-1] if failures else "no start converged"),
+        )
+    plan = best.plan
+    info = SolverInfo(iterations, time.perf_counter() - t_start, starts, plan.solver.status)
+    plan = Plan(plan.parameters, plan.profile, plan.key_angles, plan.placement, info, plan.motion_law, plan.structure)
+    return Solution(plan, best.verification)

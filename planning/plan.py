@@ -1,0 +1,136 @@
+"""The solved press cycle: a numeric profile starting at TDC plus what the solver reported."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from planning.cycle import CycleParameters, cycle_segments
+from planning.profile import Profile, Segment, advance, knot_states
+
+
+@dataclass(frozen=True)
+class SolverInfo:
+    """``iterations`` of IPOPT, ``wall_time_s`` [s] of the whole solve, ``starts`` tried, IPOPT ``status``."""
+
+    iterations: int
+    wall_time_s: float
+    starts: int
+    status: str
+
+
+@dataclass(frozen=True)
+class Plan:
+    """One press cycle with its key points.
+
+    ``parameters``: the S-curve cycle (inside units); ``profile``: the crank motion over one period,
+    time 0 at TDC (theta = 0, unwrapped to 2 pi at the end); ``key_angles`` theta1..theta4 [rad];
+    ``placement``: free | published; ``structure``: where theta1 and theta4 fall (segment names).
+    """
+
+    parameters: CycleParameters
+    profile: Profile
+    key_angles: tuple[float, float, float, float]
+    placement: str
+    solver: SolverInfo
+    motion_law: str = "improved-s-curve"
+    structure: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def period(self) -> float:
+        """Cycle time [s]."""
+        return self.profile.duration
+
+    @property
+    def spm(self) -> float:
+        """Strokes per minute."""
+        return 60.0 / self.period
+
+    def key_times(self) -> np.ndarray:
+        """Times [s] from TDC at which the crank reaches theta1..theta4."""
+        return np.array([self.profile.time_at_angle(a) for a in self.key_angles])
+
+    def segment_at(self, t: float) -> str:
+        """Where time ``t`` [s] lies: ``segment name (NN% in)``; a knot counts as the end of the earlier
+        segment (``feed:accel1 (100% in)`` is the knot where the second sub-segment starts)."""
+        tk = self.profile.knot_times
+        k = int(np.clip(np.searchsorted(tk, t, side="left") - 1, 0, len(self.profile.segments) - 1))
+        share = (t - tk[k]) / max(tk[k + 1] - tk[k], 1e-300)
+        return f"{self.profile.segments[k].name} ({100 * share:.0f}% in)"
+
+    def transfer_window(self) -> float:
+        """Achieved time [s] from theta4 to theta1 through TDC."""
+        t = self.key_times()
+        return float(t[0] + self.period - t[3])
+
+    def paper_solution(self) -> dict[str, float]:
+        """The plan in the paper's notation X = [x1..x5, wm1, wm2, T1, T5, T9, T10, T14, J].
+
+        Mapping (time from TDC, as in the paper's Fig. 6): x1 start of the feed acceleration,
+        x2 feed peak speed, x3 return peak speed, x4 end of the return deceleration, x5 the period;
+        wm1, wm2 [rpm]; T1, T5, T10, T14 the sub-segment lengths of the four halves, T9 the draw [s];
+        J [rpm/s^2] the feed jerk (the return jerk is reported separately as ``J_return``).
+        """
+        p = self.parameters
+        tk = self.profile.knot_times
+        names = [s.name for s in self.profile.segments]
+        rpm = 60.0 / (2 * math.pi)
+
+        def start(name: str) -> float:
+            return float(tk[names.index(name)])
+
+        def end(name: str) -> float:
+            return float(tk[names.index(name) + 1])
+
+        return {
+            "x1_s": start("feed:accel1"),
+            "x2_s": start("feed:decel1"),
+            "x3_s": start("return:decel1"),
+            "x4_s": end("return:decel4"),
+            "x5_s": self.period,
+            "wm1_rpm": float(p.feed_peak_speed) * rpm,
+            "wm2_rpm": float(p.return_peak_speed) * rpm,
+            "T1_s": float(p.feed_accel_time),
+            "T5_s": float(p.feed_decel_time),
+            "T9_s": float(p.draw_time),
+            "T10_s": float(p.return_accel_time),
+            "T14_s": float(p.return_decel_time),
+            "J_rpm_s2": float(p.feed_jerk) * rpm,
+            "J_return_rpm_s2": float(p.return_jerk) * rpm,
+        }
+
+
+def _split(seg: Segment, tau: float) -> tuple[Segment, Segment]:
+    """Split a linear-jerk segment ``tau`` [s] after its start."""
+    first = Segment(seg.name, tau, seg.j0, seg.j1)
+    second = Segment(seg.name, float(seg.duration) - tau, seg.j0 + seg.j1 * tau, seg.j1)
+    return first, second
+
+
+def profile_from_tdc(params: CycleParameters) -> Profile:
+    """The cycle of ``params`` (numeric) as a profile that starts at TDC and runs one period.
+
+    The NLP lays the cycle out from theta3; here it is rotated so that time 0 is the TDC crossing,
+    splitting the segment that holds it. Segments of zero length are dropped.
+    """
+    segs = [Segment(s.name, float(s.duration), float(s.j0), float(s.j1)) for s in cycle_segments(params)]
+    th3 = float(params.draw_end)
+    w2 = float(params.draw_speed)
+    states = knot_states(th3, w2, 0.0, segs)
+    two_pi = 2 * math.pi
+    k = next(i for i in range(len(segs)) if states[i + 1][0] >= two_pi)
+    probe = Profile((segs[k],), *states[k])
+    tau = probe.time_at_angle(two_pi)
+    first, second = _split(segs[k], tau)
+    _, om, al, _ = advance(*states[k], segs[k].j0, segs[k].j1, tau)
+    order = [second] + segs[k + 1 :] + segs[:k] + [first]
+    order = [s for s in order if s.duration > 0]
+    return Profile(tuple(order), 0.0, float(om), float(al))
+
+
+def params_from_numbers(values: dict[str, float], theta2: float, theta3: float) -> CycleParameters:
+    """A numeric :class:`CycleParameters` from the NLP variable values (inside units)."""
+    keys = [f for f in CycleParameters.__dataclass_fields__ if f not in ("draw_start", "draw_end")]
+    return CycleParameters(**{k: float(values[k]) for k in keys}, draw_start=theta2, draw_end=theta3)

@@ -1,0 +1,124 @@
+"""Piecewise linear-jerk motion profiles of the crank, evaluated in closed form.
+
+A profile is a start state ``(theta0 [rad], omega0 [rad/s], alpha0 [rad/s^2])`` and a list of
+segments, each a duration ``T`` [s] with a jerk that is linear in the local time ``tau`` [s]::
+
+    j(tau) = j0 + j1 tau                    [rad/s^3]
+    alpha(tau) = alpha0 + j0 tau + j1 tau^2 / 2
+    omega(tau) = omega0 + alpha0 tau + j0 tau^2 / 2 + j1 tau^3 / 6
+    theta(tau) = theta0 + omega0 tau + alpha0 tau^2 / 2 + j0 tau^3 / 6 + j1 tau^4 / 24
+
+Every motion law of the project (constant speed, the improved S-curve's ten segments) is such a
+list, so one evaluator serves the optimizer (with CasADi symbols), the plan and the verification
+(with numpy arrays). The state is continuous at every knot by construction.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any, NamedTuple
+
+import numpy as np
+
+
+class Segment(NamedTuple):
+    """One segment: ``name``, ``duration`` [s], jerk ``j0`` [rad/s^3] + ``j1`` [rad/s^4] * tau."""
+
+    name: str
+    duration: Any
+    j0: Any
+    j1: Any
+
+
+def advance(theta0: Any, omega0: Any, alpha0: Any, j0: Any, j1: Any, tau: Any) -> tuple[Any, Any, Any, Any]:
+    """State ``(theta [rad], omega [rad/s], alpha [rad/s^2], jerk [rad/s^3])`` after ``tau`` [s]
+    inside a segment with jerk ``j0 + j1 tau`` that starts at ``(theta0, omega0, alpha0)``."""
+    jerk = j0 + j1 * tau
+    alpha = alpha0 + j0 * tau + j1 * tau**2 / 2
+    omega = omega0 + alpha0 * tau + j0 * tau**2 / 2 + j1 * tau**3 / 6
+    theta = theta0 + omega0 * tau + alpha0 * tau**2 / 2 + j0 * tau**3 / 6 + j1 * tau**4 / 24
+    return theta, omega, alpha, jerk
+
+
+def knot_states(theta0: Any, omega0: Any, alpha0: Any, segments: Sequence[Segment]) -> list[tuple[Any, Any, Any]]:
+    """States ``(theta, omega, alpha)`` at the start of every segment and at the end of the last."""
+    states = [(theta0, omega0, alpha0)]
+    for seg in segments:
+        th, om, al, _ = advance(*states[-1], seg.j0, seg.j1, seg.duration)
+        states.append((th, om, al))
+    return states
+
+
+@dataclass(frozen=True)
+class Profile:
+    """A numeric piecewise linear-jerk profile starting at time ``t0`` [s].
+
+    ``segments`` hold plain floats; ``theta0`` [rad], ``omega0`` [rad/s], ``alpha0`` [rad/s^2].
+    """
+
+    segments: tuple[Segment, ...]
+    theta0: float
+    omega0: float
+    alpha0: float = 0.0
+    t0: float = 0.0
+
+    @property
+    def durations(self) -> np.ndarray:
+        """Segment durations [s]."""
+        return np.array([float(s.duration) for s in self.segments])
+
+    @property
+    def knot_times(self) -> np.ndarray:
+        """Times [s] of the segment boundaries, ``len(segments) + 1`` values."""
+        return self.t0 + np.concatenate([[0.0], np.cumsum(self.durations)])
+
+    @property
+    def duration(self) -> float:
+        """Total duration [s]."""
+        return float(self.durations.sum())
+
+    def knots(self) -> np.ndarray:
+        """Knot states as an array of shape ``(n + 1, 3)``: theta [rad], omega [rad/s], alpha [rad/s^2]."""
+        return np.array(knot_states(self.theta0, self.omega0, self.alpha0, self.segments), dtype=float)
+
+    def at_time(self, t: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(theta [rad], omega [rad/s], alpha [rad/s^2], jerk [rad/s^3])`` at times ``t`` [s].
+
+        Vectorised; times outside the profile are extrapolated from the first or last segment.
+        At a knot the later segment is used (jerk is right-continuous).
+        """
+        t = np.asarray(t, dtype=float)
+        knots = self.knots()
+        tk = self.knot_times
+        idx = np.clip(np.searchsorted(tk, t, side="right") - 1, 0, len(self.segments) - 1)
+        j0 = np.array([float(s.j0) for s in self.segments])[idx]
+        j1 = np.array([float(s.j1) for s in self.segments])[idx]
+        th0, om0, al0 = knots[idx, 0], knots[idx, 1], knots[idx, 2]
+        return advance(th0, om0, al0, j0, j1, t - tk[idx])
+
+    def time_at_angle(self, theta: float) -> float:
+        """First time [s] at which the (increasing) crank angle reaches ``theta`` [rad].
+
+        Bracketed by the knots, then refined by Newton steps on the closed form (bisection fallback).
+        """
+        knots = self.knots()
+        tk = self.knot_times
+        if theta < knots[0, 0] or theta > knots[-1, 0]:
+            raise ValueError("angle outside the profile")
+        k = int(np.clip(np.searchsorted(knots[:, 0], theta, side="right") - 1, 0, len(self.segments) - 1))
+        lo, hi = 0.0, float(self.segments[k].duration)
+        seg = self.segments[k]
+        tau = 0.5 * (lo + hi)
+        for _ in range(100):
+            th, om, _, _ = advance(*knots[k], float(seg.j0), float(seg.j1), tau)
+            err = th - theta
+            if abs(err) < 1e-14:
+                break
+            if err > 0:
+                hi = tau
+            else:
+                lo = tau
+            step = tau - err / om if om > 0 else 0.5 * (lo + hi)
+            tau = step if lo < step < hi else 0.5 * (lo + hi)
+        return float(tk[k] + tau)

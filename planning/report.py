@@ -1,0 +1,171 @@
+"""Plain-data views of a solved plan: the result dictionary, the dense trajectory, the summary text.
+
+Every output file is a function of a :class:`~planning.optimize.Solution` and its case; nothing here
+solves or verifies again.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from planning.case import KEY_POINT_NAMES, RPM, Case
+from planning.optimize import Solution
+from planning.verify import MAX_STEP_S
+
+TRAJECTORY_COLUMNS = (
+    "time_s",
+    "crank_angle_deg",
+    "crank_speed_rpm",
+    "crank_accel_rad_s2",
+    "crank_jerk_rad_s3",
+    "slider_height_mm",
+    "slider_speed_mm_s",
+    "slider_accel_mm_s2",
+)
+BINDING_SHARE = 1e-4  # a check within this share of its limit is reported as binding
+
+
+def trajectory(solution: Solution, case: Case, max_step: float = MAX_STEP_S) -> np.ndarray:
+    """One full cycle on a uniform time grid with step <= ``max_step`` [s]; columns as
+    :data:`TRAJECTORY_COLUMNS`; the first and last rows are one period apart."""
+    plan = solution.plan
+    n = int(math.ceil(plan.period / max_step))
+    t = np.linspace(0.0, plan.period, n + 1)
+    th, om, al, je = plan.profile.at_time(t)
+    h, v, a, _ = case.machine.slider(th, om, al, je)
+    return np.column_stack([t, np.degrees(th), om / RPM, al, je, h, v, a])
+
+
+def key_points(solution: Solution, case: Case) -> list[dict[str, Any]]:
+    """The four key points: name, angle [deg], time from TDC [s], height [mm], slider speed [mm/s]
+    (magnitude; ``direction`` down/up), crank speed [rpm]."""
+    plan = solution.plan
+    times = plan.key_times()
+    th, om, al, je = plan.profile.at_time(times)
+    h, v, _, _ = case.machine.slider(th, om, al, je)
+    return [
+        {
+            "name": name,
+            "angle_deg": float(math.degrees(plan.key_angles[i])),
+            "time_s": float(times[i]),
+            "height_mm": float(h[i]),
+            "slider_speed_mm_s": float(abs(v[i])),
+            "direction": "down" if v[i] < 0 else "up",
+            "crank_speed_rpm": float(om[i] / RPM),
+        }
+        for i, name in enumerate(KEY_POINT_NAMES)
+    ]
+
+
+def segments(solution: Solution) -> list[dict[str, Any]]:
+    """Every segment of the profile from TDC: name, duration [s], start/end angle [deg], jerk [rad/s^3]."""
+    prof = solution.plan.profile
+    knots = prof.knots()
+    out = []
+    for k, seg in enumerate(prof.segments):
+        T = float(seg.duration)
+        j_start, j_end = float(seg.j0), float(seg.j0 + seg.j1 * T)
+        out.append(
+            {
+                "name": seg.name,
+                "duration_s": T,
+                "start_time_s": float(prof.knot_times[k]),
+                "start_angle_deg": float(math.degrees(knots[k, 0])),
+                "end_angle_deg": float(math.degrees(knots[k + 1, 0])),
+                "jerk_rad_s3": j_start if abs(j_start) >= abs(j_end) else j_end,
+                "jerk_start_rad_s3": j_start,
+                "jerk_end_rad_s3": j_end,
+            }
+        )
+    return out
+
+
+def binding(solution: Solution) -> list[str]:
+    """Names of the inequality checks that sit at their limit (within :data:`BINDING_SHARE`)."""
+    out = []
+    for c in solution.verification.checks:
+        if c.kind in ("max", "min") and abs(c.margin) <= BINDING_SHARE * max(abs(c.limit), 1e-12):
+            out.append(c.name)
+    return out
+
+
+def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
+    """Everything ``result.json`` holds (engineering units in the keys)."""
+    plan = solution.plan
+    p = plan.parameters
+    ver = solution.verification
+    accel = next(c for c in ver.checks if c.name == "|slider acceleration|")
+    return {
+        "case": case.name,
+        "spm": plan.spm,
+        "cycle_time_s": plan.period,
+        "status": "verified" if ver.passed else "failed",
+        "verified": ver.passed,
+        "placement": plan.placement,
+        "motion_law": plan.motion_law,
+        "structure": plan.structure,
+        "draw_speed_rpm": float(p.draw_speed) / RPM,
+        "transfer_speed_rpm": float(p.transfer_speed) / RPM,
+        "feed_peak_speed_rpm": float(p.feed_peak_speed) / RPM,
+        "return_peak_speed_rpm": float(p.return_peak_speed) / RPM,
+        "feed_jerk_rad_s3": float(p.feed_jerk),
+        "return_jerk_rad_s3": float(p.return_jerk),
+        "transfer_time_s": plan.transfer_window(),
+        "max_abs_slider_accel_mm_s2": accel.value,
+        "binding_constraints": binding(solution),
+        "key_points": key_points(solution, case),
+        "segments": segments(solution),
+        "paper_solution": plan.paper_solution(),
+        "verification": {
+            "passed": ver.passed,
+            "step_s": ver.step_s,
+            "samples": ver.samples,
+            "checks": [c.as_dict() for c in ver.checks],
+        },
+        "solver": {
+            "iterations": plan.solver.iterations,
+            "wall_time_s": plan.solver.wall_time_s,
+            "starts": plan.solver.starts,
+            "status": plan.solver.status,
+        },
+    }
+
+
+def summary_text(result: dict[str, Any]) -> str:
+    """The console summary of a result dictionary."""
+    r = result
+    ps = r["paper_solution"]
+    lines = [
+        f"{r['case']}: {r['spm']:.3f} strokes/min, cycle {r['cycle_time_s']:.4f} s "
+        f"({r['motion_law']}, {r['placement']} placement, {r['status']})",
+        f"  theta1 (closing) in {r['structure']['closing']}, theta4 (opening) in {r['structure']['opening']}",
+        f"  crank speed: transfer {r['transfer_speed_rpm']:.3f} rpm, feed peak {r['feed_peak_speed_rpm']:.3f} rpm, "
+        f"draw {r['draw_speed_rpm']:.3f} rpm, return peak {r['return_peak_speed_rpm']:.3f} rpm",
+        f"  jerk: feed {r['feed_jerk_rad_s3']:.3f} rad/s^3, return {r['return_jerk_rad_s3']:.3f} rad/s^3",
+        f"  sub-segments: feed {ps['T1_s']:.4f} / {ps['T5_s']:.4f} s, return {ps['T10_s']:.4f} / "
+        f"{ps['T14_s']:.4f} s, draw {ps['T9_s']:.4f} s",
+        f"  transfer window theta4 -> theta1: {r['transfer_time_s']:.4f} s; "
+        f"max |slider accel| {r['max_abs_slider_accel_mm_s2']:.1f} mm/s^2",
+        "",
+        f"  {'key point':<11} {'angle deg':>9} {'time s':>8} {'height mm':>9} {'slider mm/s':>11} {'crank rpm':>9}",
+    ]
+    for k in r["key_points"]:
+        lines.append(
+            f"  {k['name']:<11} {k['angle_deg']:9.2f} {k['time_s']:8.4f} {k['height_mm']:9.1f} "
+            f"{k['slider_speed_mm_s']:8.1f} {k['direction']:<2} {k['crank_speed_rpm']:9.3f}"
+        )
+    lines.append("")
+    lines.append("  binding: " + (", ".join(r["binding_constraints"]) or "none"))
+    v = r["verification"]
+    lines.append(
+        f"  verified on {v['samples']} points (step {v['step_s'] * 1e3:.3f} ms): "
+        + ("all checks pass" if v["passed"] else "FAILED")
+    )
+    lines.append(
+        f"  solver: {r['solver']['iterations']} iterations, {r['solver']['starts']} starts, "
+        f"{r['solver']['wall_time_s']:.3f} s"
+    )
+    return "\n".join(lines)

@@ -1,0 +1,177 @@
+"""Independent verification of a plan: dense closed-form re-simulation against every constraint.
+
+The plan's profile is evaluated in closed form on a uniform grid of at most 1 ms (not at the
+optimizer's sample points), plus every knot, and each constraint of the case is checked with the
+tolerances below (the README's numerical contract). Only a plan whose checks all pass is a success.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from planning.case import RPM, Case
+from planning.plan import Plan
+
+MAX_STEP_S = 1e-3  # [s] dense grid step (at most)
+REL_TOL = 1e-6  # relative tolerance on every limit
+ANGLE_TOL = 1e-6  # [rad] key angles and cycle closure
+TIME_TOL = 1e-6  # [s] transfer time
+SPEED_TOL = 1e-9  # [rad/s] continuity and constant-speed draw
+ACCEL_CHECK = "|slider acceleration|"
+
+
+@dataclass(frozen=True)
+class Check:
+    """One verified constraint: measured ``value`` against ``limit`` (``kind`` max|min|equal) in ``unit``."""
+
+    name: str
+    value: float
+    limit: float
+    unit: str
+    kind: str
+    passed: bool
+
+    @property
+    def margin(self) -> float:
+        """Distance to the limit, positive when satisfied (for ``equal``: minus the error)."""
+        if self.kind == "max":
+            return self.limit - self.value
+        if self.kind == "min":
+            return self.value - self.limit
+        return -abs(self.value - self.limit)
+
+    def as_dict(self) -> dict:
+        return {**asdict(self), "margin": self.margin}
+
+
+@dataclass(frozen=True)
+class Verification:
+    """All checks of a plan; ``passed`` when every one holds. ``step_s`` [s] is the grid step used."""
+
+    checks: tuple[Check, ...]
+    step_s: float
+    samples: int
+
+    @property
+    def passed(self) -> bool:
+        return all(c.passed for c in self.checks)
+
+    def failures(self) -> list[Check]:
+        return [c for c in self.checks if not c.passed]
+
+
+def dense_times(period: float, knot_times: np.ndarray, max_step: float = MAX_STEP_S) -> np.ndarray:
+    """A uniform grid over ``[0, period]`` [s] with step <= ``max_step``, merged with the knots."""
+    n = int(math.ceil(period / max_step))
+    grid = np.linspace(0.0, period, n + 1)
+    return np.unique(np.concatenate([grid, knot_times]))
+
+
+def verify(plan: Plan, case: Case) -> Verification:
+    """Re-simulate ``plan`` densely and check it against the limits of ``case``."""
+    prof = plan.profile
+    P = plan.period
+    machine = case.machine
+    lim = case.limits
+    t = dense_times(P, prof.knot_times)
+    th, om, al, je = prof.at_time(t)
+    h, v, a, _ = machine.slider(th, om, al, je)
+    checks: list[Check] = []
+
+    def add(name: str, value: float, limit: float, unit: str, kind: str, tol: float) -> None:
+        value, limit = float(value), float(limit)
+        if not math.isfinite(value):
+            ok = False
+        elif kind == "max":
+            ok = value <= limit + tol
+        elif kind == "min":
+            ok = value >= limit - tol
+        else:
+            ok = abs(value - limit) <= tol
+        checks.append(Check(name, value, limit, unit, kind, ok))
+
+    finite = bool(np.all(np.isfinite(np.concatenate([th, om, al, h, v, a]))))
+    add("trajectory finite", 1.0 if finite else math.nan, 1.0, "", "equal", 0.0)
+    # the cycle closes: 360 deg, same speed and acceleration at both ends
+    end = prof.at_time(np.array([0.0, P]))
+    add("cycle angle", math.degrees(end[0][1] - end[0][0]), 360.0, "deg", "equal", math.degrees(ANGLE_TOL))
+    add("speed closes", (end[1][1] - end[1][0]) / RPM, 0.0, "rpm", "equal", SPEED_TOL / RPM)
+    add("acceleration closes", end[2][1] - end[2][0], 0.0, "rad/s^2", "equal", 1e-6)
+    # continuity at the knots: left limit of each segment against the right one
+    knots = prof.knot_times[1:-1]
+    if knots.size:
+        eps = 1e-9
+        left = prof.at_time(knots - eps)
+        right = prof.at_time(knots + eps)
+        jump_w = float(np.max(np.abs(right[1] - left[1])))
+        jump_a = float(np.max(np.abs(right[2] - left[2])))
+        add("crank speed continuous at knots", jump_w, 0.0, "rad/s", "equal", 1e-6)
+        add("crank acceleration continuous at knots", jump_a, 0.0, "rad/s^2", "equal", 1e-4)
+    # key angles and the transfer window
+    key_t = plan.key_times()
+    th_key = prof.at_time(key_t)[0]
+    err = float(np.max(np.abs(th_key - np.array(plan.key_angles))))
+    add("key angles reached", math.degrees(err), 0.0, "deg", "equal", math.degrees(ANGLE_TOL))
+    t1, t2, t3, t4 = key_t
+    add("transfer time theta4 -> theta1", t1 + P - t4, case.process.transfer_time_s, "s", "min", TIME_TOL)
+    window = (t >= t4) | (t <= t1)
+    add(
+        "slider at or above the safety height from theta4 to theta1",
+        float(np.min(h[window])),
+        case.process.safety_height_mm,
+        "mm",
+        "min",
+        REL_TOL * case.process.safety_height_mm,
+    )
+    # the draw at constant speed
+    draw = (t >= t2) & (t <= t3)
+    w2 = float(plan.parameters.draw_speed)
+    add(
+        "draw at constant crank speed", float(np.max(np.abs(om[draw] - w2))) / RPM, 0.0, "rpm", "equal", SPEED_TOL / RPM
+    )
+    v2 = abs(float(machine.slider(plan.key_angles[1], w2)[1]))
+    add(
+        "slider speed at the draw start",
+        v2,
+        lim.draw_start_speed_mm_s,
+        "mm/s",
+        "max",
+        REL_TOL * lim.draw_start_speed_mm_s,
+    )
+    low = h <= lim.die_height_mm
+    crossings = [float(x) for x in machine.angles_at_height(min(lim.die_height_mm, machine.stroke))]
+    v_cross = [abs(s) for s in _slider_speed_at_angles(plan, case, crossings)]
+    v_die = max(([float(np.max(np.abs(v[low])))] if low.any() else [0.0]) + v_cross)
+    add(
+        "slider speed at or below the die height",
+        v_die,
+        lim.die_speed_mm_s,
+        "mm/s",
+        "max",
+        REL_TOL * lim.die_speed_mm_s,
+    )
+    add(
+        ACCEL_CHECK, float(np.max(np.abs(a))), lim.slider_accel_mm_s2, "mm/s^2", "max", REL_TOL * lim.slider_accel_mm_s2
+    )
+    add(
+        "crank speed (forward, never stops)",
+        float(np.min(om)) / RPM,
+        lim.min_crank_speed_rpm,
+        "rpm",
+        "min",
+        REL_TOL * lim.min_crank_speed_rpm,
+    )
+    return Verification(tuple(checks), float(np.max(np.diff(t))), int(t.size))
+
+
+def _slider_speed_at_angles(plan: Plan, case: Case, angles: list[float]) -> list[float]:
+    """Slider speed [mm/s] where the crank passes each of ``angles`` [rad]."""
+    out = []
+    for ang in angles:
+        tt = plan.profile.time_at_angle(ang)
+        th, om, al, je = plan.profile.at_time(np.array([tt]))
+        out.append(float(case.machine.slider(th, om, al, je)[1][0]))
+    return out

@@ -1,0 +1,5 @@
+"""The machine: crank-slider geometry and kinematics."""
+
+from press.kinematics import CrankSlider
+
+__all__ = ["CrankSlider"]
