@@ -78,7 +78,9 @@ def _first_line(text: str) -> str:
 
 
 def _pydantic_line(exc: ValidationError, data: Any, label: str) -> str:
-    err = exc.errors(include_url=False)[0]
+    errors = exc.errors(include_url=False)
+    # an unknown key explains a "missing" one next to it (a typo): report it first
+    err = min(errors, key=lambda e: 0 if e["type"] == "extra_forbidden" else 1)
     loc = [str(p) for p in err["loc"]]
     field = ".".join(loc)
     kind = err["type"]

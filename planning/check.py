@@ -86,8 +86,8 @@ def check_text(report: dict[str, Any]) -> str:
     ]
     for k in report["key_points"]:
         lines.append(
-            f"  {k['name']:<11} {k['angle_deg']:9.2f} {k['height_mm']:10.1f} "
-            f"{k['slider_speed_mm_s']:14.1f} {k['direction']:<3}"
+            f"  {k['name']:<11} {k['angle_deg']:9.2f} {k['height_mm']:10.2f} "
+            f"{k['slider_speed_mm_s']:14.2f} {k['direction']:<3}"
         )
     lines += ["", "  checks"]
     for c in report["checks"]:

@@ -52,6 +52,15 @@ def precheck(case: Case) -> tuple[float, float]:
     """
     bounds = draw_speed_bounds(case)
     w_min = case.limits.min_crank_speed_rpm * RPM
+    th1, _, _, th4 = case.key_angles
+    window = th1 + 2 * math.pi - th4
+    if window / w_min < case.process.transfer_time_s:
+        raise PlanningError(
+            "infeasible",
+            f"transfer_time_s = {case.process.transfer_time_s:g} cannot be met: at min_crank_speed_rpm = "
+            f"{case.limits.min_crank_speed_rpm:g} the crank crosses the {math.degrees(window):.1f} deg from "
+            f"theta4 to theta1 in at most {window / w_min:.3f} s",
+        )
     w_given = case.process.draw_speed_rpm
     if w_given is not None:
         w2 = w_given * RPM

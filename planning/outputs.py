@@ -63,7 +63,7 @@ def write_json(path: Path, data: dict) -> None:
 
 def write_trajectory(path: Path, table: np.ndarray) -> None:
     header = ",".join(TRAJECTORY_COLUMNS)
-    np.savetxt(path, table, delimiter=",", header=header, comments="", fmt="%.10g")
+    np.savetxt(path, table, delimiter=",", header=header, comments="", fmt="%.12g")
 
 
 def solution_writers(solution: Solution, case: Case) -> dict[str, Callable[[Path], None]]:

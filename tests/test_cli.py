@@ -1,0 +1,117 @@
+"""The ``pressplan`` command end to end: check, solve, outputs, exit codes, safe writing."""
+
+from __future__ import annotations
+
+import csv
+import json
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from planning.cli import main
+from planning.report import TRAJECTORY_COLUMNS
+
+from .conftest import PUBLISHED_CASE
+
+INFEASIBLE = sorted((Path(__file__).parent / "data" / "infeasible").glob("*.yaml"))
+
+
+def test_check_prints_the_published_key_points(capsys):
+    assert main(["check", str(PUBLISHED_CASE)]) == 0
+    out = capsys.readouterr().out
+    for number in ("705.64", "200.12", "9.38", "297.69", "75.12"):
+        assert number in out
+    assert "FAIL" not in out
+
+
+def test_check_json(capsys):
+    assert main(["check", str(PUBLISHED_CASE), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert [k["name"] for k in data["key_points"]] == ["closing", "draw_start", "draw_end", "opening"]
+    heights = [round(k["height_mm"], 1) for k in data["key_points"]]
+    speeds = [round(k["slider_speed_mm_s"], 1) for k in data["key_points"]]
+    assert heights[1:3] == [200.1, 9.4]
+    assert heights[0] == heights[3] == 705.6  # the paper prints 705.7; see test_kinematics
+    assert speeds[1:3] == [297.7, 75.1]
+    assert 6.7 < data["max_draw_speed_rpm"] < 6.76
+    assert all(c["passed"] for c in data["checks"])
+
+
+@pytest.fixture(scope="module")
+def solved(tmp_path_factory):
+    out = tmp_path_factory.mktemp("solve") / "published"
+    code = main(["solve", str(PUBLISHED_CASE), "--out", str(out), "--placement", "published"])
+    assert code == 0
+    return out
+
+
+def test_solve_writes_result_json(solved):
+    r = json.loads((solved / "result.json").read_text())
+    for key in ("spm", "cycle_time_s", "status", "verified", "placement", "motion_law", "draw_speed_rpm",
+                "transfer_time_s", "max_abs_slider_accel_mm_s2", "key_points", "segments", "paper_solution",
+                "solver"):
+        assert key in r
+    assert r["verified"] is True and r["status"] == "verified"
+    assert 11.6 <= r["spm"] <= 11.8
+    assert r["cycle_time_s"] == pytest.approx(60 / r["spm"])
+    assert set(r["solver"]) >= {"iterations", "wall_time_s"}
+    assert {k["name"] for k in r["key_points"]} == {"closing", "draw_start", "draw_end", "opening"}
+    for k in r["key_points"]:
+        assert set(k) >= {"name", "angle_deg", "time_s", "height_mm", "slider_speed_mm_s", "crank_speed_rpm"}
+    assert sum(s["duration_s"] for s in r["segments"]) == pytest.approx(r["cycle_time_s"], abs=1e-9)
+    for s in r["segments"]:
+        assert set(s) >= {"name", "duration_s", "start_angle_deg", "end_angle_deg", "jerk_rad_s3"}
+    x = r["paper_solution"]
+    assert list(x)[:13] == ["x1_s", "x2_s", "x3_s", "x4_s", "x5_s", "wm1_rpm", "wm2_rpm", "T1_s", "T5_s", "T9_s",
+                            "T10_s", "T14_s", "J_rpm_s2"]
+    assert x["x5_s"] == pytest.approx(r["cycle_time_s"])
+
+
+def test_solve_writes_trajectory_csv(solved):
+    r = json.loads((solved / "result.json").read_text())
+    with open(solved / "trajectory.csv", newline="") as fh:
+        header = next(csv.reader(fh))
+    assert tuple(header) == TRAJECTORY_COLUMNS
+    tab = np.loadtxt(solved / "trajectory.csv", delimiter=",", skiprows=1)
+    dt = np.diff(tab[:, 0])
+    assert dt.max() <= 1e-3 + 1e-12 and dt.max() - dt.min() < 1e-9  # uniform, <= 1 ms
+    assert tab[-1, 0] - tab[0, 0] == pytest.approx(r["cycle_time_s"], abs=1e-9)
+    assert tab[-1, 1] - tab[0, 1] == pytest.approx(360.0, abs=1e-7)
+    assert np.all(np.diff(tab[:, 1]) > 0)
+    assert np.all(np.isfinite(tab))
+
+
+def test_solve_prints_the_summary(capsys, tmp_path):
+    assert main(["solve", str(PUBLISHED_CASE), "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert re.search(r"1[12]\.\d{3} strokes/min", out)
+    assert "binding:" in out and "theta1 (closing) in" in out
+
+
+@pytest.mark.parametrize("path", INFEASIBLE, ids=lambda p: p.name)
+def test_infeasible_exit_3_names_the_limit_and_writes_nothing(path, tmp_path, capsys):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "result.json").write_text("earlier run")
+    assert main(["solve", str(path), "--out", str(out)]) == 3
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "infeasible" in err
+    expect = path.read_text().splitlines()[0].removeprefix("# expect: ")
+    assert expect in err
+    assert (out / "result.json").read_text() == "earlier run"  # replaced only on success
+    assert sorted(p.name for p in out.iterdir()) == ["result.json"]
+
+
+def test_unwritable_output_is_bad_input(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    assert main(["solve", str(PUBLISHED_CASE), "--out", str(blocker / "sub")]) == 2
+    assert len(capsys.readouterr().err.strip().splitlines()) == 1
+
+
+def test_case_file_is_never_written(tmp_path):
+    before = PUBLISHED_CASE.read_bytes()
+    main(["check", str(PUBLISHED_CASE)])
+    assert PUBLISHED_CASE.read_bytes() == before
