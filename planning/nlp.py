@@ -1,7 +1,8 @@
 """The CasADi nonlinear program of one improved-S-curve press cycle (all CasADi lives here).
 
-Built once per placement structure and reused: every number of a case enters as a parameter, so a
-sweep or a multi-start only calls the compiled solver again. Decision variables are scaled to O(1).
+Built once per process and reused: every number of a case enters as a parameter and the placement
+structure is a pair of constraint rows whose bounds are set per solve, so a sweep, a multi-start or
+the other placement only calls the compiled solver again. Decision variables are scaled to O(1).
 
 Time 0 of the NLP is the end of the draw (theta3); the stages follow as in ``planning.cycle``. The
 crank angle at any time t before the draw is evaluated in closed form as
@@ -67,8 +68,10 @@ PARAMETERS: tuple[str, ...] = (
     "die_speed",  # [mm/s]
     "die_down_angle",  # target angle of the descending crossing [rad] (theta2 when inside the draw)
     "die_down_slope",  # |dh/dtheta| there [mm/rad], 0 when the crossing lies in the draw
+    "die_down_active",  # 1 when the crossing lies outside the draw, else 0 (its time is then fixed)
     "die_up_angle",
     "die_up_slope",
+    "die_up_active",
 )
 PARAMETER_INDEX = {name: i for i, name in enumerate(PARAMETERS)}
 
@@ -85,31 +88,37 @@ class ConstraintBlock:
     stop: int
 
 
-def _angle_at(t: ca.SX, starts: list, durations: list, states: list, segs: list) -> tuple[ca.SX, ca.SX]:
+def _angle_at(t: ca.SX, starts: ca.SX, segs: dict[str, ca.SX]) -> tuple[ca.SX, ca.SX]:
     """Closed-form crank angle and speed at time ``t`` [s] over the segments (clip formulation)."""
-    theta = states[0][0]
-    omega = states[0][1]
-    for s_k, T_k, st, seg in zip(starts, durations, states, segs, strict=False):
-        tau = ca.fmin(ca.fmax(t - s_k, 0), T_k)
-        th, om, _, _ = advance(0.0, st[1], st[2], seg.j0, seg.j1, tau)
-        theta = theta + th
-        omega = omega + (om - st[1])
-    return theta, omega
+    tau = ca.fmin(ca.fmax(t - starts, 0), segs["T"])
+    th, om, _, _ = advance(0.0, segs["omega"], segs["alpha"], segs["j0"], segs["j1"], tau)
+    return segs["theta0"] + ca.sum1(th), segs["omega0"] + ca.sum1(om - segs["omega"])
 
 
 @dataclass
 class CycleNLP:
-    """A compiled NLP for one placement structure; see the module docstring."""
+    """The compiled NLP; see the module docstring. ``free_rows`` hold theta1 and theta4 anywhere
+    (clip formulation), ``published_rows`` pin them to the knots of the published structure; the
+    rows of the other placement are left unbounded."""
 
-    placement: Placement
     solver: ca.Function
     lbg: np.ndarray
     ubg: np.ndarray
     blocks: tuple[ConstraintBlock, ...]
-    sample_fn: ca.Function  # (x, p) -> slider acceleration at the samples [mm/s^2]
+    free_rows: slice
+    published_rows: slice
+
+    def bounds(self, placement: Placement) -> tuple[np.ndarray, np.ndarray]:
+        """``(lbg, ubg)`` for ``placement``."""
+        lbg, ubg = self.lbg.copy(), self.ubg.copy()
+        off = self.free_rows if placement == "published" else self.published_rows
+        on = self.published_rows if placement == "published" else self.free_rows
+        lbg[off], ubg[off] = -np.inf, np.inf
+        lbg[on], ubg[on] = 0.0, 0.0
+        return lbg, ubg
 
 
-def _build(placement: Placement) -> CycleNLP:
+def _build() -> CycleNLP:
     x = ca.SX.sym("x", len(VARIABLES))
     p = ca.SX.sym("p", len(PARAMETERS))
     v = {name: x[i] * scale for i, (name, scale) in enumerate(VARIABLES)}
@@ -134,20 +143,31 @@ def _build(placement: Placement) -> CycleNLP:
     starts = [0.0]
     for T in durations[:-1]:
         starts.append(starts[-1] + T)
-    before_draw = segs[:-1]  # the 17 segments from theta3 to theta2
+    n_before = len(segs) - 1  # the 17 segments from theta3 to theta2 (all but the draw)
+    before = {
+        "T": ca.vertcat(*durations[:n_before]),
+        "omega": ca.vertcat(*[st[1] for st in states[:n_before]]),
+        "alpha": ca.vertcat(*[st[2] for st in states[:n_before]]),
+        "j0": ca.vertcat(*[s.j0 for s in segs[:n_before]]),
+        "j1": ca.vertcat(*[s.j1 for s in segs[:n_before]]),
+        "theta0": states[0][0],
+        "omega0": states[0][1],
+    }
+    start_vec = ca.vertcat(*starts[:n_before])
 
     blocks: list[ConstraintBlock] = []
     g: list = []
     lb: list = []
     ub: list = []
 
-    def add(name: str, expr: ca.SX, lo, hi) -> None:
+    def add(name: str, expr: ca.SX, lo, hi) -> slice:
         expr = ca.vec(expr)
         n = expr.shape[0]
         blocks.append(ConstraintBlock(name, len(lb), len(lb) + n))
         g.append(expr)
         lb.extend(np.broadcast_to(lo, (n,)).tolist())
         ub.extend(np.broadcast_to(hi, (n,)).tolist())
+        return slice(len(lb) - n, len(lb))
 
     w1, w2 = params.transfer_speed, params.draw_speed
     # Eq. 19 for each S-curve: the speeds meet
@@ -170,28 +190,53 @@ def _build(placement: Placement) -> CycleNLP:
         0.0,
     )
     # the cycle closes: theta at the draw start is theta2 + 2 pi
-    add("cycle closes", states[len(before_draw)][0] - (q["theta2"] + 2 * np.pi), 0.0, 0.0)
+    add("cycle closes", states[n_before][0] - (q["theta2"] + 2 * np.pi), 0.0, 0.0)
 
-    n_ret = 2 * sc.SUBSEGMENTS
-    if placement == "published":
-        t4 = starts[sc.SUBSEGMENTS] + 3 * params.return_decel_time
-        t1 = starts[n_ret + 1] + params.feed_accel_time
-    else:
-        t4, t1 = v["opening_time"], v["closing_time"]
-    sel = slice(0, len(before_draw))
-    th4, _ = _angle_at(t4, starts[sel], durations[sel], states[sel], before_draw)
-    th1, _ = _angle_at(t1, starts[sel], durations[sel], states[sel], before_draw)
-    add("opening angle", th4 - q["theta4"], 0.0, 0.0)
-    add("closing angle", th1 - (q["theta1"] + 2 * np.pi), 0.0, 0.0)
+    n = sc.SUBSEGMENTS
+    t4, t1 = v["opening_time"], v["closing_time"]
+    th4, _ = _angle_at(t4, start_vec, before)
+    th1, _ = _angle_at(t1, start_vec, before)
+    free_rows = add(
+        "key angles (free placement)",
+        ca.vertcat(th4 - q["theta4"], th1 - (q["theta1"] + 2 * np.pi)),
+        0.0,
+        0.0,
+    )
     add("transfer time", t1 - t4 - q["transfer_time"], 0.0, np.inf)
-    if placement == "free":
-        t_end_feed = starts[len(before_draw)]
-        add("key points in order", ca.vertcat(t4, t1 - t4, t_end_feed - t1), 0.0, np.inf)
+    t_end = starts[n_before]
+    add(
+        "key points in order",
+        ca.vertcat(t4, t1 - t4, t_end - t1, t_end - v["die_down_time"], t_end - v["die_up_time"]),
+        0.0,
+        np.inf,
+    )
+    # published structure (Fig. 6): theta4 at x3 + 3 T14, theta1 at x1 + T1, i.e. at two knots, so the
+    # key angles are smooth knot states; bounds switched per solve
+    k4, k1 = n + 3, 2 * n + 2  # knots: end of the 3rd return-decel / 1st feed-accel sub-segment
+    published_rows = add(
+        "key angles (published placement)",
+        ca.vertcat(
+            t4 - starts[k4],
+            t1 - starts[k1],
+            states[k4][0] - q["theta4"],
+            states[k1][0] - (q["theta1"] + 2 * np.pi),
+        ),
+        -np.inf,
+        np.inf,
+    )
 
     # die-height crossings outside the draw
-    thd, omd = _angle_at(v["die_down_time"], starts[sel], durations[sel], states[sel], before_draw)
-    thu, omu = _angle_at(v["die_up_time"], starts[sel], durations[sel], states[sel], before_draw)
-    add("die crossing angles", ca.vertcat(thd - (q["die_down_angle"] + 2 * np.pi), thu - q["die_up_angle"]), 0.0, 0.0)
+    thd, omd = _angle_at(v["die_down_time"], start_vec, before)
+    thu, omu = _angle_at(v["die_up_time"], start_vec, before)
+    add(
+        "die crossing angles",
+        ca.vertcat(
+            q["die_down_active"] * (thd - (q["die_down_angle"] + 2 * np.pi)),
+            q["die_up_active"] * (thu - q["die_up_angle"]),
+        ),
+        0.0,
+        0.0,
+    )
     add(
         "die-height speed",
         ca.vertcat(q["die_down_slope"] * omd, q["die_up_slope"] * omu) / q["die_speed"],
@@ -199,19 +244,23 @@ def _build(placement: Placement) -> CycleNLP:
         1.0,
     )
 
-    # slider acceleration at sample points of every segment
-    acc = []
+    # slider acceleration at sample points of every segment, evaluated as one vector
+    cols: dict[str, list] = {k: [] for k in ("theta", "omega", "alpha", "j0", "j1", "tau")}
     for seg, st in zip(segs, states[:-1], strict=True):
-        n = SAMPLES_CONSTANT if seg.name in ("transfer:dwell", "draw:constant") else SAMPLES_PER_SUBSEGMENT
-        for f in np.linspace(0.0, 1.0, n + 1)[:-1] if seg.name != "draw:constant" else np.linspace(0, 1, n + 1):
-            th, om, al, _ = advance(st[0], st[1], st[2], seg.j0, seg.j1, f * seg.duration)
-            d1, d2, _ = height_derivatives(th, q["R"], q["L"])
-            acc.append(d2 * om**2 + d1 * al)
-    acc = ca.vertcat(*acc)
+        constant = seg.name in ("transfer:dwell", "draw:constant")
+        fractions = np.linspace(0.0, 1.0, (SAMPLES_CONSTANT if constant else SAMPLES_PER_SUBSEGMENT) + 1)
+        if seg.name != "draw:constant":
+            fractions = fractions[:-1]  # the end is the next segment's start
+        for f in fractions:
+            for key, val in zip(("theta", "omega", "alpha", "j0", "j1"), (*st, seg.j0, seg.j1), strict=True):
+                cols[key].append(val)
+            cols["tau"].append(f * seg.duration)
+    th, om, al, _ = advance(*(ca.vertcat(*cols[k]) for k in ("theta", "omega", "alpha", "j0", "j1", "tau")))
+    d1, d2, _ = height_derivatives(th, q["R"], q["L"])
+    acc = d2 * om**2 + d1 * al
     add("slider acceleration", acc / q["accel_limit"], -1.0, 1.0)
 
-    period = params.period
-    nlp = {"x": x, "p": p, "f": period, "g": ca.vertcat(*g)}
+    nlp = {"x": x, "p": p, "f": params.period, "g": ca.vertcat(*g)}
     opts = {
         "ipopt.print_level": 0,
         "print_time": False,
@@ -221,12 +270,11 @@ def _build(placement: Placement) -> CycleNLP:
         "ipopt.max_iter": 1000,
         "ipopt.mu_strategy": "adaptive",
     }
-    solver = ca.nlpsol(f"cycle_{placement}", "ipopt", nlp, opts)
-    sample_fn = ca.Function("slider_accel_samples", [x, p], [acc])
-    return CycleNLP(placement, solver, np.array(lb), np.array(ub), tuple(blocks), sample_fn)
+    solver = ca.nlpsol("press_cycle", "ipopt", nlp, opts)
+    return CycleNLP(solver, np.array(lb), np.array(ub), tuple(blocks), free_rows, published_rows)
 
 
 @cache
-def cycle_nlp(placement: Placement) -> CycleNLP:
-    """The compiled NLP for ``placement`` (built on first use, then reused)."""
-    return _build(placement)
+def cycle_nlp() -> CycleNLP:
+    """The compiled NLP (built on first use in a process, then reused for every case and start)."""
+    return _build()

@@ -49,9 +49,21 @@ def solved(tmp_path_factory):
 
 def test_solve_writes_result_json(solved):
     r = json.loads((solved / "result.json").read_text())
-    for key in ("spm", "cycle_time_s", "status", "verified", "placement", "motion_law", "draw_speed_rpm",
-                "transfer_time_s", "max_abs_slider_accel_mm_s2", "key_points", "segments", "paper_solution",
-                "solver"):
+    for key in (
+        "spm",
+        "cycle_time_s",
+        "status",
+        "verified",
+        "placement",
+        "motion_law",
+        "draw_speed_rpm",
+        "transfer_time_s",
+        "max_abs_slider_accel_mm_s2",
+        "key_points",
+        "segments",
+        "paper_solution",
+        "solver",
+    ):
         assert key in r
     assert r["verified"] is True and r["status"] == "verified"
     assert 11.6 <= r["spm"] <= 11.8
@@ -64,8 +76,21 @@ def test_solve_writes_result_json(solved):
     for s in r["segments"]:
         assert set(s) >= {"name", "duration_s", "start_angle_deg", "end_angle_deg", "jerk_rad_s3"}
     x = r["paper_solution"]
-    assert list(x)[:13] == ["x1_s", "x2_s", "x3_s", "x4_s", "x5_s", "wm1_rpm", "wm2_rpm", "T1_s", "T5_s", "T9_s",
-                            "T10_s", "T14_s", "J_rpm_s2"]
+    assert list(x)[:13] == [
+        "x1_s",
+        "x2_s",
+        "x3_s",
+        "x4_s",
+        "x5_s",
+        "wm1_rpm",
+        "wm2_rpm",
+        "T1_s",
+        "T5_s",
+        "T9_s",
+        "T10_s",
+        "T14_s",
+        "J_rpm_s2",
+    ]
     assert x["x5_s"] == pytest.approx(r["cycle_time_s"])
 
 

@@ -1,0 +1,88 @@
+"""Speed of the default solve of the published case; writes benchmarks/RESULTS.md.
+
+Measures (a) the in-process solve after a warm-up (the NLP already built), (b) a cold
+``pressplan solve`` process beside a process that only imports casadi, numpy, matplotlib and yaml,
+and (c) the NLP build alone. Medians; run with ``python benchmarks/bench_solve.py`` from the project
+root in the environment where pressplan is installed.
+"""
+
+from __future__ import annotations
+
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from datetime import datetime, timezone
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+CASE = ROOT / "cases" / "wang2023-side-panel.yaml"
+COLD_RUNS = 5
+WARM_RUNS = 7
+
+
+def timed(cmd: list[str]) -> float:
+    t = time.perf_counter()
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    return time.perf_counter() - t
+
+
+def main() -> None:
+    import casadi
+
+    from planning.case_file import read_case
+    from planning.nlp import _build
+    from planning.optimize import solve
+
+    case = read_case(CASE)
+    t = time.perf_counter()
+    _build()
+    build = time.perf_counter() - t
+    first = solve(case)  # warm-up: builds the cached NLP
+    warm = []
+    for _ in range(WARM_RUNS):
+        t = time.perf_counter()
+        sol = solve(case)
+        warm.append(time.perf_counter() - t)
+    assert sol.verification.passed and abs(sol.plan.spm - first.plan.spm) < 1e-9
+
+    exe = Path(sys.executable).with_name("pressplan")
+    imports, cold = [], []
+    with tempfile.TemporaryDirectory() as tmp:
+        for _ in range(COLD_RUNS):
+            imports.append(timed([sys.executable, "-c", "import casadi, numpy, matplotlib, yaml"]))
+            cold.append(timed([str(exe), "solve", str(CASE), "--out", tmp]))
+    med = statistics.median
+    rows = [
+        ("NLP build (once per process)", build),
+        (f"in-process solve, warm (median of {WARM_RUNS})", med(warm)),
+        (f"import casadi, numpy, matplotlib, yaml (median of {COLD_RUNS})", med(imports)),
+        (f"cold `pressplan solve` process (median of {COLD_RUNS})", med(cold)),
+        ("cold solve beyond the imports", med(cold) - med(imports)),
+    ]
+    lines = [
+        "# Benchmarks",
+        "",
+        "Written by `python benchmarks/bench_solve.py` (do not edit by hand).",
+        "",
+        f"Machine: {os.cpu_count()} cores, {platform.machine()}, Python {platform.python_version()}, "
+        f"CasADi {casadi.__version__}; {datetime.now(timezone.utc):%Y-%m-%d}.",
+        "",
+        f"Default solve of `{CASE.relative_to(ROOT)}`: {sol.plan.spm:.3f} SPM, "
+        f"{sol.plan.solver.iterations} IPOPT iterations over {sol.plan.solver.starts} starts.",
+        "",
+        "| measurement | wall time [s] |",
+        "|---|---:|",
+        *[f"| {name} | {value:.3f} |" for name, value in rows],
+        "",
+    ]
+    out = ROOT / "benchmarks" / "RESULTS.md"
+    out.write_text("\n".join(lines))
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
