@@ -1,6 +1,7 @@
 """The CasADi nonlinear program of one improved-S-curve press cycle (all CasADi lives here).
 
-Built once per process and reused: every number of a case enters as a parameter and the placement
+Built once per process and reused: every number of a case, and the scale of every decision variable,
+enters as a parameter and the placement
 structure is a pair of constraint rows whose bounds are set per solve, so a sweep, a multi-start or
 the other placement only calls the compiled solver again. Decision variables are scaled to O(1).
 
@@ -36,7 +37,8 @@ from press.kinematics import height_derivatives
 
 Placement = Literal["free", "published"]
 
-# Decision variables: name, scale (physical = scale * scaled)
+# Decision variables: name, default scale (physical = scale * scaled; the scales are NLP parameters
+# set per case from the magnitude of its first initial guess, this default where that is zero)
 VARIABLES: tuple[tuple[str, float], ...] = (
     ("transfer_speed", 1.0),  # w1 [rad/s]
     ("draw_speed", 1.0),  # w2 [rad/s]
@@ -120,9 +122,11 @@ class CycleNLP:
 
 def _build() -> CycleNLP:
     x = ca.SX.sym("x", len(VARIABLES))
-    p = ca.SX.sym("p", len(PARAMETERS))
-    v = {name: x[i] * scale for i, (name, scale) in enumerate(VARIABLES)}
-    q = {name: p[i] for i, name in enumerate(PARAMETERS)}
+    p_case = ca.SX.sym("p", len(PARAMETERS))
+    p_scale = ca.SX.sym("scale", len(VARIABLES))  # physical value = scale * x, chosen per case
+    p = ca.vertcat(p_case, p_scale)
+    v = {name: x[i] * p_scale[i] for i, (name, _) in enumerate(VARIABLES)}
+    q = {name: p_case[i] for i, name in enumerate(PARAMETERS)}
 
     params = CycleParameters(
         transfer_speed=v["transfer_speed"],

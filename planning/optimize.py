@@ -17,7 +17,7 @@ import numpy as np
 
 from planning.case import RPM, Case, draw_speed_bounds
 from planning.laws import improved_scurve as sc
-from planning.nlp import PARAMETER_INDEX, PARAMETERS, SCALES, VARIABLE_INDEX, VARIABLES, CycleNLP, cycle_nlp
+from planning.nlp import PARAMETER_INDEX, PARAMETERS, VARIABLE_INDEX, VARIABLES, CycleNLP, cycle_nlp
 from planning.plan import Plan, SolverInfo, params_from_numbers, profile_from_tdc
 from planning.verify import ACCEL_CHECK, Verification, verify
 
@@ -161,15 +161,40 @@ def _bounds(case: Case, w2_lo: float, w2_hi: float, p: np.ndarray) -> tuple[np.n
     for k in ("die_down", "die_up"):
         if p[PARAMETER_INDEX[f"{k}_active"]] == 0.0:
             lo[i[f"{k}_time"]] = hi[i[f"{k}_time"]] = 0.0
-    return lo / SCALES, hi / SCALES
+    return lo, hi
+
+
+def scales_for(case: Case) -> np.ndarray:
+    """Variable scales from the press's own characteristic time ``T* = sqrt(R / A)`` [s] and speed
+    ``W* = sqrt(A / (R + R^2/L))`` [rad/s] (A the slider-acceleration limit): speeds ~ W*, sub-segment
+    lengths ~ T*, stage times ~ 10 T*, jerks ~ W*/T*^2. The factors make the variables O(1) for a
+    press cycle of the usual proportions; they span orders of magnitude from a small fast press to a
+    heavy slow one."""
+    R, L, A = case.press.crank_radius_mm, case.press.rod_length_mm, case.limits.slider_accel_mm_s2
+    t_star = math.sqrt(R / A)
+    w_star = math.sqrt(A / (R + R**2 / L))
+    unit = {"speed": 0.42 * w_star, "jerk": 1.6 * w_star / t_star**2, "sub": 0.28 * t_star, "time": 2.8 * t_star}
+    kinds = {
+        "transfer_speed": "speed",
+        "draw_speed": "speed",
+        "feed_jerk": "jerk",
+        "return_jerk": "jerk",
+        "feed_accel_time": "sub",
+        "feed_decel_time": "sub",
+        "return_accel_time": "sub",
+        "return_decel_time": "sub",
+    }
+    return np.array([unit[kinds.get(k, "time")] for k, _ in VARIABLES])
 
 
 def _run(nlp: CycleNLP, placement: Placement, x0: dict[str, float], p: np.ndarray, lbx: np.ndarray, ubx: np.ndarray):
-    x0v = np.clip(np.array([x0[k] for k, _ in VARIABLES]) / SCALES, lbx, ubx)
+    """One IPOPT solve; ``p`` = case parameters + variable scales, ``lbx``/``ubx`` physical bounds."""
+    scales = p[len(PARAMETERS) :]
+    x0v = np.clip(np.array([x0[k] for k, _ in VARIABLES]), lbx, ubx) / scales
     lbg, ubg = nlp.bounds(placement)
-    res = nlp.solver(x0=x0v, p=p, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
+    res = nlp.solver(x0=x0v, p=p, lbx=lbx / scales, ubx=ubx / scales, lbg=lbg, ubg=ubg)
     stats = nlp.solver.stats()
-    x = np.array(res["x"]).ravel() * SCALES
+    x = np.array(res["x"]).ravel() * scales
     g = np.array(res["g"]).ravel()
     return {k: float(x[j]) for j, (k, _) in enumerate(VARIABLES)}, g, stats
 
@@ -242,6 +267,7 @@ def solve(case: Case, placement: Placement | None = None) -> Solution:
     nlp = cycle_nlp()
     lbx, ubx = _bounds(case, w2_lo, w2_hi, p)
     guesses = [_guess(case, w2, w_transfer, 0.9, 1.0), _guess(case, w2, w_transfer, 0.6, 1.0)]
+    p = np.concatenate([p, scales_for(case)])
     pub_values = None
     for x0 in guesses:
         values = attempt(x0, "published")
@@ -252,8 +278,8 @@ def solve(case: Case, placement: Placement | None = None) -> Solution:
         free_starts = []
         if pub_values is not None:  # the published optimum is a feasible start of the free problem
             free_starts.append(pub_values)
-        free_starts.append(_guess(case, w2, 2 * w_min, 0.95, 2.0))
         free_starts.append(_guess(case, w2, w_transfer, 0.9, 1.5))
+        free_starts.append(_guess(case, w2, 2 * w_min, 0.95, 2.0))
         for x0 in free_starts:
             before = best.plan.period if best is not None else math.inf
             attempt(x0, "free")

@@ -1,0 +1,30 @@
+"""Every case in cases/ solves and verifies under both placements; free is never worse."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from planning.case_file import read_case
+from planning.optimize import solve
+from planning.report import trajectory
+
+CASES = sorted((Path(__file__).resolve().parents[1] / "cases").glob("*.yaml"))
+
+
+@pytest.mark.parametrize("path", CASES, ids=lambda p: p.stem)
+def test_case_solves_and_verifies(path):
+    case = read_case(path)
+    published = solve(case, "published")
+    free = solve(case, "free")
+    assert published.verification.passed and free.verification.passed
+    assert free.plan.spm >= published.plan.spm - 1e-9
+    tab = trajectory(free, case)
+    assert abs(tab[:, -1]).max() <= case.limits.slider_accel_mm_s2 * (1 + 1e-6)
+    assert free.plan.transfer_window() >= case.process.transfer_time_s - 1e-6
+
+
+def test_there_are_several_presses():
+    radii = {read_case(p).press.crank_radius_mm for p in CASES}
+    assert len(CASES) >= 3 and len(radii) >= 3
