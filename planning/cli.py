@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import NoReturn
 
 EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = 0, 2, 3
+PLOT_FORMATS = ("png", "svg", "pdf")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -32,11 +33,33 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--out", help="output folder (default: out/<case name>)")
     s.add_argument("--placement", choices=("free", "published"), help="where theta1/theta4 may fall (default: case)")
     s.add_argument("--json", action="store_true", help="print result.json instead of the summary")
+    s.add_argument("--format", choices=PLOT_FORMATS, default="png", help="figure format (default png)")
+    s.add_argument("--no-plots", action="store_true", help="do not draw the figures")
+    s.add_argument("--cam-points", type=_points, default=3600, metavar="N", help="cam table rows (default 3600)")
+    m = sub.add_parser("compare", help="the published solution beside ours, and checked against itself")
+    m.add_argument("case", help="case file (YAML) with a published: block")
+    m.add_argument("--out", help="output folder (default: out/<case name>)")
+    m.add_argument("--json", action="store_true", help="print comparison.json instead of the table")
+    pl = sub.add_parser("plot", help="redraw the figures of a finished output folder (no solve)")
+    pl.add_argument("folder", help="output folder of `pressplan solve`")
+    pl.add_argument("--format", choices=PLOT_FORMATS, default="png", help="figure format (default png)")
     return ap
+
+
+def _points(text: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if not 2 <= n <= 1_000_000:
+        raise argparse.ArgumentTypeError(f"must be 2 ... 1000000, got {n}")
+    return n
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = _parser().parse_args(argv)
+    if args.command == "plot":
+        return _plot(args)
     from planning.case_file import CaseFileError, read_case
 
     try:
@@ -45,6 +68,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _fail(str(exc), EXIT_INPUT)
     if args.command == "check":
         return _check(case, args)
+    if args.command == "compare":
+        return _compare(case, args)
     return _solve(case, args)
 
 
@@ -79,7 +104,10 @@ def _solve(case, args) -> int:
     if not solution.verification.passed:  # solve() returns only verified plans; belt and braces
         return _fail(f"{args.case}: unverified plan not written", EXIT_INFEASIBLE)
     try:
-        files = write_atomic(out, solution_writers(solution, case))
+        writers = solution_writers(
+            solution, case, cam_points=args.cam_points, plot_format=None if args.no_plots else args.format
+        )
+        files = write_atomic(out, writers)
     except OutputError as exc:
         return _fail(str(exc), EXIT_INPUT)
     result = result_dict(solution, case)
@@ -88,6 +116,57 @@ def _solve(case, args) -> int:
     else:
         print(summary_text(result))
         print(f"  wrote {', '.join(str(f) for f in files)}")
+    return EXIT_OK
+
+
+def _compare(case, args) -> int:
+    from planning.case import output_name
+    from planning.compare import comparison, comparison_markdown, comparison_text
+    from planning.optimize import PlanningError, solve
+    from planning.outputs import OutputError, ensure_writable, write_atomic, write_json
+
+    if case.published is None or case.published.solution is None:
+        return _fail(f"{args.case}: published.solution: the case has no published solution to compare", EXIT_INPUT)
+    out = Path(args.out) if args.out else Path("out") / output_name(case)
+    try:
+        ensure_writable(out)
+    except OutputError as exc:
+        return _fail(str(exc), EXIT_INPUT)
+    try:
+        ours_published = solve(case, "published")
+        ours_free = solve(case, "free")
+    except PlanningError as exc:
+        return _fail(f"{args.case}: {exc}", EXIT_INFEASIBLE)
+    data = comparison(case, ours_published, ours_free)
+    try:
+        files = write_atomic(
+            out,
+            {
+                "comparison.json": lambda p: write_json(p, data),
+                "comparison.md": lambda p: p.write_text(comparison_markdown(data), encoding="utf-8"),
+            },
+        )
+    except OutputError as exc:
+        return _fail(str(exc), EXIT_INPUT)
+    if args.json:
+        print(json.dumps(data, indent=2))
+    else:
+        print(comparison_text(data))
+        print(f"  wrote {', '.join(str(f) for f in files)}")
+    return EXIT_OK
+
+
+def _plot(args) -> int:
+    from planning.outputs import OutputError, plot_writers, write_atomic
+
+    folder = Path(args.folder)
+    if not (folder / "result.json").is_file():
+        return _fail(f"{folder}: no result.json here (run `pressplan solve` first)", EXIT_INPUT)
+    try:
+        files = write_atomic(folder, plot_writers(folder, args.format))
+    except OutputError as exc:
+        return _fail(str(exc), EXIT_INPUT)
+    print(f"wrote {', '.join(str(f) for f in files)}")
     return EXIT_OK
 
 

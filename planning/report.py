@@ -13,7 +13,9 @@ import numpy as np
 
 from planning.case import KEY_POINT_NAMES, RPM, Case
 from planning.optimize import Solution
+from planning.profile import Profile
 from planning.verify import MAX_STEP_S
+from press.kinematics import CrankSlider
 
 TRAJECTORY_COLUMNS = (
     "time_s",
@@ -28,15 +30,20 @@ TRAJECTORY_COLUMNS = (
 BINDING_SHARE = 1e-4  # a check within this share of its limit is reported as binding
 
 
-def trajectory(solution: Solution, case: Case, max_step: float = MAX_STEP_S) -> np.ndarray:
-    """One full cycle on a uniform time grid with step <= ``max_step`` [s]; columns as
-    :data:`TRAJECTORY_COLUMNS`; the first and last rows are one period apart."""
-    plan = solution.plan
-    n = int(math.ceil(plan.period / max_step))
-    t = np.linspace(0.0, plan.period, n + 1)
-    th, om, al, je = plan.profile.at_time(t)
-    h, v, a, _ = case.machine.slider(th, om, al, je)
+def sample_profile(profile: Profile, machine: CrankSlider, max_step: float = MAX_STEP_S) -> np.ndarray:
+    """``profile`` over its whole duration on a uniform time grid with step <= ``max_step`` [s];
+    columns as :data:`TRAJECTORY_COLUMNS`; the first and last rows are the profile's ends."""
+    n = int(math.ceil(profile.duration / max_step))
+    t = np.linspace(0.0, profile.duration, n + 1)
+    th, om, al, je = profile.at_time(profile.t0 + t)
+    h, v, a, _ = machine.slider(th, om, al, je)
     return np.column_stack([t, np.degrees(th), om / RPM, al, je, h, v, a])
+
+
+def trajectory(solution: Solution, case: Case, max_step: float = MAX_STEP_S) -> np.ndarray:
+    """One full cycle of the plan from TDC (see :func:`sample_profile`); first and last rows are one
+    period apart."""
+    return sample_profile(solution.plan.profile, case.machine, max_step)
 
 
 def key_points(solution: Solution, case: Case) -> list[dict[str, Any]]:
@@ -116,6 +123,8 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
         "transfer_time_s": plan.transfer_window(),
         "max_abs_slider_accel_mm_s2": accel.value,
         "binding_constraints": binding(solution),
+        "process": case.process.model_dump(),
+        "limits": case.limits.model_dump(),
         "key_points": key_points(solution, case),
         "segments": segments(solution),
         "paper_solution": plan.paper_solution(),

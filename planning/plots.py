@@ -1,0 +1,215 @@
+"""Figures of a solved plan, drawn from its files (``result.json``, ``trajectory.csv`` and, when the
+case has a published solution, ``published_profile.csv``). Headless: matplotlib's Agg canvas, no
+pyplot. Two figures, each with the paper's three result plots stacked (Figs. 7, 8, 9): one against
+time from TDC, one against crank angle. Key points marked, limits dashed, stages shaded."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+STAGE_COLOURS = {"transfer": "#d9ecff", "feed": "#fff2cc", "draw": "#e2f0d9", "return": "#fde2e2"}
+KEY_LABELS = {
+    "closing": "θ1 closing",
+    "draw_start": "θ2 draw start",
+    "draw_end": "θ3 draw end",
+    "opening": "θ4 opening",
+}
+PLOT_FORMATS = ("png", "svg", "pdf")
+FIGURES = ("motion_vs_time", "motion_vs_angle")
+
+
+def read_table(path: Path) -> dict[str, np.ndarray]:
+    """A CSV with a header row (after any ``#`` comment lines) as columns by name."""
+    skip = 0
+    with open(path, encoding="utf-8") as fh:
+        for line in fh:
+            skip += 1
+            if not line.startswith("#"):
+                header = line.strip().split(",")
+                break
+    data = np.loadtxt(path, delimiter=",", skiprows=skip, ndmin=2)
+    return {name: data[:, i] for i, name in enumerate(header)}
+
+
+def _stages(result: dict[str, Any], axis: str) -> list[tuple[str, float, float]]:
+    """(stage, start, end) spans in time [s] or crank angle [deg], merged over neighbouring segments."""
+    spans: list[tuple[str, float, float]] = []
+    for seg in result["segments"]:
+        stage = seg["name"].split(":")[0]
+        if axis == "time":
+            a, b = seg["start_time_s"], seg["start_time_s"] + seg["duration_s"]
+        else:
+            a, b = seg["start_angle_deg"], seg["end_angle_deg"]
+        if spans and spans[-1][0] == stage:
+            spans[-1] = (stage, spans[-1][1], b)
+        else:
+            spans.append((stage, a, b))
+    return spans
+
+
+def _decorate(ax, result: dict[str, Any], axis: str, label_stages: bool) -> None:
+    for stage, a, b in _stages(result, axis):
+        ax.axvspan(a, b, color=STAGE_COLOURS.get(stage, "#eeeeee"), alpha=0.6, lw=0, zorder=0)
+        if label_stages and b > a:
+            ax.text(
+                (a + b) / 2,
+                0.97,
+                stage,
+                transform=ax.get_xaxis_transform(),
+                ha="center",
+                va="top",
+                fontsize=8,
+                color="#555555",
+                style="italic",
+            )
+    for k in result["key_points"]:
+        x = k["time_s"] if axis == "time" else k["angle_deg"]
+        ax.axvline(x, color="#444444", lw=0.8, ls=":", zorder=1)
+    ax.grid(True, lw=0.3, alpha=0.6)
+
+
+def _key_labels(ax, result: dict[str, Any], axis: str) -> None:
+    for k in result["key_points"]:
+        x = k["time_s"] if axis == "time" else k["angle_deg"]
+        ax.text(
+            x,
+            0.02,
+            " " + KEY_LABELS.get(k["name"], k["name"]),
+            transform=ax.get_xaxis_transform(),
+            rotation=90,
+            fontsize=7.5,
+            va="bottom",
+            ha="right",
+            color="#333333",
+        )
+
+
+MAX_POINTS = 2000  # per plotted line: beyond this a 1 ms trajectory adds nothing visible
+
+
+def _thin(table: dict[str, np.ndarray] | None) -> dict[str, np.ndarray] | None:
+    """Every k-th row (first and last kept) so that a line has at most :data:`MAX_POINTS` points."""
+    if table is None:
+        return None
+    n = len(next(iter(table.values())))
+    step = max(1, int(np.ceil(n / MAX_POINTS)))
+    idx = np.unique(np.concatenate([np.arange(0, n, step), [n - 1]]))
+    return {k: v[idx] for k, v in table.items()}
+
+
+def _figure(result, traj, published, axis: str) -> Figure:
+    traj, published = _thin(traj), _thin(published)
+    lim = result.get("limits", {})
+    proc = result.get("process", {})
+    x = traj["time_s"] if axis == "time" else traj["crank_angle_deg"]
+    xp = None
+    if published is not None:
+        xp = published["time_s"] if axis == "time" else published["crank_angle_deg"]
+    xlabel = "time from TDC [s]" if axis == "time" else "crank angle from TDC [deg]"
+    fig = Figure(figsize=(11, 10.5), dpi=90)
+    fig.subplots_adjust(left=0.08, right=0.91, top=0.93, bottom=0.06, hspace=0.22)
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(3, 1, sharex=True)
+    title = (
+        f"{result['case']}: {result['spm']:.2f} strokes/min, cycle {result['cycle_time_s']:.3f} s "
+        f"({result['motion_law']}, {result['placement']} placement, {result['status']})"
+    )
+    fig.suptitle(title, fontsize=11)
+
+    # (a) Fig. 7: slider height and crank speed
+    ax = axes[0]
+    _decorate(ax, result, axis, True)
+    ax.plot(x, traj["slider_height_mm"], color="tab:blue", lw=1.6, label="slider height")
+    for name, val in (("safety height", proc.get("safety_height_mm")), ("die height", lim.get("die_height_mm"))):
+        if val is not None:
+            ax.axhline(val, color="tab:blue", ls="--", lw=0.9)
+            ax.text(x[-1], val, f" {name} {val:g} mm", fontsize=7.5, va="bottom", ha="right", color="tab:blue")
+    ax.set_ylabel("slider height above BDC [mm]", color="tab:blue")
+    ax2 = ax.twinx()
+    ax2.plot(x, traj["crank_speed_rpm"], color="tab:red", lw=1.6, label="crank speed")
+    if published is not None:
+        ax2.plot(
+            xp,
+            published["crank_speed_rpm"],
+            color="tab:red",
+            lw=1.0,
+            ls="--",
+            alpha=0.7,
+            label="published solution (rebuilt)",
+        )
+    ax2.set_ylabel("crank speed [rpm]", color="tab:red")
+    ax2.set_ylim(bottom=0)
+    h1, l1 = ax.get_legend_handles_labels()
+    h2, l2 = ax2.get_legend_handles_labels()
+    ax.legend(h1 + h2, l1 + l2, loc="center left", fontsize=8, framealpha=0.9)
+    ax.set_title("slider height and crank speed (paper Fig. 7)", fontsize=9, loc="left")
+    _key_labels(ax, result, axis)
+
+    # (b) Fig. 8: crank acceleration
+    ax = axes[1]
+    _decorate(ax, result, axis, False)
+    ax.plot(x, traj["crank_accel_rad_s2"], color="tab:purple", lw=1.6, label="crank acceleration")
+    if published is not None:
+        ax.plot(
+            xp,
+            published["crank_accel_rad_s2"],
+            color="tab:purple",
+            lw=1.0,
+            ls="--",
+            alpha=0.7,
+            label="published solution (rebuilt)",
+        )
+    ax.axhline(0, color="black", lw=0.6)
+    ax.set_ylabel("crank acceleration [rad/s²]")
+    ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
+    ax.set_title("crank acceleration (paper Fig. 8)", fontsize=9, loc="left")
+
+    # (c) Fig. 9: slider speed and acceleration
+    ax = axes[2]
+    _decorate(ax, result, axis, False)
+    ax.plot(x, traj["slider_speed_mm_s"], color="tab:green", lw=1.6, label="slider speed (up +)")
+    ax.set_ylabel("slider speed [mm/s]", color="tab:green")
+    ax2 = ax.twinx()
+    ax2.plot(x, traj["slider_accel_mm_s2"], color="tab:orange", lw=1.6, label="slider acceleration")
+    a_lim = lim.get("slider_accel_mm_s2")
+    if a_lim is not None:
+        for sign in (1, -1):
+            ax2.axhline(sign * a_lim, color="tab:orange", ls="--", lw=0.9)
+        ax2.text(x[-1], a_lim, f"±{a_lim:g} mm/s² limit ", fontsize=7.5, va="top", ha="right", color="tab:orange")
+        ax2.set_ylim(-1.15 * a_lim, 1.15 * a_lim)
+    if published is not None:
+        ax2.plot(
+            xp,
+            published["slider_accel_mm_s2"],
+            color="tab:orange",
+            lw=1.0,
+            ls="--",
+            alpha=0.6,
+            label="published solution (rebuilt)",
+        )
+    ax2.set_ylabel("slider acceleration [mm/s²]", color="tab:orange")
+    h1, l1 = ax.get_legend_handles_labels()
+    h2, l2 = ax2.get_legend_handles_labels()
+    ax.legend(h1 + h2, l1 + l2, loc="lower left", fontsize=8, framealpha=0.9)
+    ax.set_title("slider speed and acceleration (paper Fig. 9)", fontsize=9, loc="left")
+
+    axes[-1].set_xlabel(xlabel)
+    axes[-1].set_xlim(x[0], x[-1])
+    return fig
+
+
+def plot_files(
+    result: dict[str, Any], traj: dict[str, np.ndarray], published: dict[str, np.ndarray] | None, fmt: str = "png"
+) -> dict[str, Figure]:
+    """The figures by file name (``motion_vs_time.<fmt>``, ``motion_vs_angle.<fmt>``)."""
+    return {f"{name}.{fmt}": _figure(result, traj, published, name.split("_")[-1]) for name in FIGURES}
+
+
+def save(fig: Figure, path: Path) -> None:
+    """Write one figure; the format follows the file name (``.png`` at 90 dpi)."""
+    fig.savefig(path, format=path.suffix.lstrip("."))

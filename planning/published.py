@@ -1,0 +1,269 @@
+"""The source's own solution, rebuilt and checked against itself.
+
+The paper prints X = [x1..x5, wm1, wm2, T1, T5, T9, T10, T14, J] (times from TDC [s], speeds [rpm],
+J [rpm/s^2]) and the relations under its Fig. 6. Here each published quantity that can also be
+computed from the other published ones is recomputed, and flagged as inconsistent when the two
+differ by more than the printed digits allow (half a unit of each printed number's last digit,
+propagated linearly through the formula).
+
+The crank motion is rebuilt "as far as it can be": constant w1 up to x1, the feed S-curve
+w1 -> wm1 -> w2 over 4 T1 + 4 T5, the draw over T9, the return S-curve w2 -> wm2 -> w1 over
+4 T10 + 4 T14, constant w1 up to x5. Each half gets the jerk that makes it meet the printed speeds
+(the paper's single J does not; see the checks), so the rebuilt profile is acceleration-continuous
+but need not sweep 360 deg or meet the key angles.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from planning.case import RPM, Case, PublishedSolution
+from planning.laws import improved_scurve as sc
+from planning.profile import Profile, Segment
+
+
+def half_unit(value: float) -> float:
+    """Half a unit of the last printed digit of ``value`` (as written in the case file)."""
+    text = repr(float(value))
+    if "e" in text or "E" in text:
+        return abs(value) * 5e-16
+    decimals = len(text.split(".")[1].rstrip("0")) if "." in text else 0
+    return 0.5 * 10.0 ** (-decimals)
+
+
+@dataclass(frozen=True)
+class Consistency:
+    """One published quantity against its value recomputed from other published quantities."""
+
+    name: str
+    printed: float
+    recomputed: float
+    unit: str
+    allowance: float
+    formula: str
+
+    @property
+    def difference(self) -> float:
+        return self.recomputed - self.printed
+
+    @property
+    def consistent(self) -> bool:
+        return abs(self.difference) <= self.allowance + 1e-12
+
+    def as_dict(self) -> dict:
+        return {
+            "name": self.name,
+            "printed": self.printed,
+            "recomputed": self.recomputed,
+            "difference": self.difference,
+            "allowance": self.allowance,
+            "unit": self.unit,
+            "consistent": self.consistent,
+            "formula": self.formula,
+        }
+
+
+def _propagate(f: Callable[[dict[str, float]], float], values: dict[str, float], names: list[str]) -> float:
+    """Linear propagation of the printed rounding of ``names`` through ``f``."""
+    total = 0.0
+    for n in names:
+        h = half_unit(values[n])
+        if h == 0:
+            continue
+        up, dn = dict(values), dict(values)
+        up[n] += h
+        dn[n] -= h
+        total += abs(f(up) - f(dn)) / 2
+    return total
+
+
+def _inputs(case: Case) -> dict[str, float]:
+    x = case.published.solution
+    k = case.key_points
+    vals = {f: float(getattr(x, f)) for f in PublishedSolution.model_fields}
+    vals.update(theta1=k.closing_deg, theta2=k.draw_start_deg, theta3=k.draw_end_deg, theta4=k.opening_deg)
+    vals["w2_rpm"] = float(case.process.draw_speed_rpm) if case.process.draw_speed_rpm else math.nan
+    vals["T0_s"] = case.process.transfer_time_s
+    if case.published.spm is not None:
+        vals["spm"] = case.published.spm
+    return vals
+
+
+def transfer_speed_rpm(v: dict[str, float]) -> float:
+    """w1 [rpm] implied by wm1, J and T1 (Eq. 13: wm1 - w1 = 11/3 J T1^2)."""
+    return v["wm1_rpm"] - sc.speed_change(v["J_rpm_s2"], v["T1_s"])
+
+
+def rebuild_profile(case: Case) -> Profile | None:
+    """The published crank motion from TDC (see the module docstring); None without a solution."""
+    if case.published is None or case.published.solution is None or case.process.draw_speed_rpm is None:
+        return None
+    v = _inputs(case)
+    w1 = transfer_speed_rpm(v) * RPM
+    wm1, wm2, w2 = v["wm1_rpm"] * RPM, v["wm2_rpm"] * RPM, v["w2_rpm"] * RPM
+    T1, T5, T9, T10, T14 = (v[k] for k in ("T1_s", "T5_s", "T9_s", "T10_s", "T14_s"))
+
+    def jerk(dv: float, T: float) -> float:
+        return dv / (sc.SPEED_GAIN * T**2)
+
+    segs = [Segment("transfer:dwell", v["x1_s"], 0.0, 0.0)]
+    segs += sc.accel_half(T1, jerk(wm1 - w1, T1), "feed:accel")
+    segs += sc.decel_half(T5, jerk(wm1 - w2, T5), "feed:decel")
+    segs.append(Segment("draw:constant", T9, 0.0, 0.0))
+    segs += sc.accel_half(T10, jerk(wm2 - w2, T10), "return:accel")
+    segs += sc.decel_half(T14, jerk(wm2 - w1, T14), "return:decel")
+    used = sum(float(s.duration) for s in segs)
+    segs.append(Segment("transfer:dwell", max(v["x5_s"] - used, 0.0), 0.0, 0.0))
+    return Profile(tuple(segs), 0.0, w1)
+
+
+def consistency(case: Case) -> list[Consistency]:
+    """Every published quantity that other published quantities also determine."""
+    if case.published is None or case.published.solution is None:
+        return []
+    v = _inputs(case)
+    out: list[Consistency] = []
+
+    def add(name: str, printed_key: str | None, printed: float, unit: str, f, names: list[str], formula: str):
+        allowance = _propagate(f, v, names) + (half_unit(v[printed_key]) if printed_key else 0.0)
+        out.append(Consistency(name, printed, float(f(v)), unit, allowance, formula))
+
+    def draw_time(u):
+        return math.radians(u["theta3"] - u["theta2"]) / (u["w2_rpm"] * RPM)
+
+    if not math.isnan(v["w2_rpm"]):
+        add(
+            "T9 (draw time)",
+            "T9_s",
+            v["T9_s"],
+            "s",
+            draw_time,
+            ["theta2", "theta3", "w2_rpm"],
+            "(theta3 - theta2) / w2",
+        )
+    add("x2 (feed peak)", "x2_s", v["x2_s"], "s", lambda u: u["x1_s"] + 4 * u["T1_s"], ["x1_s", "T1_s"], "x1 + 4 T1")
+    add(
+        "x3 (return peak)",
+        "x3_s",
+        v["x3_s"],
+        "s",
+        lambda u: u["x2_s"] + 4 * u["T5_s"] + u["T9_s"] + 4 * u["T10_s"],
+        ["x2_s", "T5_s", "T9_s", "T10_s"],
+        "x2 + 4 T5 + T9 + 4 T10 (t2 = x2 + 4 T5, t3 = t2 + T9, x3 = t3 + 4 T10)",
+    )
+    add(
+        "x4 (end of return)",
+        "x4_s",
+        v["x4_s"],
+        "s",
+        lambda u: u["x3_s"] + 4 * u["T14_s"],
+        ["x3_s", "T14_s"],
+        "x3 + 4 T14 (t4 = x3 + 3 T14, x4 = t4 + T14)",
+    )
+    if "spm" in v:
+        add("SPM", "spm", v["spm"], "1/min", lambda u: 60.0 / u["x5_s"], ["x5_s"], "60 / x5")
+    if not math.isnan(v["w2_rpm"]):
+        add(
+            "wm1 - w2 (feed deceleration)",
+            None,
+            v["wm1_rpm"] - v["w2_rpm"],
+            "rpm",
+            lambda u: sc.speed_change(u["J_rpm_s2"], u["T5_s"]),
+            ["J_rpm_s2", "T5_s"],
+            "11/3 J T5^2 (Eq. 13)",
+        )
+        add(
+            "wm2 - w2 (return acceleration)",
+            None,
+            v["wm2_rpm"] - v["w2_rpm"],
+            "rpm",
+            lambda u: sc.speed_change(u["J_rpm_s2"], u["T10_s"]),
+            ["J_rpm_s2", "T10_s"],
+            "11/3 J T10^2 (Eq. 13)",
+        )
+    add(
+        "wm2 - w1 (return deceleration)",
+        None,
+        v["wm2_rpm"] - transfer_speed_rpm(v),
+        "rpm",
+        lambda u: sc.speed_change(u["J_rpm_s2"], u["T14_s"]),
+        ["J_rpm_s2", "T14_s"],
+        "11/3 J T14^2, with w1 = wm1 - 11/3 J T1^2",
+    )
+    prof = rebuild_profile(case)
+    if prof is not None:
+        end = prof.at_time(np.array([prof.duration]))[0][0]
+        add_angle = Consistency(
+            "angle swept by the rebuilt profile",
+            360.0,
+            float(math.degrees(end)),
+            "deg",
+            _angle_allowance(case),
+            "integral of the rebuilt crank speed over x5",
+        )
+        out.append(add_angle)
+        t1 = v["x1_s"] + v["T1_s"]
+        th1 = math.degrees(float(prof.at_time(np.array([t1]))[0][0]))
+        out.append(
+            Consistency(
+                "theta1 at t1 = x1 + T1",
+                v["theta1"],
+                th1,
+                "deg",
+                _angle_allowance(case),
+                "rebuilt profile at the published closing time",
+            )
+        )
+        t2 = v["x2_s"] + 4 * v["T5_s"]
+        th2 = math.degrees(float(prof.at_time(np.array([t2]))[0][0]))
+        out.append(
+            Consistency(
+                "theta2 at t2 = x2 + 4 T5",
+                v["theta2"],
+                th2,
+                "deg",
+                _angle_allowance(case),
+                "rebuilt profile at the published draw start",
+            )
+        )
+        t4 = v["x3_s"] + 3 * v["T14_s"]
+        out.append(
+            Consistency(
+                "transfer time theta4 -> theta1",
+                v["T0_s"],
+                v["x5_s"] - t4 + t1,
+                "s",
+                _propagate(
+                    lambda u: u["x5_s"] - u["x3_s"] - 3 * u["T14_s"] + u["x1_s"] + u["T1_s"],
+                    v,
+                    ["x5_s", "x3_s", "T14_s", "x1_s", "T1_s"],
+                ),
+                "x5 - (x3 + 3 T14) + (x1 + T1), at least T0",
+            )
+        )
+    return out
+
+
+def _angle_allowance(case: Case) -> float:
+    """Angle [deg] the printed rounding of the times and speeds allows in the rebuilt profile."""
+    v = _inputs(case)
+
+    def swept(u: dict[str, float]) -> float:
+        w1 = transfer_speed_rpm(u) * 6  # deg/s
+        w2, wm1, wm2 = u["w2_rpm"] * 6, u["wm1_rpm"] * 6, u["wm2_rpm"] * 6
+        used = u["x1_s"] + 4 * (u["T1_s"] + u["T5_s"] + u["T10_s"] + u["T14_s"]) + u["T9_s"]
+        return (
+            w1 * (u["x1_s"] + max(u["x5_s"] - used, 0.0))
+            + 2 * u["T1_s"] * (w1 + wm1)
+            + 2 * u["T5_s"] * (wm1 + w2)
+            + w2 * u["T9_s"]
+            + 2 * u["T10_s"] * (w2 + wm2)
+            + 2 * u["T14_s"] * (wm2 + w1)
+        )
+
+    names = ["x1_s", "x5_s", "T1_s", "T5_s", "T9_s", "T10_s", "T14_s", "wm1_rpm", "wm2_rpm", "J_rpm_s2"]
+    return _propagate(swept, v, names)
