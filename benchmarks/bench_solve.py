@@ -50,18 +50,21 @@ def main() -> None:
     assert sol.verification.passed and abs(sol.plan.spm - first.plan.spm) < 1e-9
 
     exe = Path(sys.executable).with_name("pressplan")
-    imports, cold = [], []
+    imports, cold, cold_plots = [], [], []
     with tempfile.TemporaryDirectory() as tmp:
         for _ in range(COLD_RUNS):
             imports.append(timed([sys.executable, "-c", "import casadi, numpy, matplotlib, yaml"]))
-            cold.append(timed([str(exe), "solve", str(CASE), "--out", tmp]))
+            cold.append(timed([str(exe), "solve", str(CASE), "--out", tmp, "--no-plots"]))
+            cold_plots.append(timed([str(exe), "solve", str(CASE), "--out", tmp]))
     med = statistics.median
     rows = [
         ("NLP build (once per process)", build),
         (f"in-process solve, warm (median of {WARM_RUNS})", med(warm)),
         (f"import casadi, numpy, matplotlib, yaml (median of {COLD_RUNS})", med(imports)),
-        (f"cold `pressplan solve` process (median of {COLD_RUNS})", med(cold)),
-        ("cold solve beyond the imports", med(cold) - med(imports)),
+        (f"cold `pressplan solve --no-plots` process (median of {COLD_RUNS})", med(cold)),
+        ("cold solve beyond the imports (no figures)", med(cold) - med(imports)),
+        (f"cold `pressplan solve` process with its two figures (median of {COLD_RUNS})", med(cold_plots)),
+        ("cold solve with figures beyond the imports", med(cold_plots) - med(imports)),
     ]
     lines = [
         "# Benchmarks",

@@ -77,8 +77,8 @@ PARAMETERS: tuple[str, ...] = (
 )
 PARAMETER_INDEX = {name: i for i, name in enumerate(PARAMETERS)}
 
-SAMPLES_PER_SUBSEGMENT = 6
-SAMPLES_CONSTANT = 24
+SAMPLES_PER_SUBSEGMENT = 5
+SAMPLES_CONSTANT = 20
 
 
 @dataclass(frozen=True)
@@ -272,7 +272,6 @@ def _build() -> CycleNLP:
         "ipopt.tol": 1e-10,
         "ipopt.constr_viol_tol": 1e-10,
         "ipopt.max_iter": 1000,
-        "ipopt.mu_strategy": "adaptive",
     }
     solver = ca.nlpsol("press_cycle", "ipopt", nlp, opts)
     return CycleNLP(solver, np.array(lb), np.array(ub), tuple(blocks), free_rows, published_rows)

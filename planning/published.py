@@ -45,6 +45,7 @@ class Consistency:
     unit: str
     allowance: float
     formula: str
+    kind: str = "equal"  # "equal", or "at least" (the recomputed value must reach the printed one)
 
     @property
     def difference(self) -> float:
@@ -52,6 +53,8 @@ class Consistency:
 
     @property
     def consistent(self) -> bool:
+        if self.kind == "at least":
+            return self.difference >= -self.allowance - 1e-12
         return abs(self.difference) <= self.allowance + 1e-12
 
     def as_dict(self) -> dict:
@@ -63,6 +66,7 @@ class Consistency:
             "allowance": self.allowance,
             "unit": self.unit,
             "consistent": self.consistent,
+            "kind": self.kind,
             "formula": self.formula,
         }
 
@@ -243,6 +247,7 @@ def consistency(case: Case) -> list[Consistency]:
                     ["x5_s", "x3_s", "T14_s", "x1_s", "T1_s"],
                 ),
                 "x5 - (x3 + 3 T14) + (x1 + T1), at least T0",
+                kind="at least",
             )
         )
     return out
