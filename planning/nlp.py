@@ -23,7 +23,7 @@ crank speed >= the minimum crank speed (the S-curve halves are monotone for J >=
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cache
 from typing import Literal
 
@@ -77,6 +77,21 @@ PARAMETERS: tuple[str, ...] = (
 )
 PARAMETER_INDEX = {name: i for i, name in enumerate(PARAMETERS)}
 
+IPOPT_OPTIONS = {
+    "ipopt.print_level": 0,
+    "print_time": False,
+    "ipopt.sb": "yes",
+    "ipopt.tol": 1e-10,
+    "ipopt.constr_viol_tol": 1e-10,
+    "ipopt.max_iter": 400,  # a start that has not converged by then is dropped (others remain)
+}
+WARM_OPTIONS = {
+    "ipopt.warm_start_init_point": "yes",
+    "ipopt.mu_init": 1e-6,
+    "ipopt.warm_start_bound_push": 1e-9,
+    "ipopt.warm_start_mult_bound_push": 1e-9,
+    "ipopt.warm_start_slack_bound_push": 1e-9,
+}
 SAMPLES_PER_SUBSEGMENT = 5
 SAMPLES_CONSTANT = 20
 
@@ -109,6 +124,18 @@ class CycleNLP:
     blocks: tuple[ConstraintBlock, ...]
     free_rows: slice
     published_rows: slice
+    problem: dict = field(repr=False, default_factory=dict)
+    options: dict = field(repr=False, default_factory=dict)
+    _warm: ca.Function | None = field(repr=False, default=None)
+
+    def warm_solver(self) -> ca.Function:
+        """The same NLP with IPOPT set up for a warm start from a nearby solution and its multipliers
+        (built on first use): re-solves after a small change of a parameter take a few iterations."""
+        if self._warm is None:
+            opts = dict(self.options)
+            opts.update(WARM_OPTIONS)
+            self._warm = ca.nlpsol("press_cycle_warm", "ipopt", self.problem, opts)
+        return self._warm
 
     def bounds(self, placement: Placement) -> tuple[np.ndarray, np.ndarray]:
         """``(lbg, ubg)`` for ``placement``."""
@@ -265,16 +292,8 @@ def _build() -> CycleNLP:
     add("slider acceleration", acc / q["accel_limit"], -1.0, 1.0)
 
     nlp = {"x": x, "p": p, "f": params.period, "g": ca.vertcat(*g)}
-    opts = {
-        "ipopt.print_level": 0,
-        "print_time": False,
-        "ipopt.sb": "yes",
-        "ipopt.tol": 1e-10,
-        "ipopt.constr_viol_tol": 1e-10,
-        "ipopt.max_iter": 1000,
-    }
-    solver = ca.nlpsol("press_cycle", "ipopt", nlp, opts)
-    return CycleNLP(solver, np.array(lb), np.array(ub), tuple(blocks), free_rows, published_rows)
+    solver = ca.nlpsol("press_cycle", "ipopt", nlp, IPOPT_OPTIONS)
+    return CycleNLP(solver, np.array(lb), np.array(ub), tuple(blocks), free_rows, published_rows, nlp, IPOPT_OPTIONS)
 
 
 @cache

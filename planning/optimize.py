@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
@@ -187,16 +187,32 @@ def scales_for(case: Case) -> np.ndarray:
     return np.array([unit[kinds.get(k, "time")] for k, _ in VARIABLES])
 
 
-def _run(nlp: CycleNLP, placement: Placement, x0: dict[str, float], p: np.ndarray, lbx: np.ndarray, ubx: np.ndarray):
-    """One IPOPT solve; ``p`` = case parameters + variable scales, ``lbx``/``ubx`` physical bounds."""
+def _run(
+    nlp: CycleNLP,
+    placement: Placement,
+    x0: dict[str, float],
+    p: np.ndarray,
+    lbx: np.ndarray,
+    ubx: np.ndarray,
+    multipliers: tuple[np.ndarray, np.ndarray] | None = None,
+):
+    """One IPOPT solve; ``p`` = case parameters + variable scales, ``lbx``/``ubx`` physical bounds.
+    With ``multipliers`` (of a nearby solve) the warm-start solver is used. Returns the values, the
+    constraint values, IPOPT's statistics and the multipliers."""
     scales = p[len(PARAMETERS) :]
     x0v = np.clip(np.array([x0[k] for k, _ in VARIABLES]), lbx, ubx) / scales
     lbg, ubg = nlp.bounds(placement)
-    res = nlp.solver(x0=x0v, p=p, lbx=lbx / scales, ubx=ubx / scales, lbg=lbg, ubg=ubg)
-    stats = nlp.solver.stats()
-    x = np.array(res["x"]).ravel() * scales
+    args = {"x0": x0v, "p": p, "lbx": lbx / scales, "ubx": ubx / scales, "lbg": lbg, "ubg": ubg}
+    solver = nlp.solver
+    if multipliers is not None:
+        solver = nlp.warm_solver()
+        args.update(lam_x0=multipliers[0], lam_g0=multipliers[1])
+    res = solver(**args)
+    stats = solver.stats()
+    x = np.clip(np.array(res["x"]).ravel() * scales, lbx, ubx)  # IPOPT relaxes bounds by ~1e-8
     g = np.array(res["g"]).ravel()
-    return {k: float(x[j]) for j, (k, _) in enumerate(VARIABLES)}, g, stats
+    lam = (np.array(res["lam_x"]).ravel(), np.array(res["lam_g"]).ravel())
+    return {k: float(x[j]) for j, (k, _) in enumerate(VARIABLES)}, g, stats, lam
 
 
 def _plan(case: Case, values: dict[str, float], placement: Placement, info: SolverInfo) -> Plan:
@@ -206,7 +222,16 @@ def _plan(case: Case, values: dict[str, float], placement: Placement, info: Solv
     plan = Plan(params, profile, tuple(float(a) for a in th), placement, info)
     t = plan.key_times()
     structure = {"closing": plan.segment_at(float(t[0])), "opening": plan.segment_at(float(t[3]))}
-    return Plan(params, profile, plan.key_angles, placement, info, structure=structure)
+    return replace(plan, structure=structure, nlp_values=dict(values))
+
+
+def _fits(plan: Plan, case: Case, placement: Placement, w2_lo: float, w2_hi: float) -> bool:
+    """Whether ``plan`` is a candidate answer for ``case``: same placement rule (a published-structure
+    plan is also a free one), same key angles, a draw speed within this case's bounds."""
+    same_angles = np.allclose(plan.key_angles, case.key_angles, rtol=0, atol=1e-12)
+    w2 = float(plan.parameters.draw_speed)
+    fits_placement = placement == "free" or plan.placement == "published"
+    return bool(same_angles and fits_placement and w2_lo - 1e-12 <= w2 <= w2_hi + 1e-12)
 
 
 def _violation(nlp: CycleNLP, placement: Placement, g: np.ndarray) -> tuple[str, float]:
@@ -217,8 +242,14 @@ def _violation(nlp: CycleNLP, placement: Placement, g: np.ndarray) -> tuple[str,
     return worst.name, float(np.max(viol[worst.start : worst.stop], initial=0.0))
 
 
-def solve(case: Case, placement: Placement | None = None) -> Solution:
-    """The fastest verified cycle for ``case``; raises :class:`PlanningError` when there is none."""
+def solve(case: Case, placement: Placement | None = None, warm: Plan | None = None) -> Solution:
+    """The fastest verified cycle for ``case``; raises :class:`PlanningError` when there is none.
+
+    ``warm``: a plan of a neighbouring case (a sweep, a relaxed limit). It is verified against this
+    case as it stands (when its placement fits and its key angles and draw speed are this case's) and
+    its NLP values start the multi-start, so the answer is never worse than ``warm`` where ``warm``
+    is feasible here.
+    """
     placement = placement or case.planner.placement
     t_start = time.perf_counter()
     w2_lo, w2_hi = precheck(case)
@@ -240,9 +271,10 @@ def solve(case: Case, placement: Placement | None = None) -> Solution:
         nonlocal best, iterations, starts
         q = p.copy()
         values = x0
+        lam = None
         starts += 1
         for _ in range(REFINEMENTS + 1):
-            values, g, stats = _run(nlp, as_placement, values, q, lbx, ubx)
+            values, g, stats, lam = _run(nlp, as_placement, values, q, lbx, ubx, lam)
             iterations += int(stats["iter_count"])
             status = str(stats["return_status"])
             if status not in ("Solve_Succeeded", "Solved_To_Acceptable_Level"):
@@ -269,7 +301,12 @@ def solve(case: Case, placement: Placement | None = None) -> Solution:
         """Run the starts in order until the two best verified ones agree on the period (the optimum
         is confirmed) or the starts run out; the values of the best verified start."""
         found: list[tuple[float, dict[str, float]]] = []
+        tried: list[np.ndarray] = []
         for x0 in x0s:
+            key = np.array([x0[k] for k, _ in VARIABLES])
+            if any(np.allclose(key, other, rtol=1e-9, atol=1e-12) for other in tried):
+                continue  # the same start again would only repeat its answer
+            tried.append(key)
             out = attempt(x0, as_placement)
             if out is None:
                 continue
@@ -282,28 +319,29 @@ def solve(case: Case, placement: Placement | None = None) -> Solution:
     nlp = cycle_nlp()
     lbx, ubx = _bounds(case, w2_lo, w2_hi, p)
     p = np.concatenate([p, scales_for(case)])
-    published_starts = [_guess(case, w2, w_transfer, share, 1.0) for share in (0.9, 0.6, 0.75)]
+    if warm is not None and _fits(warm, case, placement, w2_lo, w2_hi):
+        check = verify(warm, case)
+        if check.passed:
+            best = Solution(warm, check)
+    warm_values = [warm.nlp_values] if warm is not None and warm.nlp_values else []
+    published_starts = [_guess(case, w2, w_transfer, share, 1.0) for share in (0.9, 0.6)]
+    published_starts.append(_guess(case, w2, 0.5 * (w_transfer + w_min), 0.75, 1.0))
+    if warm is not None and warm.placement == "published":
+        published_starts = warm_values + published_starts
     pub_values = multi_start(published_starts, "published")
     if placement == "free":
-        free_starts = [pub_values] if pub_values is not None else []  # a feasible start of the free problem
+        free_starts = warm_values if warm is not None and warm.placement == "free" else []
+        free_starts += [pub_values] if pub_values is not None else []  # a feasible start of the free problem
         free_starts.append(_guess(case, w2, w_transfer, 0.9, 1.5))
         free_starts.append(_guess(case, w2, 2 * w_min, 0.95, 2.0))
         multi_start(free_starts, "free")
         if best is not None and best.plan.placement == "published":
             # the published structure is one of the free structures: report it as the free answer
-            plan = best.plan
-            best = Solution(
-                Plan(
-                    plan.parameters, plan.profile, plan.key_angles, "free", plan.solver, plan.motion_law, plan.structure
-                ),
-                best.verification,
-            )
+            best = Solution(replace(best.plan, placement="free"), best.verification)
     if best is None:
         raise PlanningError(
             "infeasible" if not any(f.startswith("verification") for f in failures) else "unverified",
             "no plan meets the limits: " + (failures[-1] if failures else "no start converged"),
         )
-    plan = best.plan
-    info = SolverInfo(iterations, time.perf_counter() - t_start, starts, plan.solver.status)
-    plan = Plan(plan.parameters, plan.profile, plan.key_angles, plan.placement, info, plan.motion_law, plan.structure)
-    return Solution(plan, best.verification)
+    info = SolverInfo(iterations, time.perf_counter() - t_start, starts, best.plan.solver.status)
+    return Solution(replace(best.plan, solver=info), best.verification)

@@ -37,6 +37,7 @@ class Plan:
     solver: SolverInfo
     motion_law: str = "improved-s-curve"
     structure: dict[str, str] = field(default_factory=dict)
+    nlp_values: dict[str, float] = field(default_factory=dict, repr=False)  # the NLP variables (warm starts)
 
     @property
     def period(self) -> float:
