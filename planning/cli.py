@@ -86,17 +86,27 @@ def _check(case, args) -> int:
     return EXIT_OK if all(c["passed"] for c in report["checks"]) else EXIT_INFEASIBLE
 
 
-def _solve(case, args) -> int:
+def _output_folder(case, args) -> Path | int:
+    """``--out`` or ``out/<case name>``, checked writable before any solving; an exit code if not."""
     from planning.case import output_name
-    from planning.optimize import PlanningError, solve
-    from planning.outputs import OutputError, ensure_writable, solution_writers, write_atomic
-    from planning.report import result_dict, summary_text
+    from planning.outputs import OutputError, ensure_writable
 
     out = Path(args.out) if args.out else Path("out") / output_name(case)
     try:
         ensure_writable(out)
     except OutputError as exc:
         return _fail(str(exc), EXIT_INPUT)
+    return out
+
+
+def _solve(case, args) -> int:
+    from planning.optimize import PlanningError, solve
+    from planning.outputs import OutputError, solution_writers, write_atomic
+    from planning.report import result_dict, summary_text
+
+    out = _output_folder(case, args)
+    if isinstance(out, int):
+        return out
     try:
         solution = solve(case, args.placement)
     except PlanningError as exc:
@@ -120,18 +130,15 @@ def _solve(case, args) -> int:
 
 
 def _compare(case, args) -> int:
-    from planning.case import output_name
     from planning.compare import comparison, comparison_markdown, comparison_text
     from planning.optimize import PlanningError, solve
-    from planning.outputs import OutputError, ensure_writable, write_atomic, write_json
+    from planning.outputs import OutputError, write_atomic, write_json
 
     if case.published is None or case.published.solution is None:
         return _fail(f"{args.case}: published.solution: the case has no published solution to compare", EXIT_INPUT)
-    out = Path(args.out) if args.out else Path("out") / output_name(case)
-    try:
-        ensure_writable(out)
-    except OutputError as exc:
-        return _fail(str(exc), EXIT_INPUT)
+    out = _output_folder(case, args)
+    if isinstance(out, int):
+        return out
     try:
         ours_published = solve(case, "published")
         ours_free = solve(case, "free")

@@ -102,6 +102,12 @@ def _thin(table: dict[str, np.ndarray] | None) -> dict[str, np.ndarray] | None:
     return {k: v[idx] for k, v in table.items()}
 
 
+def _overlay(ax, x, published: dict[str, np.ndarray] | None, column: str, colour: str, alpha: float) -> None:
+    """The rebuilt published solution, dashed, when there is one."""
+    if published is not None:
+        ax.plot(x, published[column], color=colour, lw=1.0, ls="--", alpha=alpha, label="published solution (rebuilt)")
+
+
 def _figure(result, traj, published, axis: str) -> Figure:
     traj, published = _thin(traj), _thin(published)
     lim = result.get("limits", {})
@@ -132,16 +138,7 @@ def _figure(result, traj, published, axis: str) -> Figure:
     ax.set_ylabel("slider height above BDC [mm]", color="tab:blue")
     ax2 = ax.twinx()
     ax2.plot(x, traj["crank_speed_rpm"], color="tab:red", lw=1.6, label="crank speed")
-    if published is not None:
-        ax2.plot(
-            xp,
-            published["crank_speed_rpm"],
-            color="tab:red",
-            lw=1.0,
-            ls="--",
-            alpha=0.7,
-            label="published solution (rebuilt)",
-        )
+    _overlay(ax2, xp, published, "crank_speed_rpm", "tab:red", 0.7)
     ax2.set_ylabel("crank speed [rpm]", color="tab:red")
     ax2.set_ylim(bottom=0)
     h1, l1 = ax.get_legend_handles_labels()
@@ -154,16 +151,7 @@ def _figure(result, traj, published, axis: str) -> Figure:
     ax = axes[1]
     _decorate(ax, result, axis, False)
     ax.plot(x, traj["crank_accel_rad_s2"], color="tab:purple", lw=1.6, label="crank acceleration")
-    if published is not None:
-        ax.plot(
-            xp,
-            published["crank_accel_rad_s2"],
-            color="tab:purple",
-            lw=1.0,
-            ls="--",
-            alpha=0.7,
-            label="published solution (rebuilt)",
-        )
+    _overlay(ax, xp, published, "crank_accel_rad_s2", "tab:purple", 0.7)
     ax.axhline(0, color="black", lw=0.6)
     ax.set_ylabel("crank acceleration [rad/s²]")
     ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
@@ -182,16 +170,7 @@ def _figure(result, traj, published, axis: str) -> Figure:
             ax2.axhline(sign * a_lim, color="tab:orange", ls="--", lw=0.9)
         ax2.text(x[-1], a_lim, f"±{a_lim:g} mm/s² limit ", fontsize=7.5, va="top", ha="right", color="tab:orange")
         ax2.set_ylim(-1.15 * a_lim, 1.15 * a_lim)
-    if published is not None:
-        ax2.plot(
-            xp,
-            published["slider_accel_mm_s2"],
-            color="tab:orange",
-            lw=1.0,
-            ls="--",
-            alpha=0.6,
-            label="published solution (rebuilt)",
-        )
+    _overlay(ax2, xp, published, "slider_accel_mm_s2", "tab:orange", 0.6)
     ax2.set_ylabel("slider acceleration [mm/s²]", color="tab:orange")
     h1, l1 = ax.get_legend_handles_labels()
     h2, l2 = ax2.get_legend_handles_labels()
