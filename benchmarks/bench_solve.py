@@ -1,8 +1,9 @@
-"""Speed of the default solve of the published case; writes benchmarks/RESULTS.md.
+"""Speed of the published case; writes benchmarks/RESULTS.md.
 
-Measures (a) the in-process solve after a warm-up (the NLP already built), (b) a cold
-``pressplan solve`` process beside a process that only imports casadi, numpy, matplotlib and yaml,
-and (c) the NLP build alone. Medians; run with ``python benchmarks/bench_solve.py`` from the project
+Measures (a) the in-process solve after a warm-up (the NLP already built), a cold ``pressplan solve``
+process beside a process that only imports casadi, numpy, matplotlib and yaml, and the NLP build
+alone; (b) a 41-point transfer-time sweep with 1 and 2 workers (whole process, points per second).
+Motion-law figures (c) come when there are other laws. Medians; run with ``python benchmarks/bench_solve.py`` from the project
 root in the environment where pressplan is installed.
 """
 
@@ -56,6 +57,23 @@ def main() -> None:
             imports.append(timed([sys.executable, "-c", "import casadi, numpy, matplotlib, yaml"]))
             cold.append(timed([str(exe), "solve", str(CASE), "--out", tmp, "--no-plots"]))
             cold_plots.append(timed([str(exe), "solve", str(CASE), "--out", tmp]))
+    sweep_rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for workers in (1, 2):
+            wall = timed(
+                [
+                    str(exe),
+                    "sweep",
+                    str(CASE),
+                    "--vary",
+                    "process.transfer_time_s=1.0:3.0:41",
+                    "--workers",
+                    str(workers),
+                    "--out",
+                    f"{tmp}/w{workers}",
+                ]
+            )
+            sweep_rows.append((workers, wall))
     med = statistics.median
     rows = [
         ("NLP build (once per process)", build),
@@ -66,6 +84,9 @@ def main() -> None:
         (f"cold `pressplan solve` process with its two figures (median of {COLD_RUNS})", med(cold_plots)),
         ("cold solve with figures beyond the imports", med(cold_plots) - med(imports)),
     ]
+    for workers, wall in sweep_rows:
+        rows.append((f"41-point transfer-time sweep, {workers} worker(s), whole `pressplan sweep` process", wall))
+        rows.append((f"  sweep throughput, {workers} worker(s) [points/s]", 41 / wall))
     lines = [
         "# Benchmarks",
         "",

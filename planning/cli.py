@@ -40,10 +40,34 @@ def _parser() -> argparse.ArgumentParser:
     m.add_argument("case", help="case file (YAML) with a published: block")
     m.add_argument("--out", help="output folder (default: out/<case name>)")
     m.add_argument("--json", action="store_true", help="print comparison.json instead of the table")
+    w = sub.add_parser("sweep", help="solve a grid over case fields (resumable, parallel, Dask)")
+    w.add_argument("case", help="case file (YAML)")
+    w.add_argument(
+        "--vary",
+        action="append",
+        required=True,
+        metavar="FIELD=START:STOP:COUNT",
+        help="a dotted numeric case field and its values, e.g. process.transfer_time_s=1:3:21",
+    )
+    w.add_argument("--law", choices=("improved-s-curve",), default=None, help="motion law (default: case)")
+    w.add_argument("--placement", choices=("free", "published"), help="where theta1/theta4 may fall")
+    w.add_argument("--workers", type=_positive, default=2, help="local worker processes (default 2)")
+    w.add_argument("--scheduler", help="address of a Dask distributed scheduler (instead of local workers)")
+    w.add_argument("--out", required=True, help="output folder (sweep.csv, sweep.json, sweep_spm.png)")
     pl = sub.add_parser("plot", help="redraw the figures of a finished output folder (no solve)")
     pl.add_argument("folder", help="output folder of `pressplan solve`")
     pl.add_argument("--format", choices=PLOT_FORMATS, default="png", help="figure format (default png)")
     return ap
+
+
+def _positive(text: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if not 1 <= n <= 256:
+        raise argparse.ArgumentTypeError(f"must be 1 ... 256, got {n}")
+    return n
 
 
 def _points(text: str) -> int:
@@ -70,6 +94,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _check(case, args)
     if args.command == "compare":
         return _compare(case, args)
+    if args.command == "sweep":
+        return _sweep(case, args)
     return _solve(case, args)
 
 
@@ -160,6 +186,52 @@ def _compare(case, args) -> int:
     else:
         print(comparison_text(data))
         print(f"  wrote {', '.join(str(f) for f in files)}")
+    return EXIT_OK
+
+
+def _sweep(case, args) -> int:
+    import planning.optimize  # noqa: F401 - loaded once here, inherited by forked workers
+    from planning.outputs import OutputError, ensure_writable
+    from planning.plots import save, sweep_figure
+    from planning.sweep import SweepError, parse_vary, run_sweep
+
+    try:
+        varies = [parse_vary(v) for v in args.vary]
+    except SweepError as exc:
+        return _fail(str(exc), EXIT_INPUT)
+    if len({v.field for v in varies}) != len(varies):
+        return _fail("--vary: each field at most once", EXIT_INPUT)
+    out = Path(args.out)
+    try:
+        ensure_writable(out)
+    except OutputError as exc:
+        return _fail(str(exc), EXIT_INPUT)
+    base = case.model_dump(exclude_none=True)
+    if args.law:
+        base.setdefault("planner", {})["motion_law"] = args.law
+    tty = sys.stderr.isatty()
+
+    def progress(done: int, total: int, failed: int) -> None:
+        if tty:
+            bar = "#" * int(30 * done / total)
+            print(f"\rsweep [{bar:<30}] {done}/{total} points, {failed} without a plan", end="", file=sys.stderr)
+
+    try:
+        result = run_sweep(base, args.case, varies, out, args.workers, args.scheduler, args.placement, progress)
+    except SweepError as exc:
+        return _fail(str(exc), EXIT_INPUT)
+    if tty:
+        print(file=sys.stderr)
+    rows = result.rows
+    verified = sum(r["status"] == "verified" for r in rows)
+    if len(varies) <= 2:
+        title = f"{case.name}: strokes per minute over {' x '.join(v.field for v in varies)}"
+        save(sweep_figure(rows, result.fields, title), out / "sweep_spm.png")
+    print(
+        f"{case.name}: {len(rows)} points, {verified} verified, {len(rows) - verified} without a plan"
+        f"{f' ({result.resumed} from an earlier run)' if result.resumed else ''}"
+        f"{f', {result.repaired} improved from a neighbour' if result.repaired else ''}; wrote {out / 'sweep.csv'}"
+    )
     return EXIT_OK
 
 

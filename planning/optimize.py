@@ -242,13 +242,15 @@ def _violation(nlp: CycleNLP, placement: Placement, g: np.ndarray) -> tuple[str,
     return worst.name, float(np.max(viol[worst.start : worst.stop], initial=0.0))
 
 
-def solve(case: Case, placement: Placement | None = None, warm: Plan | None = None) -> Solution:
+def solve(case: Case, placement: Placement | None = None, warm: Plan | None = None, follow: bool = False) -> Solution:
     """The fastest verified cycle for ``case``; raises :class:`PlanningError` when there is none.
 
     ``warm``: a plan of a neighbouring case (a sweep, a relaxed limit). It is verified against this
     case as it stands (when its placement fits and its key angles and draw speed are this case's) and
     its NLP values start the multi-start, so the answer is never worse than ``warm`` where ``warm``
-    is feasible here.
+    is feasible here. ``follow``: with a fitting ``warm`` plan, solve from it alone and return what
+    that start finds when it verifies (a sweep following its neighbours); otherwise the full
+    multi-start runs.
     """
     placement = placement or case.planner.placement
     t_start = time.perf_counter()
@@ -324,24 +326,41 @@ def solve(case: Case, placement: Placement | None = None, warm: Plan | None = No
         if check.passed:
             best = Solution(warm, check)
     warm_values = [warm.nlp_values] if warm is not None and warm.nlp_values else []
+    same_rule = warm is not None and (warm.placement == placement or placement == "free")
+    if follow and warm_values and same_rule and attempt(warm_values[0], warm.placement) is not None:
+        return _finished(best, iterations, starts, t_start, placement)
     published_starts = [_guess(case, w2, w_transfer, share, 1.0) for share in (0.9, 0.6)]
     published_starts.append(_guess(case, w2, 0.5 * (w_transfer + w_min), 0.75, 1.0))
     if warm is not None and warm.placement == "published":
         published_starts = warm_values + published_starts
     pub_values = multi_start(published_starts, "published")
     if placement == "free":
-        free_starts = warm_values if warm is not None and warm.placement == "free" else []
+        free_starts = list(warm_values) if warm is not None and warm.placement == "free" else []
         free_starts += [pub_values] if pub_values is not None else []  # a feasible start of the free problem
         free_starts.append(_guess(case, w2, w_transfer, 0.9, 1.5))
         free_starts.append(_guess(case, w2, 2 * w_min, 0.95, 2.0))
         multi_start(free_starts, "free")
-        if best is not None and best.plan.placement == "published":
-            # the published structure is one of the free structures: report it as the free answer
-            best = Solution(replace(best.plan, placement="free"), best.verification)
+    return _finished(best, iterations, starts, t_start, placement, failures)
+
+
+def _finished(
+    best: Solution | None,
+    iterations: int,
+    starts: int,
+    t_start: float,
+    placement: Placement,
+    failures: list[str] | None = None,
+) -> Solution:
+    """The answer of :func:`solve`: the best verified plan with the solver's totals, or the error."""
     if best is None:
+        failures = failures or []
         raise PlanningError(
             "infeasible" if not any(f.startswith("verification") for f in failures) else "unverified",
             "no plan meets the limits: " + (failures[-1] if failures else "no start converged"),
         )
-    info = SolverInfo(iterations, time.perf_counter() - t_start, starts, best.plan.solver.status)
-    return Solution(replace(best.plan, solver=info), best.verification)
+    plan = best.plan
+    if placement == "free" and plan.placement == "published":
+        # the published structure is one of the free structures: report it as the free answer
+        plan = replace(plan, placement="free")
+    info = SolverInfo(iterations, time.perf_counter() - t_start, starts, plan.solver.status)
+    return Solution(replace(plan, solver=info), best.verification)

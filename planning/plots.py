@@ -192,3 +192,39 @@ def plot_files(
 def save(fig: Figure, path: Path) -> None:
     """Write one figure; the format follows the file name (``.png`` at 90 dpi)."""
     fig.savefig(path, format=path.suffix.lstrip("."))
+
+
+def sweep_figure(rows: list[dict[str, Any]], fields: list[str], title: str) -> Figure:
+    """SPM against the swept field (one field) or a heat map of SPM (two fields); failed points shown."""
+    fig = Figure(figsize=(9, 6), dpi=90)
+    FigureCanvasAgg(fig)
+    ax = fig.subplots()
+    spm = np.array([float(r["spm"]) if r.get("spm") not in ("", None) else np.nan for r in rows])
+    ok = np.array([r.get("status") == "verified" for r in rows])
+    if len(fields) == 1:
+        x = np.array([float(r[fields[0]]) for r in rows])
+        ax.plot(x[ok], spm[ok], "o-", color="tab:blue", ms=4, lw=1.4, label="verified plan")
+        if (~ok).any():
+            ax.plot(
+                x[~ok],
+                np.full((~ok).sum(), np.nanmin(spm) if ok.any() else 0.0),
+                "x",
+                color="tab:red",
+                label="no verified plan",
+            )
+        ax.set_xlabel(fields[0])
+        ax.set_ylabel("strokes per minute")
+        ax.grid(True, lw=0.3)
+        ax.legend(fontsize=9)
+    else:
+        xs = sorted({float(r[fields[0]]) for r in rows})
+        ys = sorted({float(r[fields[1]]) for r in rows})
+        z = np.full((len(ys), len(xs)), np.nan)
+        for r, v in zip(rows, spm, strict=True):
+            z[ys.index(float(r[fields[1]])), xs.index(float(r[fields[0]]))] = v
+        mesh = ax.pcolormesh(xs, ys, z, shading="nearest", cmap="viridis")
+        fig.colorbar(mesh, ax=ax, label="strokes per minute")
+        ax.set_xlabel(fields[0])
+        ax.set_ylabel(fields[1])
+    ax.set_title(title, fontsize=10)
+    return fig

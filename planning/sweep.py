@@ -1,0 +1,347 @@
+"""Parameter sweeps: the full grid over dotted case fields, each point solved and verified.
+
+The grid is cut into contiguous blocks of at most :data:`BLOCK_POINTS` points. A block is solved in
+order, each point starting from its neighbour's plan (``solve(..., warm=..., follow=True)``); the first
+point of a block gets the full multi-start. The blocks go to local worker processes or to a Dask
+distributed cluster; the cut depends on the grid alone, so both give the same rows. Rows are appended
+to ``sweep.csv`` as blocks finish, so a sweep that is stopped resumes with the points it lacks. A
+point that fails becomes a row that says why; it never stops the sweep. When all blocks are in, a
+repair pass re-solves any point whose neighbour's plan is feasible for it and better (see
+:func:`repair`), and the file is rewritten in grid order.
+"""
+
+from __future__ import annotations
+
+import csv
+import difflib
+import itertools
+import json
+import math
+import os
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from pydantic import BaseModel
+
+from planning.case import Case
+
+BLOCK_POINTS = 6
+ROW_FIELDS = ("spm", "cycle_time_s", "status", "binding", "solve_time_s", "message")
+
+
+class SweepError(ValueError):
+    """A sweep that cannot start; ``str()`` is a one-line message."""
+
+
+@dataclass(frozen=True)
+class Vary:
+    """One swept field: dotted ``field``, ``count`` values from ``start`` to ``stop`` (inclusive)."""
+
+    field: str
+    start: float
+    stop: float
+    count: int
+
+    @property
+    def values(self) -> np.ndarray:
+        """The swept values, rounded to 12 significant digits (no 1.7000000000000002 in the table)."""
+        return np.array([float(f"{v:.12g}") for v in np.linspace(self.start, self.stop, self.count)])
+
+
+def numeric_fields(model: type[BaseModel] = Case, prefix: str = "") -> list[str]:
+    """Dotted names of every numeric field of a case (the fields a sweep can vary)."""
+    out = []
+    for name, info in model.model_fields.items():
+        if prefix == "" and name == "published":
+            continue
+        args = getattr(info.annotation, "__args__", (info.annotation,))
+        nested = [a for a in args if isinstance(a, type) and issubclass(a, BaseModel)]
+        if nested:
+            out += numeric_fields(nested[0], f"{prefix}{name}.")
+        elif float in args or info.annotation is float or "float" in str(info.annotation):
+            out.append(f"{prefix}{name}")
+    return out
+
+
+def parse_vary(text: str) -> Vary:
+    """``FIELD=START:STOP:COUNT`` -> :class:`Vary`; :class:`SweepError` naming what is wrong."""
+    if "=" not in text:
+        raise SweepError(f"--vary: expected FIELD=START:STOP:COUNT (got {text!r})")
+    field, spec = text.split("=", 1)
+    field = field.strip()
+    valid = numeric_fields()
+    if field not in valid:
+        hint = difflib.get_close_matches(field, valid, n=1, cutoff=0.5)
+        did = f"; did you mean '{hint[0]}'?" if hint else f"; numeric fields: {', '.join(valid)}"
+        raise SweepError(f"--vary: {field}: not a numeric case field{did}")
+    parts = spec.split(":")
+    if len(parts) != 3:
+        raise SweepError(f"--vary: {field}: expected START:STOP:COUNT (got {spec!r})")
+    try:
+        start, stop = float(parts[0]), float(parts[1])
+        count = int(parts[2])
+    except ValueError:
+        raise SweepError(
+            f"--vary: {field}: START and STOP must be numbers, COUNT a whole number (got {spec!r})"
+        ) from None
+    if not (math.isfinite(start) and math.isfinite(stop)):
+        raise SweepError(f"--vary: {field}: START and STOP must be finite (got {spec!r})")
+    if not 1 <= count <= 100_000:
+        raise SweepError(f"--vary: {field}: COUNT must be 1 ... 100000 (got {count})")
+    return Vary(field, start, stop, count)
+
+
+def grid(varies: list[Vary]) -> list[tuple[float, ...]]:
+    """Every combination of the swept values, the last field varying fastest."""
+    return [tuple(float(v) for v in combo) for combo in itertools.product(*(v.values for v in varies))]
+
+
+def point_data(base: dict[str, Any], fields: list[str], values: tuple[float, ...]) -> dict[str, Any]:
+    """The case mapping of one grid point (a deep copy of ``base`` with the fields set)."""
+    data = json.loads(json.dumps(base))
+    for field, value in zip(fields, values, strict=True):
+        node = data
+        *parents, leaf = field.split(".")
+        for key in parents:
+            node = node.setdefault(key, {})
+        node[leaf] = value
+    return data
+
+
+def solve_block(
+    base: dict[str, Any],
+    fields: list[str],
+    points: list[tuple[int, tuple[float, ...]]],
+    placement: str | None,
+    label: str,
+) -> list[dict[str, Any]]:
+    """Solve a block of grid points in order, each from its neighbour's plan; one row per point."""
+    from planning.case_file import CaseFileError, case_from_data
+    from planning.optimize import PlanningError, solve
+
+    rows = []
+    warm = None
+    for index, values in points:
+        row: dict[str, Any] = {"index": index, **dict(zip(fields, values, strict=True))}
+        t = time.perf_counter()
+        try:
+            case = case_from_data(point_data(base, fields, values), f"{label}[{index}]")
+            sol = solve(case, placement, warm=warm, follow=warm is not None)
+            warm = sol.plan
+            row.update(_solved_row(sol), plan=sol.plan)
+        except CaseFileError as exc:
+            row.update(status="bad input", message=str(exc))
+        except PlanningError as exc:
+            row.update(status=exc.kind, message=exc.reason)
+        except Exception as exc:  # noqa: BLE001 - one failing point never stops the sweep
+            row.update(status="error", message=f"{type(exc).__name__}: {exc}")
+        row["solve_time_s"] = time.perf_counter() - t
+        rows.append(row)
+    return rows
+
+
+def _solved_row(sol) -> dict[str, Any]:
+    from planning.report import binding
+
+    return {
+        "spm": sol.plan.spm,
+        "cycle_time_s": sol.plan.period,
+        "status": "verified",
+        "binding": ";".join(binding(sol)),
+        "message": "",
+    }
+
+
+def neighbours(index: int, shape: tuple[int, ...]) -> list[int]:
+    """Grid indices one step away from ``index`` along each field."""
+    pos = np.unravel_index(index, shape)
+    out = []
+    for axis in range(len(shape)):
+        for step in (-1, 1):
+            q = list(pos)
+            q[axis] += step
+            if 0 <= q[axis] < shape[axis]:
+                out.append(int(np.ravel_multi_index(q, shape)))
+    return out
+
+
+def repair(
+    base: dict[str, Any],
+    fields: list[str],
+    points: list[tuple[float, ...]],
+    shape: tuple[int, ...],
+    rows: dict[int, dict[str, Any]],
+    placement: str | None,
+    label: str,
+    passes: int = 12,
+) -> int:
+    """Where a neighbour's plan verifies for a point and beats it, re-solve the point from that plan.
+
+    The blocks follow their neighbours one way only; a chain can lose the better optimum at a change
+    of structure. A plan of a neighbouring point that passes this point's verification is a feasible
+    answer here, so the point is never left worse than it. Passes alternate in direction until
+    nothing changes. Returns how many re-solves improved a point.
+    """
+    from planning.case_file import CaseFileError, case_from_data
+    from planning.optimize import PlanningError, solve
+    from planning.verify import verify
+
+    improved = 0
+    for k in range(passes):
+        changed = False
+        for i in sorted(rows, reverse=k % 2 == 1):  # alternate directions: improvements travel both ways
+            try:
+                case = case_from_data(point_data(base, fields, points[i]), f"{label}[{i}]")
+            except CaseFileError:
+                continue
+            current = rows[i].get("spm") if rows[i].get("status") == "verified" else None
+            for j in neighbours(i, shape):
+                plan = rows.get(j, {}).get("plan")
+                if plan is None or (current is not None and plan.spm <= current + 1e-9):
+                    continue
+                same = np.allclose(plan.key_angles, case.key_angles, atol=1e-12)
+                if not same or not verify(plan, case).passed:
+                    continue
+                try:
+                    sol = solve(case, placement, warm=plan, follow=True)
+                except PlanningError:
+                    continue
+                if current is None or sol.plan.spm > current + 1e-9:
+                    rows[i].update(_solved_row(sol), plan=sol.plan)
+                    current = sol.plan.spm
+                    improved += 1
+                    changed = True
+        if not changed:
+            break
+    return improved
+
+
+def blocks(pending: list[int], points: list[tuple[float, ...]]) -> list[list[tuple[int, tuple[float, ...]]]]:
+    """Contiguous runs of pending point indices, cut every :data:`BLOCK_POINTS` grid points."""
+    out: dict[int, list[tuple[int, tuple[float, ...]]]] = {}
+    for i in pending:
+        out.setdefault(i // BLOCK_POINTS, []).append((i, points[i]))
+    return [out[k] for k in sorted(out)]
+
+
+@dataclass
+class SweepResult:
+    """``rows`` (all points, by index), how many were ``resumed`` from an earlier run, how many were
+    ``repaired`` from a neighbour's better plan."""
+
+    rows: list[dict[str, Any]]
+    resumed: int
+    fields: list[str]
+    repaired: int = 0
+
+
+def _read_rows(path: Path) -> list[dict[str, Any]]:
+    if not path.exists():
+        return []
+    with open(path, newline="", encoding="utf-8") as fh:
+        return list(csv.DictReader(fh))
+
+
+def run_sweep(
+    base: dict[str, Any],
+    label: str,
+    varies: list[Vary],
+    out: Path,
+    workers: int = 2,
+    scheduler: str | None = None,
+    placement: str | None = None,
+    progress: Callable[[int, int, int], None] | None = None,
+) -> SweepResult:
+    """Solve the grid into ``out/sweep.csv`` (resuming what an earlier run of the same sweep wrote)."""
+    fields = [v.field for v in varies]
+    points = grid(varies)
+    out.mkdir(parents=True, exist_ok=True)
+    spec = {
+        "fields": fields,
+        "grid": [[v.start, v.stop, v.count] for v in varies],
+        "case": base,
+        "placement": placement,
+    }
+    spec_path, csv_path = out / "sweep.json", out / "sweep.csv"
+    if spec_path.exists() and json.loads(spec_path.read_text(encoding="utf-8")) != spec:
+        raise SweepError(f"{out}: holds a different sweep (sweep.json); choose another --out")
+    spec_path.write_text(json.dumps(spec, indent=2) + "\n", encoding="utf-8")
+    done = {int(r["index"]) for r in _read_rows(csv_path) if r.get("status")}
+    pending = [i for i in range(len(points)) if i not in done]
+    columns = ["index", *fields, *ROW_FIELDS]
+    new_file = not csv_path.exists() or csv_path.stat().st_size == 0
+    earlier = {int(r["index"]): r for r in _read_rows(csv_path) if r.get("status")}
+    failed = sum(1 for r in earlier.values() if r["status"] != "verified")
+    finished = len(done)
+    fresh: dict[int, dict[str, Any]] = {}
+    with open(csv_path, "a", newline="", encoding="utf-8") as fh:
+        writer = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
+        if new_file:
+            writer.writeheader()
+        for rows in _execute(base, fields, blocks(pending, points), placement, label, workers, scheduler):
+            for row in rows:
+                writer.writerow({k: _cell(row.get(k)) for k in columns})
+                fresh[row["index"]] = row
+                finished += 1
+                failed += row["status"] != "verified"
+            fh.flush()
+            os.fsync(fh.fileno())
+            if progress:
+                progress(finished, len(points), failed)
+    shape = tuple(v.count for v in varies)
+    for i, r in earlier.items():  # rows of an earlier run: their plans are not kept
+        fresh.setdefault(i, {**r, "index": i, "spm": float(r["spm"]) if r.get("spm") else None})
+    improved = repair(base, fields, points, shape, fresh, placement, label)
+    tmp = csv_path.with_suffix(".csv.tmp")
+    with open(tmp, "w", newline="", encoding="utf-8") as fh:
+        writer = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
+        writer.writeheader()
+        for i in sorted(fresh):
+            writer.writerow({k: _cell(fresh[i].get(k)) for k in columns})
+    os.replace(tmp, csv_path)
+    rows = sorted(_read_rows(csv_path), key=lambda r: int(r["index"]))
+    return SweepResult(rows, len(done), fields, improved)
+
+
+def _cell(value: Any) -> Any:
+    if isinstance(value, float):
+        return repr(value)
+    return "" if value is None else value
+
+
+def _execute(base, fields, work, placement, label, workers, scheduler) -> Iterator[list[dict[str, Any]]]:
+    """Blocks of rows as they finish: in this process (1 worker), a process pool, or Dask."""
+    if not work:
+        return
+    if scheduler:
+        try:
+            from dask.distributed import Client, as_completed
+        except ImportError:
+            raise SweepError("--scheduler needs dask.distributed (pip install 'pressplan[cluster]')") from None
+        try:
+            client = Client(scheduler, timeout="10s")
+        except (OSError, TimeoutError) as exc:
+            raise SweepError(f"--scheduler: cannot reach {scheduler} ({exc})") from None
+        try:
+            futures = [client.submit(solve_block, base, fields, blk, placement, label, pure=False) for blk in work]
+            for fut in as_completed(futures):
+                yield fut.result()
+        finally:
+            client.close()
+        return
+    if workers <= 1:
+        for blk in work:
+            yield solve_block(base, fields, blk, placement, label)
+        return
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    ctx = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
+    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+        futures = [pool.submit(solve_block, base, fields, blk, placement, label) for blk in work]
+        for fut in as_completed(futures):
+            yield fut.result()
