@@ -3,8 +3,8 @@
 Measures (a) the in-process solve after a warm-up (the NLP already built), a cold ``pressplan solve``
 process beside a process that only imports casadi, numpy, matplotlib and yaml, and the NLP build
 alone; (b) a 41-point transfer-time sweep with 1 and 2 workers (whole process, points per second).
-Motion-law figures (c) come when there are other laws. Medians; run with ``python benchmarks/bench_solve.py`` from the project
-root in the environment where pressplan is installed.
+Motion-law figures (c) come when there are other laws. Medians; run with
+``python benchmarks/bench_solve.py`` from the project root where pressplan is installed.
 """
 
 from __future__ import annotations
