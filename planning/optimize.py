@@ -354,10 +354,10 @@ def _finished(
     """The answer of :func:`solve`: the best verified plan with the solver's totals, or the error."""
     if best is None:
         failures = failures or []
-        raise PlanningError(
-            "infeasible" if not any(f.startswith("verification") for f in failures) else "unverified",
-            "no plan meets the limits: " + (failures[-1] if failures else "no start converged"),
-        )
+        found = [f for f in failures if f.startswith("verification")]
+        if found:  # a converged plan failed the dense check: that finding is the answer
+            raise PlanningError("unverified", "no plan meets the limits: " + found[0])
+        raise PlanningError("infeasible", "no plan meets the limits: " + (failures[-1] if failures else "no start"))
     plan = best.plan
     if placement == "free" and plan.placement == "published":
         # the published structure is one of the free structures: report it as the free answer

@@ -140,3 +140,33 @@ def test_case_file_is_never_written(tmp_path):
     before = PUBLISHED_CASE.read_bytes()
     main(["check", str(PUBLISHED_CASE)])
     assert PUBLISHED_CASE.read_bytes() == before
+
+
+def test_solver_success_but_failed_verification_is_exit_3(monkeypatch, tmp_path, capsys):
+    """No false successes: when every plan fails the dense check, nothing is written and exit is 3."""
+    import planning.optimize as optimize
+    from planning.verify import Check, Verification
+
+    def failing(plan, case):
+        return Verification((Check("|slider acceleration|", 9999.0, 3500.0, "mm/s^2", "max", False),), 1e-3, 10)
+
+    monkeypatch.setattr(optimize, "verify", failing)
+    out = tmp_path / "o"
+    assert main(["solve", str(PUBLISHED_CASE), "--out", str(out)]) == 3
+    err = capsys.readouterr().err
+    assert "verification failed: |slider acceleration| = 9999" in err and len(err.strip().splitlines()) == 1
+    assert not out.exists() or not any(out.iterdir())
+
+
+def test_last_iterate_names_the_violated_constraint():
+    import numpy as np
+
+    from planning.nlp import cycle_nlp
+    from planning.optimize import _violation
+
+    nlp = cycle_nlp()
+    lbg, ubg = nlp.bounds("free")
+    g = np.where(np.isfinite(lbg), lbg, np.where(np.isfinite(ubg), ubg, 0.0))
+    block = next(b for b in nlp.blocks if b.name == "transfer time")
+    g[block.start] = -0.7  # 0.7 s short of the transfer time
+    assert _violation(nlp, "free", g) == ("transfer time", 0.7)
