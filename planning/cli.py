@@ -54,6 +54,10 @@ def _parser() -> argparse.ArgumentParser:
     w.add_argument("--workers", type=_positive, default=2, help="local worker processes (default 2)")
     w.add_argument("--scheduler", help="address of a Dask distributed scheduler (instead of local workers)")
     w.add_argument("--out", required=True, help="output folder (sweep.csv, sweep.json, sweep_spm.png)")
+    b = sub.add_parser("bound", help="the time-optimal bound: the most strokes any motion can make")
+    b.add_argument("case", help="case file (YAML)")
+    b.add_argument("--points", type=_points, default=1440, metavar="N", help="grid intervals (default 1440)")
+    b.add_argument("--json", action="store_true", help="print JSON")
     pl = sub.add_parser("plot", help="redraw the figures of a finished output folder (no solve)")
     pl.add_argument("folder", help="output folder of `pressplan solve`")
     pl.add_argument("--format", choices=PLOT_FORMATS, default="png", help="figure format (default png)")
@@ -96,6 +100,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _compare(case, args)
     if args.command == "sweep":
         return _sweep(case, args)
+    if args.command == "bound":
+        return _bound(case, args)
     return _solve(case, args)
 
 
@@ -232,6 +238,26 @@ def _sweep(case, args) -> int:
         f"{f' ({result.resumed} from an earlier run)' if result.resumed else ''}"
         f"{f', {result.repaired} improved from a neighbour' if result.repaired else ''}; wrote {out / 'sweep.csv'}"
     )
+    return EXIT_OK
+
+
+def _bound(case, args) -> int:
+    from planning.bound import time_optimal_bound
+    from planning.optimize import PlanningError
+
+    try:
+        bound = time_optimal_bound(case, args.points)
+    except PlanningError as exc:
+        return _fail(f"{args.case}: {exc}", EXIT_INFEASIBLE)
+    data = {"case": case.name, **bound.as_dict()}
+    if args.json:
+        print(json.dumps(data, indent=2))
+    else:
+        print(
+            f"{case.name}: time-optimal bound {bound.spm:.3f} strokes/min, cycle {bound.cycle_time_s:.4f} s "
+            f"({bound.points} intervals; peak crank speed {data['peak_crank_speed_rpm']:.2f} rpm, "
+            f"draw {bound.draw_speed_rpm:.3f} rpm, robot-window slack {bound.window_slack_s:.3f} s)"
+        )
     return EXIT_OK
 
 

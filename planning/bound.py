@@ -1,0 +1,148 @@
+"""The time-optimal bound: the shortest cycle any crank motion can make under the case's limits.
+
+No motion law: the crank speed is free except for the limits (acceleration-limited; the acceleration
+may jump). Direct transcription over crank angle in the phase plane: on a grid theta_0 < ... <
+theta_N = theta_0 + 2 pi (the key angles are nodes) the variable is ``s_i = omega_i^2`` [rad^2/s^2].
+With s linear between nodes the crank acceleration is constant on each interval,
+``alpha = (s_{i+1} - s_i) / (2 dtheta)``, and the interval takes ``2 dtheta / (sqrt(s_i) + sqrt(s_{i+1}))``.
+
+    minimise   sum tau_i
+    subject to tau_i >= 2 dtheta_i / (sqrt(s_i) + sqrt(s_{i+1}))       (convex)
+               |d2h/dtheta2 s + dh/dtheta alpha_i| <= A  at both ends of interval i   (linear in s)
+               s = w2^2 on the draw (w2 given, or one free value within its bounds)
+               s <= (v_die / |dh/dtheta|)^2 where the slider is at or below the die height
+               s >= w_min^2;   sum of tau over theta4 -> theta1 >= transfer time   (linear)
+
+Every constraint set is convex and the objective linear, so IPOPT's optimum is the global one: a
+local solution cannot be mistaken for the bound. Where ``tau_i`` exceeds the interval's time (only
+useful inside the robot window), the problem is a relaxation and the bound is still valid (never below
+the best SPM any motion reaches); ``window_slack_s`` reports how much was used. Without a crank
+acceleration limit the slack can be realised: near TDC dh/dtheta -> 0, so the slider does not feel the
+crank's acceleration there and the crank may slow almost to a stop at no cost in slider acceleration.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from planning.case import RPM, Case
+from planning.optimize import PlanningError, precheck
+
+DEFAULT_POINTS = 1440
+
+
+@dataclass(frozen=True)
+class Bound:
+    """The bound: ``spm``, ``cycle_time_s`` [s], ``points`` of the grid, ``window_slack_s`` [s] (time the
+    relaxation adds in the robot window beyond the motion's own), ``draw_speed_rpm``, the speed
+    profile ``angle_deg`` / ``crank_speed_rpm`` at the nodes, ``wall_time_s`` [s]."""
+
+    spm: float
+    cycle_time_s: float
+    points: int
+    window_slack_s: float
+    draw_speed_rpm: float
+    angle_deg: np.ndarray
+    crank_speed_rpm: np.ndarray
+    wall_time_s: float
+
+    def as_dict(self) -> dict:
+        return {
+            "spm": self.spm,
+            "cycle_time_s": self.cycle_time_s,
+            "points": self.points,
+            "window_slack_s": self.window_slack_s,
+            "draw_speed_rpm": self.draw_speed_rpm,
+            "peak_crank_speed_rpm": float(np.max(self.crank_speed_rpm)),
+            "wall_time_s": self.wall_time_s,
+            "method": "phase-plane direct transcription over crank angle, convex (global optimum)",
+        }
+
+
+def angle_grid(case: Case, points: int) -> np.ndarray:
+    """Nodes [rad] from theta1 over one revolution, the key angles among them, about ``points`` in all."""
+    th1, th2, th3, th4 = case.key_angles
+    arcs = [th1, th2, th3, th4, th1 + 2 * math.pi]
+    nodes = [np.array([th1])]
+    for a, b in zip(arcs[:-1], arcs[1:], strict=True):
+        n = max(4, int(round(points * (b - a) / (2 * math.pi))))
+        nodes.append(np.linspace(a, b, n + 1)[1:])
+    return np.concatenate(nodes)
+
+
+def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
+    """The bound for ``case`` on a grid of about ``points`` intervals; :class:`PlanningError` if none."""
+    t_start = time.perf_counter()
+    w2_lo, w2_hi = precheck(case)
+    th = angle_grid(case, points)
+    n = len(th) - 1  # intervals; node n is node 0 one revolution on
+    dth = np.diff(th)
+    m = case.machine
+    d1, d2, _ = m.derivatives(th)
+    h = m.height(th)
+    lim = case.limits
+    th1, th2, th3, th4 = case.key_angles
+    w_min = lim.min_crank_speed_rpm * RPM
+
+    s = ca.MX.sym("s", n)  # s at nodes 0..n-1; node n is node 0
+    tau = ca.MX.sym("tau", n)
+    s_next = ca.vertcat(s[1:], s[0])
+    alpha = (s_next - s) / (2 * dth)
+    a_start = d2[:-1] * s + d1[:-1] * alpha
+    a_end = d2[1:] * s_next + d1[1:] * alpha
+    g = [tau - 2 * dth / (ca.sqrt(s) + ca.sqrt(s_next)), a_start, a_end]
+    lbg = [np.zeros(n), -lim.slider_accel_mm_s2 * np.ones(n), -lim.slider_accel_mm_s2 * np.ones(n)]
+    ubg = [np.full(n, np.inf), lim.slider_accel_mm_s2 * np.ones(n), lim.slider_accel_mm_s2 * np.ones(n)]
+    window = th[:-1] >= th4 - 1e-12  # the grid starts at theta1: the robot window is [theta4, theta1 + 2 pi)
+    g.append(ca.sum1(tau[np.flatnonzero(window).tolist()]))
+    lbg.append(np.array([case.process.transfer_time_s]))
+    ubg.append(np.array([np.inf]))
+    draw = np.flatnonzero((th[:-1] >= th2 - 1e-12) & (th[:-1] <= th3 + 1e-12))
+    if draw.size > 1:  # one speed through the draw
+        g.append(s[draw[1:].tolist()] - s[draw[:-1].tolist()])
+        lbg.append(np.zeros(draw.size - 1))
+        ubg.append(np.zeros(draw.size - 1))
+    lbx_s = np.full(n, w_min**2)
+    ubx_s = np.full(n, np.inf)
+    lbx_s[draw] = w2_lo**2
+    ubx_s[draw] = w2_hi**2
+    low = (h[:-1] <= lim.die_height_mm) & (np.abs(d1[:-1]) > 0)
+    ubx_s[low] = np.minimum(ubx_s[low], (lim.die_speed_mm_s / np.abs(d1[:-1][low])) ** 2)
+    if np.any(ubx_s < lbx_s):
+        raise PlanningError("infeasible", "the die-height speed limit leaves no crank speed above the minimum")
+    x = ca.vertcat(s, tau)
+    nlp = {"x": x, "f": ca.sum1(tau), "g": ca.vertcat(*g)}
+    opts = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.tol": 1e-10, "ipopt.max_iter": 3000}
+    solver = ca.nlpsol("bound", "ipopt", nlp, opts)
+    s0 = np.clip(np.full(n, (0.5 * (w2_lo + w2_hi)) ** 2), lbx_s, np.where(np.isfinite(ubx_s), ubx_s, np.inf))
+    x0 = np.concatenate([s0, 2 * dth / (2 * np.sqrt(s0))])
+    res = solver(
+        x0=x0,
+        lbx=np.concatenate([lbx_s, np.zeros(n)]),
+        ubx=np.concatenate([ubx_s, np.full(n, np.inf)]),
+        lbg=np.concatenate(lbg),
+        ubg=np.concatenate(ubg),
+    )
+    status = solver.stats()["return_status"]
+    if status not in ("Solve_Succeeded", "Solved_To_Acceptable_Level"):
+        raise PlanningError("infeasible", f"the time-optimal bound did not converge ({status})")
+    xs = np.array(res["x"]).ravel()
+    s_opt, tau_opt = np.maximum(xs[:n], 0.0), xs[n:]
+    s_next_opt = np.roll(s_opt, -1)
+    motion = 2 * dth / (np.sqrt(s_opt) + np.sqrt(s_next_opt))
+    period = float(np.sum(tau_opt))
+    return Bound(
+        spm=60.0 / period,
+        cycle_time_s=period,
+        points=n,
+        window_slack_s=float(np.sum(tau_opt - motion)),
+        draw_speed_rpm=float(np.sqrt(s_opt[draw[0]]) / RPM) if draw.size else math.nan,
+        angle_deg=np.degrees(th[:-1]) % 360.0,
+        crank_speed_rpm=np.sqrt(s_opt) / RPM,
+        wall_time_s=time.perf_counter() - t_start,
+    )
