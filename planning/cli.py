@@ -35,7 +35,9 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--json", action="store_true", help="print result.json instead of the summary")
     s.add_argument("--format", choices=PLOT_FORMATS, default="png", help="figure format (default png)")
     s.add_argument("--no-plots", action="store_true", help="do not draw the figures")
-    s.add_argument("--cam-points", type=_points, default=3600, metavar="N", help="cam table rows (default 3600)")
+    s.add_argument(
+        "--cam-points", type=_whole(2, 1_000_000), default=3600, metavar="N", help="cam table rows (default 3600)"
+    )
     m = sub.add_parser("compare", help="the published solution beside ours, and checked against itself")
     m.add_argument("case", help="case file (YAML) with a published: block")
     m.add_argument("--out", help="output folder (default: out/<case name>)")
@@ -51,12 +53,14 @@ def _parser() -> argparse.ArgumentParser:
     )
     w.add_argument("--law", choices=("improved-s-curve",), default=None, help="motion law (default: case)")
     w.add_argument("--placement", choices=("free", "published"), help="where theta1/theta4 may fall")
-    w.add_argument("--workers", type=_positive, default=2, help="local worker processes (default 2)")
+    w.add_argument("--workers", type=_whole(1, 256), default=2, help="local worker processes (default 2)")
     w.add_argument("--scheduler", help="address of a Dask distributed scheduler (instead of local workers)")
     w.add_argument("--out", required=True, help="output folder (sweep.csv, sweep.json, sweep_spm.png)")
     b = sub.add_parser("bound", help="the time-optimal bound: the most strokes any motion can make")
     b.add_argument("case", help="case file (YAML)")
-    b.add_argument("--points", type=_points, default=1440, metavar="N", help="grid intervals (default 1440)")
+    b.add_argument(
+        "--points", type=_whole(2, 1_000_000), default=1440, metavar="N", help="grid intervals (default 1440)"
+    )
     b.add_argument("--json", action="store_true", help="print JSON")
     pl = sub.add_parser("plot", help="redraw the figures of a finished output folder (no solve)")
     pl.add_argument("folder", help="output folder of `pressplan solve`")
@@ -64,24 +68,19 @@ def _parser() -> argparse.ArgumentParser:
     return ap
 
 
-def _positive(text: str) -> int:
-    try:
-        n = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
-    if not 1 <= n <= 256:
-        raise argparse.ArgumentTypeError(f"must be 1 ... 256, got {n}")
-    return n
+def _whole(lo: int, hi: int):
+    """An argparse type: a whole number in ``lo ... hi``."""
 
+    def parse(text: str) -> int:
+        try:
+            n = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+        if not lo <= n <= hi:
+            raise argparse.ArgumentTypeError(f"must be {lo} ... {hi}, got {n}")
+        return n
 
-def _points(text: str) -> int:
-    try:
-        n = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
-    if not 2 <= n <= 1_000_000:
-        raise argparse.ArgumentTypeError(f"must be 2 ... 1000000, got {n}")
-    return n
+    return parse
 
 
 def main(argv: Sequence[str] | None = None) -> int:
