@@ -16,7 +16,9 @@ With s linear between nodes the crank acceleration is constant on each interval,
 Every constraint set is convex and the objective linear, so IPOPT's optimum is the global one: a
 local solution cannot be mistaken for the bound. Where ``tau_i`` exceeds the interval's time (only
 useful inside the robot window), the problem is a relaxation and the bound is still valid (never below
-the best SPM any motion reaches); ``window_slack_s`` reports how much was used. Without a crank
+the best SPM any motion reaches); ``window_slack_s`` reports how much was used. The drive's speed and
+acceleration limits enter as bounds on s and alpha; a crank-jerk limit does not (the bound then
+ignores it and stays valid, if less tight). Without a crank
 acceleration limit the slack can be realised: near TDC dh/dtheta -> 0, so the slider does not feel the
 crank's acceleration there and the crank may slow almost to a stop at no cost in slider acceleration.
 """
@@ -98,6 +100,10 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
     g = [tau - 2 * dth / (ca.sqrt(s) + ca.sqrt(s_next)), a_start, a_end]
     lbg = [np.zeros(n), -lim.slider_accel_mm_s2 * np.ones(n), -lim.slider_accel_mm_s2 * np.ones(n)]
     ubg = [np.full(n, np.inf), lim.slider_accel_mm_s2 * np.ones(n), lim.slider_accel_mm_s2 * np.ones(n)]
+    if lim.crank_accel_rad_s2 is not None:  # the drive's acceleration limit, linear in s
+        g.append(alpha)
+        lbg.append(-lim.crank_accel_rad_s2 * np.ones(n))
+        ubg.append(lim.crank_accel_rad_s2 * np.ones(n))
     window = th[:-1] >= th4 - 1e-12  # the grid starts at theta1: the robot window is [theta4, theta1 + 2 pi)
     g.append(ca.sum1(tau[np.flatnonzero(window).tolist()]))
     lbg.append(np.array([case.process.transfer_time_s]))
@@ -108,7 +114,7 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
         lbg.append(np.zeros(draw.size - 1))
         ubg.append(np.zeros(draw.size - 1))
     lbx_s = np.full(n, w_min**2)
-    ubx_s = np.full(n, np.inf)
+    ubx_s = np.full(n, (lim.crank_speed_rpm * RPM) ** 2 if lim.crank_speed_rpm is not None else np.inf)
     lbx_s[draw] = w2_lo**2
     ubx_s[draw] = w2_hi**2
     low = (h[:-1] <= lim.die_height_mm) & (np.abs(d1[:-1]) > 0)

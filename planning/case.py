@@ -77,13 +77,17 @@ class ProcessModel(_Model):
 
 
 class LimitsModel(_Model):
-    """Process and machine limits; ``min_crank_speed_rpm`` keeps the crank turning forward."""
+    """Process and machine limits [units in the names]; ``min_crank_speed_rpm`` keeps the crank turning
+    forward; ``crank_speed_rpm``, ``crank_accel_rad_s2``, ``crank_jerk_rad_s3`` are the drive's limits."""
 
     draw_start_speed_mm_s: Positive
     die_height_mm: NonNegative
     die_speed_mm_s: Positive
     slider_accel_mm_s2: Positive
     min_crank_speed_rpm: Positive = 1.0
+    crank_speed_rpm: Positive | None = None  # motor limits (optional), on the crank
+    crank_accel_rad_s2: Positive | None = None
+    crank_jerk_rad_s3: Positive | None = None
 
 
 class PlannerModel(_Model):
@@ -183,6 +187,8 @@ def draw_speed_bounds(case: Case) -> dict[str, float]:
     out["die_speed"] = case.limits.die_speed_mm_s / peak if peak > 0 else math.inf
     curv = float(np.max(np.abs(d2)))
     out["slider_accel"] = math.sqrt(case.limits.slider_accel_mm_s2 / curv) if curv > 0 else math.inf
+    if case.limits.crank_speed_rpm is not None:
+        out["crank_speed"] = case.limits.crank_speed_rpm * RPM
     return out
 
 
@@ -222,6 +228,13 @@ def cross_checks(case: Case) -> None:
             f"must be below the slider height at the draw start ({h2:.1f} mm)",
             case.limits.die_height_mm,
         )
+    top = case.limits.crank_speed_rpm
+    if top is not None and top <= case.limits.min_crank_speed_rpm:
+        raise CaseError(
+            "limits.crank_speed_rpm",
+            f"must be above limits.min_crank_speed_rpm = {case.limits.min_crank_speed_rpm:g}",
+            top,
+        )
     if case.process.draw_speed_rpm is not None:
         bounds = draw_speed_bounds(case)
         limit_fields = {"draw_start_speed": "limits.draw_start_speed_mm_s", "die_speed": "limits.die_speed_mm_s"}
@@ -232,6 +245,11 @@ def cross_checks(case: Case) -> None:
                     f"is above the {bounds[key] / RPM:.3f} rpm that {field} allows",
                     case.process.draw_speed_rpm,
                 )
+        top = case.limits.crank_speed_rpm
+        if top is not None and case.process.draw_speed_rpm > top:
+            raise CaseError(
+                "process.draw_speed_rpm", f"is above limits.crank_speed_rpm = {top:g}", case.process.draw_speed_rpm
+            )
         if case.process.draw_speed_rpm < case.limits.min_crank_speed_rpm:
             raise CaseError(
                 "process.draw_speed_rpm",

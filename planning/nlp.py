@@ -74,6 +74,9 @@ PARAMETERS: tuple[str, ...] = (
     "die_up_angle",
     "die_up_slope",
     "die_up_active",
+    "crank_speed_max",  # motor limits [rad/s, rad/s^2, rad/s^3] (very large when the case sets none)
+    "crank_accel_max",
+    "crank_jerk_max",
 )
 PARAMETER_INDEX = {name: i for i, name in enumerate(PARAMETERS)}
 
@@ -290,6 +293,18 @@ def _build() -> CycleNLP:
     d1, d2, _ = height_derivatives(th, q["R"], q["L"])
     acc = d2 * om**2 + d1 * al
     add("slider acceleration", acc / q["accel_limit"], -1.0, 1.0)
+    # motor limits: the S-curve halves are monotone in speed, their accelerations peak at 3/2 J T (Eqs. 17,
+    # 21) and their jerk never exceeds J (Eq. 10)
+    peaks = ca.vertcat(params.feed_peak_speed, params.return_peak_speed, w1, w2)
+    add("crank speed limit", peaks / q["crank_speed_max"], -np.inf, 1.0)
+    halves = ca.vertcat(
+        sc.peak_accel(params.feed_jerk, params.feed_accel_time),
+        sc.peak_accel(params.feed_jerk, params.feed_decel_time),
+        sc.peak_accel(params.return_jerk, params.return_accel_time),
+        sc.peak_accel(params.return_jerk, params.return_decel_time),
+    )
+    add("crank acceleration limit", halves / q["crank_accel_max"], -np.inf, 1.0)
+    add("crank jerk limit", ca.vertcat(params.feed_jerk, params.return_jerk) / q["crank_jerk_max"], -np.inf, 1.0)
 
     nlp = {"x": x, "p": p, "f": params.period, "g": ca.vertcat(*g)}
     solver = ca.nlpsol("press_cycle", "ipopt", nlp, IPOPT_OPTIONS)

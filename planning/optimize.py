@@ -26,6 +26,7 @@ ACCEL_BACKOFF = 5e-4  # the NLP keeps |slider acceleration| <= (1 - backoff) * l
 MIN_SUBSEGMENT_S = 1e-3  # [s] lower bound on an S-curve sub-segment
 MAX_TIME_S = 600.0  # [s] upper bound on any time variable
 REFINEMENTS = 3  # re-solves with a lowered sampled acceleration limit
+NO_LIMIT = 1e9  # stands for an absent motor limit in the NLP's parameters
 AGREE_S = 1e-6  # [s] two starts whose best periods agree this closely have found the same optimum
 
 
@@ -87,8 +88,9 @@ def precheck(case: Case) -> tuple[float, float]:
 def nlp_parameters(case: Case) -> np.ndarray:
     """The parameter vector of the NLP for ``case`` (inside units)."""
     m = case.machine
+    lim = case.limits
     th1, th2, th3, th4 = case.key_angles
-    down, up = (float(a) for a in m.angles_at_height(case.limits.die_height_mm))
+    down, up = (float(a) for a in m.angles_at_height(lim.die_height_mm))
     values = {
         "R": case.press.crank_radius_mm,
         "L": case.press.rod_length_mm,
@@ -106,6 +108,9 @@ def nlp_parameters(case: Case) -> np.ndarray:
         "die_up_angle": up,
         "die_up_slope": abs(float(m.derivatives(up)[0])) if up > th3 else 0.0,
         "die_up_active": 1.0 if up > th3 else 0.0,
+        "crank_speed_max": (lim.crank_speed_rpm or NO_LIMIT) * RPM,
+        "crank_accel_max": lim.crank_accel_rad_s2 or NO_LIMIT,
+        "crank_jerk_max": lim.crank_jerk_rad_s3 or NO_LIMIT,
     }
     return np.array([values[k] for k in PARAMETERS], dtype=float)
 
@@ -116,7 +121,9 @@ def _guess(case: Case, w2: float, w1: float, peak_share: float, inside: float) -
     R, L = case.press.crank_radius_mm, case.press.rod_length_mm
     th1, th2, th3, th4 = case.key_angles
     w_acc = math.sqrt(case.limits.slider_accel_mm_s2 / (R + R**2 / L))  # |d2h/dtheta2| peaks at BDC
-    wm = max(peak_share * w_acc, 1.2 * max(w1, w2))
+    top = case.limits.crank_speed_rpm * RPM if case.limits.crank_speed_rpm else math.inf
+    w1 = min(w1, 0.8 * top)
+    wm = min(max(peak_share * w_acc, 1.2 * max(w1, w2)), max(0.98 * top, 1.01 * max(w1, w2)))
 
     def halves(angle: float, w_from: float, w_to: float) -> tuple[float, float, float]:
         ratio = math.sqrt((wm - w_to) / (wm - w_from))  # one jerk for both halves (Eq. 14)

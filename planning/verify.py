@@ -161,6 +161,14 @@ def verify(plan: Plan, case: Case) -> Verification:
     add(
         ACCEL_CHECK, float(np.max(np.abs(a))), lim.slider_accel_mm_s2, "mm/s^2", "max", REL_TOL * lim.slider_accel_mm_s2
     )
+    motor = (
+        ("crank speed <= crank_speed_rpm", lim.crank_speed_rpm, float(np.max(om)) / RPM, "rpm"),
+        ("|crank acceleration| <= crank_accel_rad_s2", lim.crank_accel_rad_s2, float(np.max(np.abs(al))), "rad/s^2"),
+        ("|crank jerk| <= crank_jerk_rad_s3", lim.crank_jerk_rad_s3, _max_abs_jerk(prof), "rad/s^3"),
+    )
+    for name, limit, value, unit in motor:
+        if limit is not None:
+            add(name, value, limit, unit, "max", REL_TOL * limit)
     add(
         "crank speed (forward, never stops)",
         float(np.min(om)) / RPM,
@@ -170,6 +178,11 @@ def verify(plan: Plan, case: Case) -> Verification:
         REL_TOL * lim.min_crank_speed_rpm,
     )
     return Verification(tuple(checks), float(np.max(np.diff(t))), int(t.size))
+
+
+def _max_abs_jerk(prof) -> float:
+    """Largest |crank jerk| [rad/s^3]: the jerk is linear in each segment, so at a segment's ends."""
+    return max(max(abs(float(s.j0)), abs(float(s.j0) + float(s.j1) * float(s.duration))) for s in prof.segments)
 
 
 def _slider_speed_at_angles(plan: Plan, case: Case, angles: list[float]) -> list[float]:
