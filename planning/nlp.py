@@ -16,9 +16,10 @@ acceleration), t4 = x3 + 3 T14 (three sub-segments into the return deceleration)
 
 Constraints: speed continuity of both S-curves (Eq. 19), the cycle closes at 2 pi, the key angles
 theta1 and theta4 are met, time(theta4 -> theta1) >= transfer time, |slider acceleration| <= limit at
-sample points of every segment (with a small back-off so that the dense verification holds between
-samples), slider speed at the die-height crossings outside the draw, draw speed within its bounds,
-crank speed >= the minimum crank speed (the S-curve halves are monotone for J >= 0).
+sample points of every segment (the orchestrator lowers that sampled limit until the dense
+verification holds between samples), slider speed at the die-height crossings outside the draw, draw
+speed within its bounds, crank speed >= the minimum crank speed (the S-curve halves are monotone for
+J >= 0), and the drive's limits: peak speeds, peak accelerations 3/2 J T, jerks J.
 """
 
 from __future__ import annotations
