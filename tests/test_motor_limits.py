@@ -25,8 +25,11 @@ def test_motor_limits_hold_on_the_dense_grid(limited):
     case, sol = limited
     lim = case.limits
     names = {c.name: c for c in sol.verification.checks}
-    for name in ("crank speed <= crank_speed_rpm", "|crank acceleration| <= crank_accel_rad_s2",
-                 "|crank jerk| <= crank_jerk_rad_s3"):
+    for name in (
+        "crank speed <= crank_speed_rpm",
+        "|crank acceleration| <= crank_accel_rad_s2",
+        "|crank jerk| <= crank_jerk_rad_s3",
+    ):
         assert names[name].passed
     t = np.linspace(0, sol.plan.period, 20001)
     _, om, al, je = sol.plan.profile.at_time(t)
