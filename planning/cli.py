@@ -132,7 +132,7 @@ def _output_folder(case, args) -> Path | int:
 
 def _solve(case, args) -> int:
     from planning.optimize import PlanningError, solve
-    from planning.outputs import OutputError, solution_writers, write_atomic
+    from planning.outputs import solution_writers
     from planning.report import result_dict, summary_text
 
     out = _output_folder(case, args)
@@ -144,26 +144,16 @@ def _solve(case, args) -> int:
         return _fail(f"{args.case}: {exc}", EXIT_INFEASIBLE)
     if not solution.verification.passed:  # solve() returns only verified plans; belt and braces
         return _fail(f"{args.case}: unverified plan not written", EXIT_INFEASIBLE)
-    try:
-        writers = solution_writers(
-            solution, case, cam_points=args.cam_points, plot_format=None if args.no_plots else args.format
-        )
-        files = write_atomic(out, writers)
-    except OutputError as exc:
-        return _fail(str(exc), EXIT_INPUT)
+    plot_format = None if args.no_plots else args.format
+    writers = solution_writers(solution, case, cam_points=args.cam_points, plot_format=plot_format)
     result = result_dict(solution, case)
-    if args.json:
-        print(json.dumps(result, indent=2))
-    else:
-        print(summary_text(result))
-        print(f"  wrote {', '.join(str(f) for f in files)}")
-    return EXIT_OK
+    return _write_and_report(out, writers, result, summary_text(result), args.json)
 
 
 def _compare(case, args) -> int:
     from planning.compare import comparison, comparison_markdown, comparison_text
     from planning.optimize import PlanningError, solve
-    from planning.outputs import OutputError, write_atomic, write_json
+    from planning.outputs import write_json
 
     if case.published is None or case.published.solution is None:
         return _fail(f"{args.case}: published.solution: the case has no published solution to compare", EXIT_INPUT)
@@ -176,20 +166,25 @@ def _compare(case, args) -> int:
     except PlanningError as exc:
         return _fail(f"{args.case}: {exc}", EXIT_INFEASIBLE)
     data = comparison(case, ours_published, ours_free)
+    writers = {
+        "comparison.json": lambda p: write_json(p, data),
+        "comparison.md": lambda p: p.write_text(comparison_markdown(data), encoding="utf-8"),
+    }
+    return _write_and_report(out, writers, data, comparison_text(data), args.json)
+
+
+def _write_and_report(out: Path, writers: dict, data: dict, text: str, as_json: bool) -> int:
+    """Write the files all or nothing, then print ``data`` as JSON or ``text`` with the files written."""
+    from planning.outputs import OutputError, write_atomic
+
     try:
-        files = write_atomic(
-            out,
-            {
-                "comparison.json": lambda p: write_json(p, data),
-                "comparison.md": lambda p: p.write_text(comparison_markdown(data), encoding="utf-8"),
-            },
-        )
+        files = write_atomic(out, writers)
     except OutputError as exc:
         return _fail(str(exc), EXIT_INPUT)
-    if args.json:
+    if as_json:
         print(json.dumps(data, indent=2))
     else:
-        print(comparison_text(data))
+        print(text)
         print(f"  wrote {', '.join(str(f) for f in files)}")
     return EXIT_OK
 
