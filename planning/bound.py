@@ -17,8 +17,11 @@ Every constraint set is convex and the objective linear, so IPOPT's optimum is t
 local solution cannot be mistaken for the bound. Where ``tau_i`` exceeds the interval's time (only
 useful inside the robot window), the problem is a relaxation and the bound is still valid (never below
 the best SPM any motion reaches); ``window_slack_s`` reports how much was used. The drive's speed and
-acceleration limits enter as bounds on s and alpha; a crank-jerk limit does not (the bound then
-ignores it and stays valid, if less tight). Without a crank
+acceleration limits enter as bounds on s and alpha. A crank-jerk limit J enters between neighbouring
+intervals as ``|alpha_{i+1} - alpha_i| <= J (tau_i + tau_{i+1}) / 2``: the acceleration of the interval
+centres may change by at most J times the time between them. It is linear in (s, tau), so the problem
+stays convex; since tau is at least the interval's time it is a relaxation of the jerk limit, and the
+bound stays an upper bound on what a jerk-limited motion reaches. Without a crank
 acceleration limit the slack can be realised: near TDC dh/dtheta -> 0, so the slider does not feel the
 crank's acceleration there and the crank may slow almost to a stop at no cost in slider acceleration.
 """
@@ -104,6 +107,13 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
         g.append(alpha)
         lbg.append(-lim.crank_accel_rad_s2 * np.ones(n))
         ubg.append(lim.crank_accel_rad_s2 * np.ones(n))
+    if lim.crank_jerk_rad_s3 is not None:  # |alpha_{i+1} - alpha_i| <= J (tau_i + tau_{i+1}) / 2, linear
+        alpha_next = ca.vertcat(alpha[1:], alpha[0])
+        tau_next = ca.vertcat(tau[1:], tau[0])
+        jerk_room = lim.crank_jerk_rad_s3 * (tau + tau_next) / 2
+        g += [alpha_next - alpha - jerk_room, alpha_next - alpha + jerk_room]
+        lbg += [np.full(n, -np.inf), np.zeros(n)]
+        ubg += [np.zeros(n), np.full(n, np.inf)]
     window = th[:-1] >= th4 - 1e-12  # the grid starts at theta1: the robot window is [theta4, theta1 + 2 pi)
     g.append(ca.sum1(tau[np.flatnonzero(window).tolist()]))
     lbg.append(np.array([case.process.transfer_time_s]))

@@ -16,6 +16,7 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
+from planning.laws import DEFAULT_LAW, LawName
 from press.kinematics import CrankSlider
 
 RPM = 2.0 * math.pi / 60.0  # [rad/s] per rpm
@@ -93,7 +94,7 @@ class LimitsModel(_Model):
 class PlannerModel(_Model):
     """``motion_law`` and ``placement`` of the key points (free | published)."""
 
-    motion_law: Literal["improved-s-curve"] = "improved-s-curve"
+    motion_law: LawName = DEFAULT_LAW
     placement: Literal["free", "published"] = "free"
 
 

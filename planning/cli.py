@@ -13,6 +13,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import NoReturn
 
+from planning.laws import LAWS
+
 EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = 0, 2, 3
 PLOT_FORMATS = ("png", "svg", "pdf")
 
@@ -32,6 +34,7 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("case", help="case file (YAML)")
     s.add_argument("--out", help="output folder (default: out/<case name>)")
     s.add_argument("--placement", choices=("free", "published"), help="where theta1/theta4 may fall (default: case)")
+    s.add_argument("--law", choices=tuple(LAWS), default=None, help="motion law (default: case, improved-s-curve)")
     s.add_argument("--json", action="store_true", help="print result.json instead of the summary")
     s.add_argument("--format", choices=PLOT_FORMATS, default="png", help="figure format (default png)")
     s.add_argument("--no-plots", action="store_true", help="do not draw the figures")
@@ -51,7 +54,7 @@ def _parser() -> argparse.ArgumentParser:
         metavar="FIELD=START:STOP:COUNT",
         help="a dotted numeric case field and its values, e.g. process.transfer_time_s=1:3:21",
     )
-    w.add_argument("--law", choices=("improved-s-curve",), default=None, help="motion law (default: case)")
+    w.add_argument("--law", choices=tuple(LAWS), default=None, help="motion law (default: case)")
     w.add_argument("--placement", choices=("free", "published"), help="where theta1/theta4 may fall")
     w.add_argument("--workers", type=_whole(1, 256), default=2, help="local worker processes (default 2)")
     w.add_argument("--scheduler", help="address of a Dask distributed scheduler (instead of local workers)")
@@ -135,6 +138,8 @@ def _solve(case, args) -> int:
     from planning.outputs import solution_writers
     from planning.report import result_dict, summary_text
 
+    if args.law:
+        case = case.model_copy(update={"planner": case.planner.model_copy(update={"motion_law": args.law})})
     out = _output_folder(case, args)
     if isinstance(out, int):
         return out

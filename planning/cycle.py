@@ -1,15 +1,16 @@
-"""One press cycle assembled from the improved S-curve and constant-speed stages (paper Fig. 6).
+"""One press cycle assembled from a motion law and constant-speed stages (paper Fig. 6).
 
 Stages, in the order the optimizer lays them out (time 0 at the end of the draw, crank angle theta3):
 
-    return   S-curve w2 -> wm2 -> w1 (accel half T_ra, decel half T_rd, jerk J_r)
+    return   w2 -> wm2 -> w1: accel half (duration D_ra), decel half (D_rd)
     transfer constant w1 for T_c (around TDC; the robot's window theta4 -> theta1 lies here and in the
-             neighbouring S-curve halves)
-    feed     S-curve w1 -> wm1 -> w2 (accel half T_fa, decel half T_fd, jerk J_f), ends at theta2
+             neighbouring halves)
+    feed     w1 -> wm1 -> w2: accel half (D_fa), decel half (D_fd), ends at theta2
     draw     constant w2 from theta2 to theta3, duration (theta3 - theta2) / w2
 
-The cycle closes after exactly 2 pi when the angle of every stage adds up (a constraint of the NLP).
-Time in the written plan starts at TDC, as in the paper's Figs. 7-9.
+Each half follows the motion law (``planning.laws``). The cycle closes after exactly 2 pi when the
+angle of every stage adds up (a constraint of the NLP). Time in the written plan starts at TDC, as
+in the paper's Figs. 7-9.
 """
 
 from __future__ import annotations
@@ -17,33 +18,38 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 from typing import Any
 
+from planning.laws import get_law
 from planning.laws import improved_scurve as sc
 from planning.profile import Segment
 
 STAGES = ("return", "transfer", "feed", "draw")
+HALVES = ("feed_accel", "feed_decel", "return_accel", "return_decel")
+RISING = {"feed_accel": 1.0, "feed_decel": -1.0, "return_accel": 1.0, "return_decel": -1.0}  # the peaks lie above
 
 
 @dataclass(frozen=True)
 class CycleParameters:
-    """The free numbers of an improved-S-curve cycle (all inside units).
+    """The free numbers of a cycle (all inside units).
 
-    ``transfer_speed`` w1 [rad/s], ``draw_speed`` w2 [rad/s], ``feed_jerk`` / ``return_jerk`` [rad/s^3],
-    ``feed_accel_time`` / ``feed_decel_time`` / ``return_accel_time`` / ``return_decel_time``: the
-    sub-segment length of each half [s], ``transfer_dwell``: the constant-w1 segment [s],
-    ``draw_start`` / ``draw_end``: theta2, theta3 [rad].
+    ``transfer_speed`` w1, ``draw_speed`` w2, ``feed_peak_speed`` wm1, ``return_peak_speed`` wm2
+    [rad/s]; ``feed_accel_duration`` ... ``return_decel_duration``: the duration of each half [s];
+    ``transfer_dwell``: the constant-w1 segment [s]; ``law_parameter``: the shape parameter of the law
+    (0 when it has none); ``draw_start`` / ``draw_end``: theta2, theta3 [rad]; ``motion_law``: its name.
     """
 
     transfer_speed: Any
     draw_speed: Any
-    feed_jerk: Any
-    feed_accel_time: Any
-    feed_decel_time: Any
-    return_jerk: Any
-    return_accel_time: Any
-    return_decel_time: Any
+    feed_peak_speed: Any
+    return_peak_speed: Any
+    feed_accel_duration: Any
+    feed_decel_duration: Any
+    return_accel_duration: Any
+    return_decel_duration: Any
     transfer_dwell: Any
+    law_parameter: Any
     draw_start: Any
     draw_end: Any
+    motion_law: str = "improved-s-curve"
 
     def as_dict(self) -> dict[str, Any]:
         """Field name -> value."""
@@ -55,32 +61,58 @@ class CycleParameters:
         return (self.draw_end - self.draw_start) / self.draw_speed
 
     @property
-    def feed_peak_speed(self) -> Any:
-        """wm1 [rad/s], Eq. 13."""
-        return self.transfer_speed + sc.speed_change(self.feed_jerk, self.feed_accel_time)
-
-    @property
-    def return_peak_speed(self) -> Any:
-        """wm2 [rad/s], Eq. 13."""
-        return self.draw_speed + sc.speed_change(self.return_jerk, self.return_accel_time)
-
-    @property
     def period(self) -> Any:
         """Cycle time [s] (Eq. 20 over all stages)."""
-        n = sc.SUBSEGMENTS
-        return (
-            n * (self.return_accel_time + self.return_decel_time + self.feed_accel_time + self.feed_decel_time)
-            + self.transfer_dwell
-            + self.draw_time
-        )
+        halves = self.feed_accel_duration + self.feed_decel_duration
+        halves += self.return_accel_duration + self.return_decel_duration
+        return halves + self.transfer_dwell + self.draw_time
+
+    def half(self, name: str) -> tuple[Any, Any]:
+        """``(duration [s], speed change [rad/s])`` of the half ``name`` (one of :data:`HALVES`)."""
+        w1, w2, wm1, wm2 = self.transfer_speed, self.draw_speed, self.feed_peak_speed, self.return_peak_speed
+        dv = {"feed_accel": wm1 - w1, "feed_decel": w2 - wm1, "return_accel": wm2 - w2, "return_decel": w1 - wm2}
+        return getattr(self, f"{name}_duration"), dv[name]
+
+    def peak_accelerations(self) -> list[Any]:
+        """Peak |crank acceleration| [rad/s^2] of each half, in :data:`HALVES` order."""
+        law = get_law(self.motion_law)
+        out = []
+        for name in HALVES:
+            D, dv = self.half(name)
+            out.append(law.peak_rate(self.law_parameter) * RISING[name] * dv / D)
+        return out
+
+    def peak_jerks(self) -> list[Any]:
+        """Peak |crank jerk| [rad/s^3] of each half, in :data:`HALVES` order."""
+        law = get_law(self.motion_law)
+        out = []
+        for name in HALVES:
+            D, dv = self.half(name)
+            out.append(law.peak_jerk(self.law_parameter) * RISING[name] * dv / D**2)
+        return out
+
+    # improved S-curve only: the paper's jerks and sub-segment lengths (Eqs. 10, 13)
+    @property
+    def feed_jerk(self) -> Any:
+        """J of the feed S-curve [rad/s^3] (improved S-curve; Eq. 13 on the acceleration half)."""
+        T = self.feed_accel_duration / sc.SUBSEGMENTS
+        return (self.feed_peak_speed - self.transfer_speed) / (sc.SPEED_GAIN * T**2)
+
+    @property
+    def return_jerk(self) -> Any:
+        """J of the return S-curve [rad/s^3] (improved S-curve)."""
+        T = self.return_accel_duration / sc.SUBSEGMENTS
+        return (self.return_peak_speed - self.draw_speed) / (sc.SPEED_GAIN * T**2)
 
 
 def cycle_segments(p: CycleParameters) -> list[Segment]:
-    """The 18 segments of a cycle from the end of the draw, named ``stage:part``."""
-    segs = sc.accel_half(p.return_accel_time, p.return_jerk, "return:accel")
-    segs += sc.decel_half(p.return_decel_time, p.return_jerk, "return:decel")
+    """The segments of a cycle from the end of the draw, named ``stage:part``."""
+    law = get_law(p.motion_law)
+    segs: list[Segment] = []
+    for name in ("return_accel", "return_decel"):
+        segs += law.half(name.replace("_", ":"), *p.half(name), p.law_parameter)
     segs.append(Segment("transfer:dwell", p.transfer_dwell, 0.0, 0.0))
-    segs += sc.accel_half(p.feed_accel_time, p.feed_jerk, "feed:accel")
-    segs += sc.decel_half(p.feed_decel_time, p.feed_jerk, "feed:decel")
+    for name in ("feed_accel", "feed_decel"):
+        segs += law.half(name.replace("_", ":"), *p.half(name), p.law_parameter)
     segs.append(Segment("draw:constant", p.draw_time, 0.0, 0.0))
     return segs

@@ -1,9 +1,10 @@
-"""The CasADi nonlinear program of one improved-S-curve press cycle (all CasADi lives here).
+"""The CasADi nonlinear program of one press cycle under a motion law (all CasADi lives here).
 
-Built once per process and reused: every number of a case, and the scale of every decision variable,
-enters as a parameter and the placement
-structure is a pair of constraint rows whose bounds are set per solve, so a sweep, a multi-start or
-the other placement only calls the compiled solver again. Decision variables are scaled to O(1).
+Built once per process and law, then reused: every number of a case, and the scale of every decision
+variable, enters as a parameter and the placement structure is a pair of constraint rows whose bounds
+are set per solve, so a sweep, a multi-start or the other placement only calls the compiled solver
+again. Decision variables are scaled to O(1): the four speeds w1, w2, wm1, wm2, the durations of the
+four halves, the transfer dwell, the law's shape parameter and the times of the key points.
 
 Time 0 of the NLP is the end of the draw (theta3); the stages follow as in ``planning.cycle``. The
 crank angle at any time t before the draw is evaluated in closed form as
@@ -11,15 +12,16 @@ crank angle at any time t before the draw is evaluated in closed form as
 segment k. The clip makes theta(t) continuously differentiable in t and in every segment variable
 (the kink of one term is cancelled by the next), so a key point may move across knots inside one
 smooth NLP: that is the ``free`` placement. The ``published`` placement fixes the key points where
-the relations under the paper's Fig. 6 put them: t1 = x1 + T1 (one sub-segment into the feed
-acceleration), t4 = x3 + 3 T14 (three sub-segments into the return deceleration).
+the relations under the paper's Fig. 6 put them: t1 = x1 + T1 (a quarter, one sub-segment, into the
+feed acceleration), t4 = x3 + 3 T14 (three quarters into the return deceleration).
 
-Constraints: speed continuity of both S-curves (Eq. 19), the cycle closes at 2 pi, the key angles
-theta1 and theta4 are met, time(theta4 -> theta1) >= transfer time, |slider acceleration| <= limit at
-sample points of every segment (the orchestrator lowers that sampled limit until the dense
-verification holds between samples), slider speed at the die-height crossings outside the draw, draw
-speed within its bounds, crank speed >= the minimum crank speed (the S-curve halves are monotone for
-J >= 0), and the drive's limits: peak speeds, peak accelerations 3/2 J T, jerks J.
+Constraints: the peaks lie above the speeds they join, one jerk per S-curve (Eq. 14, improved S-curve
+only), the cycle closes at 2 pi, the key angles theta1 and theta4 are met, time(theta4 -> theta1) >=
+transfer time, |slider acceleration| <= limit at sample points of every segment (the orchestrator
+lowers that sampled limit until the dense verification holds between samples), slider speed at the
+die-height crossings outside the draw, draw speed within its bounds, crank speed >= the minimum crank
+speed (the halves are monotone), and the drive's limits: peak speeds, the closed-form peak
+acceleration and jerk of every half.
 """
 
 from __future__ import annotations
@@ -32,8 +34,8 @@ import casadi as ca
 import numpy as np
 
 from planning.cycle import CycleParameters, cycle_segments
-from planning.laws import improved_scurve as sc
-from planning.profile import advance, knot_states
+from planning.laws import DEFAULT_LAW, get_law
+from planning.profile import Segment, advance_segment, knot_states
 from press.kinematics import height_derivatives
 
 Placement = Literal["free", "published"]
@@ -43,13 +45,14 @@ Placement = Literal["free", "published"]
 VARIABLES: tuple[tuple[str, float], ...] = (
     ("transfer_speed", 1.0),  # w1 [rad/s]
     ("draw_speed", 1.0),  # w2 [rad/s]
-    ("feed_jerk", 30.0),  # J_f [rad/s^3]
-    ("feed_accel_time", 0.1),  # [s]
-    ("feed_decel_time", 0.1),
-    ("return_jerk", 30.0),
-    ("return_accel_time", 0.1),
-    ("return_decel_time", 0.1),
+    ("feed_peak_speed", 1.0),  # wm1 [rad/s]
+    ("return_peak_speed", 1.0),  # wm2 [rad/s]
+    ("feed_accel_duration", 0.4),  # [s] each half
+    ("feed_decel_duration", 0.4),
+    ("return_accel_duration", 0.4),
+    ("return_decel_duration", 0.4),
     ("transfer_dwell", 1.0),  # [s]
+    ("law_parameter", 1.0),  # the motion law's shape parameter (fixed at 0 when it has none)
     ("closing_time", 1.0),  # t1 from the end of the draw [s]
     ("opening_time", 1.0),  # t4
     ("die_down_time", 1.0),  # time of the descending die-height crossing
@@ -109,24 +112,26 @@ class ConstraintBlock:
     stop: int
 
 
-def _angle_at(t: ca.SX, starts: ca.SX, segs: dict[str, ca.SX]) -> tuple[ca.SX, ca.SX]:
+def _angle_at(t: ca.SX, starts: list, states: list, segs: list[Segment]) -> tuple[ca.SX, ca.SX]:
     """Closed-form crank angle and speed at time ``t`` [s] over the segments (clip formulation)."""
-    tau = ca.fmin(ca.fmax(t - starts, 0), segs["T"])
-    th, om, _, _ = advance(0.0, segs["omega"], segs["alpha"], segs["j0"], segs["j1"], tau)
-    return segs["theta0"] + ca.sum1(th), segs["omega0"] + ca.sum1(om - segs["omega"])
+    theta, omega = states[0][0], states[0][1]
+    for start, st, seg in zip(starts, states, segs, strict=True):
+        tau = ca.fmin(ca.fmax(t - start, 0), seg.duration)
+        th, om, _, _ = advance_segment(seg, 0.0, st[1], st[2], tau)
+        theta += th
+        omega += om - st[1]
+    return theta, omega
 
 
 @dataclass
 class CycleNLP:
-    """The compiled NLP; see the module docstring. ``free_rows`` hold theta1 and theta4 anywhere
-    (clip formulation), ``published_rows`` pin them to the knots of the published structure; the
-    rows of the other placement are left unbounded."""
+    """The compiled NLP; see the module docstring. ``published_rows`` pin theta1 and theta4 to the
+    points of the published structure; they are left unbounded for the free placement."""
 
     solver: ca.Function
     lbg: np.ndarray
     ubg: np.ndarray
     blocks: tuple[ConstraintBlock, ...]
-    free_rows: slice
     published_rows: slice
     problem: dict = field(repr=False, default_factory=dict)
     options: dict = field(repr=False, default_factory=dict)
@@ -144,51 +149,32 @@ class CycleNLP:
     def bounds(self, placement: Placement) -> tuple[np.ndarray, np.ndarray]:
         """``(lbg, ubg)`` for ``placement``."""
         lbg, ubg = self.lbg.copy(), self.ubg.copy()
-        off = self.free_rows if placement == "published" else self.published_rows
-        on = self.published_rows if placement == "published" else self.free_rows
-        lbg[off], ubg[off] = -np.inf, np.inf
-        lbg[on], ubg[on] = 0.0, 0.0
+        pinned = 0.0 if placement == "published" else np.inf
+        lbg[self.published_rows], ubg[self.published_rows] = -pinned, pinned
         return lbg, ubg
 
 
-def _build() -> CycleNLP:
+def _build(law_name: str) -> CycleNLP:
+    law = get_law(law_name)
     x = ca.SX.sym("x", len(VARIABLES))
     p_case = ca.SX.sym("p", len(PARAMETERS))
     p_scale = ca.SX.sym("scale", len(VARIABLES))  # physical value = scale * x, chosen per case
     p = ca.vertcat(p_case, p_scale)
     v = {name: x[i] * p_scale[i] for i, (name, _) in enumerate(VARIABLES)}
+    unit = {name: p_scale[i] for i, (name, _) in enumerate(VARIABLES)}
     q = {name: p_case[i] for i, name in enumerate(PARAMETERS)}
 
+    fields = [f for f in CycleParameters.__dataclass_fields__ if f in v]
     params = CycleParameters(
-        transfer_speed=v["transfer_speed"],
-        draw_speed=v["draw_speed"],
-        feed_jerk=v["feed_jerk"],
-        feed_accel_time=v["feed_accel_time"],
-        feed_decel_time=v["feed_decel_time"],
-        return_jerk=v["return_jerk"],
-        return_accel_time=v["return_accel_time"],
-        return_decel_time=v["return_decel_time"],
-        transfer_dwell=v["transfer_dwell"],
-        draw_start=q["theta2"],
-        draw_end=q["theta3"],
+        **{f: v[f] for f in fields}, draw_start=q["theta2"], draw_end=q["theta3"], motion_law=law_name
     )
     segs = cycle_segments(params)
     states = knot_states(q["theta3"], params.draw_speed, 0.0, segs)
-    durations = [s.duration for s in segs]
     starts = [0.0]
-    for T in durations[:-1]:
-        starts.append(starts[-1] + T)
-    n_before = len(segs) - 1  # the 17 segments from theta3 to theta2 (all but the draw)
-    before = {
-        "T": ca.vertcat(*durations[:n_before]),
-        "omega": ca.vertcat(*[st[1] for st in states[:n_before]]),
-        "alpha": ca.vertcat(*[st[2] for st in states[:n_before]]),
-        "j0": ca.vertcat(*[s.j0 for s in segs[:n_before]]),
-        "j1": ca.vertcat(*[s.j1 for s in segs[:n_before]]),
-        "theta0": states[0][0],
-        "omega0": states[0][1],
-    }
-    start_vec = ca.vertcat(*starts[:n_before])
+    for seg in segs[:-1]:
+        starts.append(starts[-1] + seg.duration)
+    n_before = len(segs) - 1  # the segments from theta3 to theta2 (all but the draw)
+    before = (starts[:n_before], states[:n_before], segs[:n_before])
 
     blocks: list[ConstraintBlock] = []
     g: list = []
@@ -205,38 +191,32 @@ def _build() -> CycleNLP:
         return slice(len(lb) - n, len(lb))
 
     w1, w2 = params.transfer_speed, params.draw_speed
-    # Eq. 19 for each S-curve: the speeds meet
+    wm1, wm2 = params.feed_peak_speed, params.return_peak_speed
+    # the peaks lie above the speeds they join (each half is then monotone: the crank speed is
+    # smallest at w1 or w2, which the variable bounds keep above the minimum)
     add(
-        "feed speed continuity",
-        w1
-        + sc.speed_change(params.feed_jerk, params.feed_accel_time)
-        - sc.speed_change(params.feed_jerk, params.feed_decel_time)
-        - w2,
-        0.0,
-        0.0,
+        "peak speeds above their ends",
+        ca.vertcat(wm1 - w1, wm1 - w2, wm2 - w2, wm2 - w1) / unit["draw_speed"],
+        0,
+        np.inf,
     )
-    add(
-        "return speed continuity",
-        w2
-        + sc.speed_change(params.return_jerk, params.return_accel_time)
-        - sc.speed_change(params.return_jerk, params.return_decel_time)
-        - w1,
-        0.0,
-        0.0,
-    )
+    if law.one_jerk_per_curve:  # Eq. 14: one jerk J for both halves of each S-curve
+        d_fa, d_fd = params.feed_accel_duration, params.feed_decel_duration
+        d_ra, d_rd = params.return_accel_duration, params.return_decel_duration
+        t2 = unit["feed_accel_duration"] ** 2 * unit["draw_speed"]
+        add(
+            "one jerk per S-curve (Eq. 14)",
+            ca.vertcat((wm1 - w1) * d_fd**2 - (wm1 - w2) * d_fa**2, (wm2 - w2) * d_rd**2 - (wm2 - w1) * d_ra**2) / t2,
+            0.0,
+            0.0,
+        )
     # the cycle closes: theta at the draw start is theta2 + 2 pi
     add("cycle closes", states[n_before][0] - (q["theta2"] + 2 * np.pi), 0.0, 0.0)
 
-    n = sc.SUBSEGMENTS
     t4, t1 = v["opening_time"], v["closing_time"]
-    th4, _ = _angle_at(t4, start_vec, before)
-    th1, _ = _angle_at(t1, start_vec, before)
-    free_rows = add(
-        "key angles (free placement)",
-        ca.vertcat(th4 - q["theta4"], th1 - (q["theta1"] + 2 * np.pi)),
-        0.0,
-        0.0,
-    )
+    th4, _ = _angle_at(t4, *before)
+    th1, _ = _angle_at(t1, *before)
+    add("key angles", ca.vertcat(th4 - q["theta4"], th1 - (q["theta1"] + 2 * np.pi)), 0.0, 0.0)
     add("transfer time", t1 - t4 - q["transfer_time"], 0.0, np.inf)
     t_end = starts[n_before]
     add(
@@ -245,24 +225,23 @@ def _build() -> CycleNLP:
         0.0,
         np.inf,
     )
-    # published structure (Fig. 6): theta4 at x3 + 3 T14, theta1 at x1 + T1, i.e. at two knots, so the
-    # key angles are smooth knot states; bounds switched per solve
-    k4, k1 = n + 3, 2 * n + 2  # knots: end of the 3rd return-decel / 1st feed-accel sub-segment
+    # published structure (Fig. 6): theta4 at x3 + 3 T14 (three quarters into the return deceleration),
+    # theta1 at x1 + T1 (a quarter into the feed acceleration); bounds switched per solve
+    rd_start = params.return_accel_duration
+    fa_start = rd_start + params.return_decel_duration + params.transfer_dwell
     published_rows = add(
         "key angles (published placement)",
         ca.vertcat(
-            t4 - starts[k4],
-            t1 - starts[k1],
-            states[k4][0] - q["theta4"],
-            states[k1][0] - (q["theta1"] + 2 * np.pi),
+            t4 - (rd_start + 0.75 * params.return_decel_duration),
+            t1 - (fa_start + 0.25 * params.feed_accel_duration),
         ),
         -np.inf,
         np.inf,
     )
 
     # die-height crossings outside the draw
-    thd, omd = _angle_at(v["die_down_time"], start_vec, before)
-    thu, omu = _angle_at(v["die_up_time"], start_vec, before)
+    thd, omd = _angle_at(v["die_down_time"], *before)
+    thu, omu = _angle_at(v["die_up_time"], *before)
     add(
         "die crossing angles",
         ca.vertcat(
@@ -279,40 +258,33 @@ def _build() -> CycleNLP:
         1.0,
     )
 
-    # slider acceleration at sample points of every segment, evaluated as one vector
-    cols: dict[str, list] = {k: [] for k in ("theta", "omega", "alpha", "j0", "j1", "tau")}
+    # slider acceleration at sample points of every segment, one vector per segment
+    th_s, om_s, al_s = [], [], []
     for seg, st in zip(segs, states[:-1], strict=True):
         constant = seg.name in ("transfer:dwell", "draw:constant")
-        fractions = np.linspace(0.0, 1.0, (SAMPLES_CONSTANT if constant else SAMPLES_PER_SUBSEGMENT) + 1)
+        fractions = np.linspace(0.0, 1.0, (SAMPLES_CONSTANT if constant else law.samples) + 1)
         if seg.name != "draw:constant":
             fractions = fractions[:-1]  # the end is the next segment's start
-        for f in fractions:
-            for key, val in zip(("theta", "omega", "alpha", "j0", "j1"), (*st, seg.j0, seg.j1), strict=True):
-                cols[key].append(val)
-            cols["tau"].append(f * seg.duration)
-    th, om, al, _ = advance(*(ca.vertcat(*cols[k]) for k in ("theta", "omega", "alpha", "j0", "j1", "tau")))
+        th, om, al, _ = advance_segment(seg, *st, ca.DM(fractions) * seg.duration)
+        th_s.append(th)
+        om_s.append(om)
+        al_s.append(al)
+    th, om, al = ca.vertcat(*th_s), ca.vertcat(*om_s), ca.vertcat(*al_s)
     d1, d2, _ = height_derivatives(th, q["R"], q["L"])
     acc = d2 * om**2 + d1 * al
     add("slider acceleration", acc / q["accel_limit"], -1.0, 1.0)
-    # motor limits: the S-curve halves are monotone in speed, their accelerations peak at 3/2 J T (Eqs. 17,
-    # 21) and their jerk never exceeds J (Eq. 10)
-    peaks = ca.vertcat(params.feed_peak_speed, params.return_peak_speed, w1, w2)
-    add("crank speed limit", peaks / q["crank_speed_max"], -np.inf, 1.0)
-    halves = ca.vertcat(
-        sc.peak_accel(params.feed_jerk, params.feed_accel_time),
-        sc.peak_accel(params.feed_jerk, params.feed_decel_time),
-        sc.peak_accel(params.return_jerk, params.return_accel_time),
-        sc.peak_accel(params.return_jerk, params.return_decel_time),
-    )
-    add("crank acceleration limit", halves / q["crank_accel_max"], -np.inf, 1.0)
-    add("crank jerk limit", ca.vertcat(params.feed_jerk, params.return_jerk) / q["crank_jerk_max"], -np.inf, 1.0)
+    # motor limits: the halves are monotone in speed; their peak acceleration and jerk in closed form
+    add("crank speed limit", ca.vertcat(wm1, wm2, w1, w2) / q["crank_speed_max"], -np.inf, 1.0)
+    add("crank acceleration limit", ca.vertcat(*params.peak_accelerations()) / q["crank_accel_max"], -np.inf, 1.0)
+    add("crank jerk limit", ca.vertcat(*params.peak_jerks()) / q["crank_jerk_max"], -np.inf, 1.0)
 
     nlp = {"x": x, "p": p, "f": params.period, "g": ca.vertcat(*g)}
-    solver = ca.nlpsol("press_cycle", "ipopt", nlp, IPOPT_OPTIONS)
-    return CycleNLP(solver, np.array(lb), np.array(ub), tuple(blocks), free_rows, published_rows, nlp, IPOPT_OPTIONS)
+    solver = ca.nlpsol("press_cycle_" + law_name.replace("-", "_"), "ipopt", nlp, IPOPT_OPTIONS)
+    return CycleNLP(solver, np.array(lb), np.array(ub), tuple(blocks), published_rows, nlp, IPOPT_OPTIONS)
 
 
 @cache
-def cycle_nlp() -> CycleNLP:
-    """The compiled NLP (built on first use in a process, then reused for every case and start)."""
-    return _build()
+def cycle_nlp(law: str = DEFAULT_LAW) -> CycleNLP:
+    """The compiled NLP of motion law ``law`` (built on first use in a process, then reused for every
+    case and start)."""
+    return _build(law)

@@ -16,6 +16,8 @@ from typing import Literal
 import numpy as np
 
 from planning.case import RPM, Case, draw_speed_bounds
+from planning.cycle import HALVES
+from planning.laws import get_law
 from planning.laws import improved_scurve as sc
 from planning.nlp import PARAMETER_INDEX, PARAMETERS, VARIABLE_INDEX, VARIABLES, CycleNLP, cycle_nlp
 from planning.plan import Plan, SolverInfo, params_from_numbers, profile_from_tdc
@@ -23,7 +25,7 @@ from planning.verify import ACCEL_CHECK, Verification, verify
 
 Placement = Literal["free", "published"]
 ACCEL_BACKOFF = 5e-4  # the NLP keeps |slider acceleration| <= (1 - backoff) * limit at its samples
-MIN_SUBSEGMENT_S = 1e-3  # [s] lower bound on an S-curve sub-segment
+MIN_HALF_S = 4e-3  # [s] lower bound on the duration of a half (1 ms per improved-S-curve sub-segment)
 MAX_TIME_S = 600.0  # [s] upper bound on any time variable
 REFINEMENTS = 3  # re-solves with a lowered sampled acceleration limit
 NO_LIMIT = 1e9  # stands for an absent motor limit in the NLP's parameters
@@ -117,7 +119,8 @@ def nlp_parameters(case: Case) -> np.ndarray:
 
 def _guess(case: Case, w2: float, w1: float, peak_share: float, inside: float) -> dict[str, float]:
     """A rough start: S-curves that sweep the key-point angles, peak speeds ``peak_share`` of the
-    constant-speed acceleration bound, key points ``inside`` sub-segments into the S-curves."""
+    constant-speed acceleration bound, key points ``inside`` quarters into the halves."""
+    law = get_law(case.planner.motion_law)
     R, L = case.press.crank_radius_mm, case.press.rod_length_mm
     th1, th2, th3, th4 = case.key_angles
     w_acc = math.sqrt(case.limits.slider_accel_mm_s2 / (R + R**2 / L))  # |d2h/dtheta2| peaks at BDC
@@ -125,28 +128,29 @@ def _guess(case: Case, w2: float, w1: float, peak_share: float, inside: float) -
     w1 = min(w1, 0.8 * top)
     wm = min(max(peak_share * w_acc, 1.2 * max(w1, w2)), max(0.98 * top, 1.01 * max(w1, w2)))
 
-    def halves(angle: float, w_from: float, w_to: float) -> tuple[float, float, float]:
+    def halves(angle: float, w_from: float, w_to: float) -> tuple[float, float]:
         ratio = math.sqrt((wm - w_to) / (wm - w_from))  # one jerk for both halves (Eq. 14)
-        T_a = angle / (2 * (w_from + wm) + 2 * ratio * (wm + w_to))
-        J = (wm - w_from) / (sc.SPEED_GAIN * T_a**2)
-        return T_a, ratio * T_a, J
+        D_a = angle / ((w_from + wm) / 2 + ratio * (wm + w_to) / 2)  # a symmetric half sweeps D (v0 + v1) / 2
+        return D_a, ratio * D_a
 
-    T_fa, T_fd, J_f = halves(th2 - th1, w1, w2)
-    T_ra, T_rd, J_r = halves(th4 - th3, w2, w1)
+    D_fa, D_fd = halves(th2 - th1, w1, w2)
+    D_ra, D_rd = halves(th4 - th3, w2, w1)
     T_c = (th1 + 2 * math.pi - th4) / w1
-    t4 = 4 * T_ra + (4 - inside) * T_rd
-    t1 = 4 * T_ra + 4 * T_rd + T_c + inside * T_fa
-    t_feed_end = t1 - inside * T_fa + 4 * T_fa + 4 * T_fd
+    share = inside / sc.SUBSEGMENTS
+    t4 = D_ra + (1 - share) * D_rd
+    t1 = D_ra + D_rd + T_c + share * D_fa
+    t_feed_end = t1 - share * D_fa + D_fa + D_fd
     return {
         "transfer_speed": w1,
         "draw_speed": w2,
-        "feed_jerk": J_f,
-        "feed_accel_time": T_fa,
-        "feed_decel_time": T_fd,
-        "return_jerk": J_r,
-        "return_accel_time": T_ra,
-        "return_decel_time": T_rd,
+        "feed_peak_speed": wm,
+        "return_peak_speed": wm,
+        "feed_accel_duration": D_fa,
+        "feed_decel_duration": D_fd,
+        "return_accel_duration": D_ra,
+        "return_decel_duration": D_rd,
         "transfer_dwell": T_c,
+        "law_parameter": law.parameter[3] if law.parameter else 0.0,
         "closing_time": t1,
         "opening_time": t4,
         "die_down_time": 0.5 * (t1 + t_feed_end),
@@ -161,10 +165,12 @@ def _bounds(case: Case, w2_lo: float, w2_hi: float, p: np.ndarray) -> tuple[np.n
     i = VARIABLE_INDEX
     lo[i["transfer_speed"]], hi[i["transfer_speed"]] = w_min, 1e3
     lo[i["draw_speed"]], hi[i["draw_speed"]] = w2_lo, w2_hi
-    for k in ("feed_jerk", "return_jerk"):
-        lo[i[k]], hi[i[k]] = 0.0, 1e6
-    for k in ("feed_accel_time", "feed_decel_time", "return_accel_time", "return_decel_time"):
-        lo[i[k]] = MIN_SUBSEGMENT_S
+    for k in ("feed_peak_speed", "return_peak_speed"):
+        lo[i[k]], hi[i[k]] = w_min, 1e3
+    for k in HALVES:
+        lo[i[f"{k}_duration"]] = MIN_HALF_S
+    law = get_law(case.planner.motion_law)
+    lo[i["law_parameter"]], hi[i["law_parameter"]] = law.parameter[1:3] if law.parameter else (0.0, 0.0)
     for k in ("die_down", "die_up"):
         if p[PARAMETER_INDEX[f"{k}_active"]] == 0.0:
             lo[i[f"{k}_time"]] = hi[i[f"{k}_time"]] = 0.0
@@ -174,23 +180,16 @@ def _bounds(case: Case, w2_lo: float, w2_hi: float, p: np.ndarray) -> tuple[np.n
 def scales_for(case: Case) -> np.ndarray:
     """Variable scales from the press's own characteristic time ``T* = sqrt(R / A)`` [s] and speed
     ``W* = sqrt(A / (R + R^2/L))`` [rad/s] (A the slider-acceleration limit): speeds ~ W*, sub-segment
-    lengths ~ T*, stage times ~ 10 T*, jerks ~ W*/T*^2. The factors make the variables O(1) for a
+    durations of the halves ~ T*, stage times ~ 10 T*. The factors make the variables O(1) for a
     press cycle of the usual proportions; they span orders of magnitude from a small fast press to a
     heavy slow one."""
     R, L, A = case.press.crank_radius_mm, case.press.rod_length_mm, case.limits.slider_accel_mm_s2
     t_star = math.sqrt(R / A)
     w_star = math.sqrt(A / (R + R**2 / L))
-    unit = {"speed": 0.42 * w_star, "jerk": 1.6 * w_star / t_star**2, "sub": 0.28 * t_star, "time": 2.8 * t_star}
-    kinds = {
-        "transfer_speed": "speed",
-        "draw_speed": "speed",
-        "feed_jerk": "jerk",
-        "return_jerk": "jerk",
-        "feed_accel_time": "sub",
-        "feed_decel_time": "sub",
-        "return_accel_time": "sub",
-        "return_decel_time": "sub",
-    }
+    unit = {"speed": 0.42 * w_star, "half": 1.12 * t_star, "time": 2.8 * t_star, "shape": 1.0}
+    kinds = {f"{k}_duration": "half" for k in HALVES}
+    kinds.update({f"{k}_speed": "speed" for k in ("transfer", "draw", "feed_peak", "return_peak")})
+    kinds["law_parameter"] = "shape"
     return np.array([unit[kinds.get(k, "time")] for k, _ in VARIABLES])
 
 
@@ -224,9 +223,10 @@ def _run(
 
 def _plan(case: Case, values: dict[str, float], placement: Placement, info: SolverInfo) -> Plan:
     th = case.key_angles
-    params = params_from_numbers(values, float(th[1]), float(th[2]))
+    law = case.planner.motion_law
+    params = params_from_numbers(values, float(th[1]), float(th[2]), law)
     profile = profile_from_tdc(params)
-    plan = Plan(params, profile, tuple(float(a) for a in th), placement, info)
+    plan = Plan(params, profile, tuple(float(a) for a in th), placement, info, motion_law=law)
     t = plan.key_times()
     structure = {"closing": plan.segment_at(float(t[0])), "opening": plan.segment_at(float(t[3]))}
     return replace(plan, structure=structure, nlp_values=dict(values))
@@ -238,7 +238,8 @@ def _fits(plan: Plan, case: Case, placement: Placement, w2_lo: float, w2_hi: flo
     same_angles = np.allclose(plan.key_angles, case.key_angles, rtol=0, atol=1e-12)
     w2 = float(plan.parameters.draw_speed)
     fits_placement = placement == "free" or plan.placement == "published"
-    return bool(same_angles and fits_placement and w2_lo - 1e-12 <= w2 <= w2_hi + 1e-12)
+    same_law = plan.motion_law == case.planner.motion_law
+    return bool(same_angles and same_law and fits_placement and w2_lo - 1e-12 <= w2 <= w2_hi + 1e-12)
 
 
 def _violation(nlp: CycleNLP, placement: Placement, g: np.ndarray) -> tuple[str, float]:
@@ -325,13 +326,15 @@ def solve(case: Case, placement: Placement | None = None, warm: Plan | None = No
                 break
         return found[0][1] if found else None
 
-    nlp = cycle_nlp()
+    nlp = cycle_nlp(case.planner.motion_law)
     lbx, ubx = _bounds(case, w2_lo, w2_hi, p)
     p = np.concatenate([p, scales_for(case)])
     if warm is not None and _fits(warm, case, placement, w2_lo, w2_hi):
         check = verify(warm, case)
         if check.passed:
             best = Solution(warm, check)
+    if warm is not None and warm.motion_law != case.planner.motion_law:
+        warm = None  # another law's plan neither answers this case nor starts its NLP
     warm_values = [warm.nlp_values] if warm is not None and warm.nlp_values else []
     same_rule = warm is not None and (warm.placement == placement or placement == "free")
     if follow and warm_values and same_rule and attempt(warm_values[0], warm.placement) is not None:

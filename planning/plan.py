@@ -8,7 +8,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from planning.cycle import CycleParameters, cycle_segments
-from planning.profile import Profile, Segment, advance, knot_states
+from planning.laws import improved_scurve as sc
+from planning.profile import Profile, advance_segment, knot_states, split_segment
 
 
 @dataclass(frozen=True)
@@ -75,6 +76,9 @@ class Plan:
         J [rpm/s^2] the feed jerk (the return jerk is reported separately as ``J_return``).
         """
         p = self.parameters
+        if self.motion_law != "improved-s-curve":
+            raise ValueError("the paper's notation describes improved-s-curve plans only")
+        n = sc.SUBSEGMENTS
         tk = self.profile.knot_times
         names = [s.name for s in self.profile.segments]
         rpm = 60.0 / (2 * math.pi)
@@ -93,21 +97,14 @@ class Plan:
             "x5_s": self.period,
             "wm1_rpm": float(p.feed_peak_speed) * rpm,
             "wm2_rpm": float(p.return_peak_speed) * rpm,
-            "T1_s": float(p.feed_accel_time),
-            "T5_s": float(p.feed_decel_time),
+            "T1_s": float(p.feed_accel_duration) / n,
+            "T5_s": float(p.feed_decel_duration) / n,
             "T9_s": float(p.draw_time),
-            "T10_s": float(p.return_accel_time),
-            "T14_s": float(p.return_decel_time),
+            "T10_s": float(p.return_accel_duration) / n,
+            "T14_s": float(p.return_decel_duration) / n,
             "J_rpm_s2": float(p.feed_jerk) * rpm,
             "J_return_rpm_s2": float(p.return_jerk) * rpm,
         }
-
-
-def _split(seg: Segment, tau: float) -> tuple[Segment, Segment]:
-    """Split a linear-jerk segment ``tau`` [s] after its start."""
-    first = Segment(seg.name, tau, seg.j0, seg.j1)
-    second = Segment(seg.name, float(seg.duration) - tau, seg.j0 + seg.j1 * tau, seg.j1)
-    return first, second
 
 
 def profile_from_tdc(params: CycleParameters) -> Profile:
@@ -116,7 +113,7 @@ def profile_from_tdc(params: CycleParameters) -> Profile:
     The NLP lays the cycle out from theta3; here it is rotated so that time 0 is the TDC crossing,
     splitting the segment that holds it. Segments of zero length are dropped.
     """
-    segs = [Segment(s.name, float(s.duration), float(s.j0), float(s.j1)) for s in cycle_segments(params)]
+    segs = [_numeric(s) for s in cycle_segments(params)]
     th3 = float(params.draw_end)
     w2 = float(params.draw_speed)
     states = knot_states(th3, w2, 0.0, segs)
@@ -124,14 +121,25 @@ def profile_from_tdc(params: CycleParameters) -> Profile:
     k = next(i for i in range(len(segs)) if states[i + 1][0] >= two_pi)
     probe = Profile((segs[k],), *states[k])
     tau = probe.time_at_angle(two_pi)
-    first, second = _split(segs[k], tau)
-    _, om, al, _ = advance(*states[k], segs[k].j0, segs[k].j1, tau)
+    first, second = split_segment(segs[k], tau)
+    _, om, al, _ = advance_segment(segs[k], *states[k], tau)
     order = [second] + segs[k + 1 :] + segs[:k] + [first]
     order = [s for s in order if s.duration > 0]
     return Profile(tuple(order), 0.0, float(om), float(al))
 
 
-def params_from_numbers(values: dict[str, float], theta2: float, theta3: float) -> CycleParameters:
-    """A numeric :class:`CycleParameters` from the NLP variable values (inside units)."""
-    keys = [f for f in CycleParameters.__dataclass_fields__ if f not in ("draw_start", "draw_end")]
-    return CycleParameters(**{k: float(values[k]) for k in keys}, draw_start=theta2, draw_end=theta3)
+def _numeric(seg):
+    """``seg`` with plain floats (a shape keeps its own parameter, already a float here)."""
+    return seg._replace(
+        duration=float(seg.duration),
+        j0=float(seg.j0),
+        j1=float(seg.j1),
+        dv=float(seg.dv),
+        span=None if seg.span is None else float(seg.span),
+    )
+
+
+def params_from_numbers(values: dict[str, float], theta2: float, theta3: float, law: str) -> CycleParameters:
+    """A numeric :class:`CycleParameters` of motion law ``law`` from the NLP variable values (inside units)."""
+    keys = [f for f in CycleParameters.__dataclass_fields__ if f not in ("draw_start", "draw_end", "motion_law")]
+    return CycleParameters(**{k: float(values[k]) for k in keys}, draw_start=theta2, draw_end=theta3, motion_law=law)

@@ -1,4 +1,4 @@
-"""Piecewise linear-jerk motion profiles of the crank, evaluated in closed form.
+"""Piecewise motion profiles of the crank, evaluated in closed form.
 
 A profile is a start state ``(theta0 [rad], omega0 [rad/s], alpha0 [rad/s^2])`` and a list of
 segments, each a duration ``T`` [s] with a jerk that is linear in the local time ``tau`` [s]::
@@ -8,9 +8,19 @@ segments, each a duration ``T`` [s] with a jerk that is linear in the local time
     omega(tau) = omega0 + alpha0 tau + j0 tau^2 / 2 + j1 tau^3 / 6
     theta(tau) = theta0 + omega0 tau + alpha0 tau^2 / 2 + j0 tau^3 / 6 + j1 tau^4 / 24
 
-Every motion law of the project (constant speed, the improved S-curve's ten segments) is such a
-list, so one evaluator serves the optimizer (with CasADi symbols), the plan and the verification
-(with numpy arrays). The state is continuous at every knot by construction.
+plus, for the laws that are not piecewise polynomial in jerk (``planning.laws.shapes``), a shape
+term: a speed change ``dv`` [rad/s] along a normalised shape ``s(u)`` over a span ``D`` [s], of which
+the segment covers ``u`` from ``u0`` to ``u0 + T / D`` (``u0 > 0`` only for a piece split off a half).
+The shape term is added as its remainder beyond the start state, so the start state is always the
+full state and the two parts superpose::
+
+    omega += dv (s(u) - s(u0) - s'(u0) du),   du = tau / D,  u = u0 + du
+    theta += dv D (S(u) - S(u0) - s(u0) du - s'(u0) du^2 / 2)
+    alpha += dv / D (s'(u) - s'(u0)),         jerk += dv / D^2 s''(u)
+
+Every motion law of the project is such a list, so one evaluator serves the optimizer (with CasADi
+symbols), the plan and the verification (with numpy arrays). The state is continuous at every knot by
+construction.
 """
 
 from __future__ import annotations
@@ -23,12 +33,59 @@ import numpy as np
 
 
 class Segment(NamedTuple):
-    """One segment: ``name``, ``duration`` [s], jerk ``j0`` [rad/s^3] + ``j1`` [rad/s^4] * tau."""
+    """One segment: ``name``, ``duration`` [s], jerk ``j0`` [rad/s^3] + ``j1`` [rad/s^4] * tau, and an
+    optional ``shape`` term: speed change ``dv`` [rad/s] over ``span`` [s] from ``u0`` (see above)."""
 
     name: str
     duration: Any
     j0: Any
     j1: Any
+    shape: Any = None
+    dv: Any = 0.0
+    span: Any = None
+    u0: float = 0.0
+
+
+def shape_segment(name: str, duration: Any, dv: Any, shape: Any) -> Segment:
+    """A whole shaped half: speed change ``dv`` [rad/s] over ``duration`` [s] along ``shape``."""
+    return Segment(name, duration, 0.0, 0.0, shape, dv, duration, 0.0)
+
+
+def shape_part(seg: Segment, tau: Any) -> tuple[Any, Any, Any, Any]:
+    """The shape term of ``seg`` after ``tau`` [s]: ``(dtheta, domega, dalpha, jerk)``, zero without one."""
+    if seg.shape is None:
+        return 0.0, 0.0, 0.0, 0.0
+    D, dv = seg.span, seg.dv
+    du = tau / D
+    s, S, s1, s2 = seg.shape.terms(seg.u0 + du)
+    if isinstance(seg.u0, float) and seg.u0 == 0.0:  # every shape starts at rest: s = S = s' = 0
+        return dv * D * S, dv * s, dv / D * s1, dv / D**2 * s2
+    a, A, a1, _ = seg.shape.terms(seg.u0)
+    return (
+        dv * D * (S - A - a * du - a1 * du**2 / 2),
+        dv * (s - a - a1 * du),
+        dv / D * (s1 - a1),
+        dv / D**2 * s2,
+    )
+
+
+def advance_segment(seg: Segment, theta0: Any, omega0: Any, alpha0: Any, tau: Any) -> tuple[Any, Any, Any, Any]:
+    """State ``(theta, omega, alpha, jerk)`` after ``tau`` [s] inside ``seg`` from the given start state."""
+    th, om, al, je = advance(theta0, omega0, alpha0, seg.j0, seg.j1, tau)
+    dth, dom, dal, dje = shape_part(seg, tau)
+    return th + dth, om + dom, al + dal, je + dje
+
+
+def split_segment(seg: Segment, tau: float) -> tuple[Segment, Segment]:
+    """``seg`` (numeric) cut ``tau`` [s] after its start into two segments that together move the same."""
+    first = seg._replace(duration=tau)
+    span = seg.span if seg.span is not None else 1.0
+    second = seg._replace(
+        duration=float(seg.duration) - tau,
+        j0=seg.j0 + seg.j1 * tau,
+        u0=seg.u0 + (tau / span if seg.shape is not None else 0.0),
+    )
+    return first, second
 
 
 def advance(theta0: Any, omega0: Any, alpha0: Any, j0: Any, j1: Any, tau: Any) -> tuple[Any, Any, Any, Any]:
@@ -45,14 +102,14 @@ def knot_states(theta0: Any, omega0: Any, alpha0: Any, segments: Sequence[Segmen
     """States ``(theta, omega, alpha)`` at the start of every segment and at the end of the last."""
     states = [(theta0, omega0, alpha0)]
     for seg in segments:
-        th, om, al, _ = advance(*states[-1], seg.j0, seg.j1, seg.duration)
+        th, om, al, _ = advance_segment(seg, *states[-1], seg.duration)
         states.append((th, om, al))
     return states
 
 
 @dataclass(frozen=True)
 class Profile:
-    """A numeric piecewise linear-jerk profile starting at time ``t0`` [s].
+    """A numeric piecewise profile starting at time ``t0`` [s].
 
     ``segments`` hold plain floats; ``theta0`` [rad], ``omega0`` [rad/s], ``alpha0`` [rad/s^2].
     """
@@ -95,7 +152,14 @@ class Profile:
         j0 = np.array([float(s.j0) for s in self.segments])[idx]
         j1 = np.array([float(s.j1) for s in self.segments])[idx]
         th0, om0, al0 = knots[idx, 0], knots[idx, 1], knots[idx, 2]
-        return advance(th0, om0, al0, j0, j1, t - tk[idx])
+        tau = t - tk[idx]
+        out = [np.array(v, dtype=float) for v in np.broadcast_arrays(*advance(th0, om0, al0, j0, j1, tau))]
+        for k, seg in enumerate(self.segments):
+            if seg.shape is not None:
+                mask = idx == k
+                for v, d in zip(out, shape_part(seg, tau[mask]), strict=True):
+                    v[mask] += d
+        return tuple(out)
 
     def time_at_angle(self, theta: float) -> float:
         """First time [s] at which the (increasing) crank angle reaches ``theta`` [rad].
@@ -111,7 +175,7 @@ class Profile:
         seg = self.segments[k]
         tau = 0.5 * (lo + hi)
         for _ in range(100):
-            th, om, _, _ = advance(*knots[k], float(seg.j0), float(seg.j1), tau)
+            th, om, _, _ = advance_segment(seg, *knots[k], tau)
             err = th - theta
             if abs(err) < 1e-14:
                 break

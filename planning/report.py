@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from planning.case import KEY_POINT_NAMES, RPM, Case
+from planning.cycle import HALVES
 from planning.optimize import Solution
 from planning.profile import Profile
 from planning.verify import MAX_STEP_S
@@ -72,9 +73,11 @@ def segments(solution: Solution) -> list[dict[str, Any]]:
     prof = solution.plan.profile
     knots = prof.knots()
     out = []
+    jerk = prof.at_time(prof.knot_times)[3]  # right-continuous: the start of each segment
+    jerk_end = prof.at_time(prof.knot_times[1:] - 1e-12 * np.maximum(prof.durations, 1e-9))[3]
     for k, seg in enumerate(prof.segments):
         T = float(seg.duration)
-        j_start, j_end = float(seg.j0), float(seg.j0 + seg.j1 * T)
+        j_start, j_end = float(jerk[k]), float(jerk_end[k])
         out.append(
             {
                 "name": seg.name,
@@ -118,8 +121,11 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
         "transfer_speed_rpm": float(p.transfer_speed) / RPM,
         "feed_peak_speed_rpm": float(p.feed_peak_speed) / RPM,
         "return_peak_speed_rpm": float(p.return_peak_speed) / RPM,
-        "feed_jerk_rad_s3": float(p.feed_jerk),
-        "return_jerk_rad_s3": float(p.return_jerk),
+        "peak_crank_jerk_rad_s3": float(max(p.peak_jerks())),
+        "peak_crank_accel_rad_s2": float(max(p.peak_accelerations())),
+        "law_parameter": float(p.law_parameter),
+        "half_durations_s": {k: float(p.half(k)[0]) for k in HALVES},
+        "transfer_dwell_s": float(p.transfer_dwell),
         "transfer_time_s": plan.transfer_window(),
         "max_abs_slider_accel_mm_s2": accel.value,
         "binding_constraints": binding(solution),
@@ -127,7 +133,7 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
         "limits": case.limits.model_dump(),
         "key_points": key_points(solution, case),
         "segments": segments(solution),
-        "paper_solution": plan.paper_solution(),
+        "paper_solution": plan.paper_solution() if plan.motion_law == "improved-s-curve" else None,
         "verification": {
             "passed": ver.passed,
             "step_s": ver.step_s,
@@ -146,16 +152,17 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
 def summary_text(result: dict[str, Any]) -> str:
     """The console summary of a result dictionary."""
     r = result
-    ps = r["paper_solution"]
+    hd = r["half_durations_s"]
     lines = [
         f"{r['case']}: {r['spm']:.3f} strokes/min, cycle {r['cycle_time_s']:.4f} s "
         f"({r['motion_law']}, {r['placement']} placement, {r['status']})",
         f"  theta1 (closing) in {r['structure']['closing']}, theta4 (opening) in {r['structure']['opening']}",
         f"  crank speed: transfer {r['transfer_speed_rpm']:.3f} rpm, feed peak {r['feed_peak_speed_rpm']:.3f} rpm, "
         f"draw {r['draw_speed_rpm']:.3f} rpm, return peak {r['return_peak_speed_rpm']:.3f} rpm",
-        f"  jerk: feed {r['feed_jerk_rad_s3']:.3f} rad/s^3, return {r['return_jerk_rad_s3']:.3f} rad/s^3",
-        f"  sub-segments: feed {ps['T1_s']:.4f} / {ps['T5_s']:.4f} s, return {ps['T10_s']:.4f} / "
-        f"{ps['T14_s']:.4f} s, draw {ps['T9_s']:.4f} s",
+        f"  peaks: crank acceleration {r['peak_crank_accel_rad_s2']:.3f} rad/s^2, "
+        f"crank jerk {r['peak_crank_jerk_rad_s3']:.3f} rad/s^3",
+        f"  halves: feed {hd['feed_accel']:.4f} / {hd['feed_decel']:.4f} s, return {hd['return_accel']:.4f} / "
+        f"{hd['return_decel']:.4f} s; draw {r['cycle_time_s'] - sum(hd.values()) - r['transfer_dwell_s']:.4f} s",
         f"  transfer window theta4 -> theta1: {r['transfer_time_s']:.4f} s; "
         f"max |slider accel| {r['max_abs_slider_accel_mm_s2']:.1f} mm/s^2",
         "",

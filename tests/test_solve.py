@@ -89,7 +89,7 @@ def test_verification_rejects_a_plan_that_breaks_a_limit(free_solution, case):
     """No false success: a slightly faster variant of the optimum must fail the dense check."""
     plan = free_solution.plan
     p = plan.parameters
-    faster = replace(p, feed_jerk=p.feed_jerk * 1.05, feed_accel_time=p.feed_accel_time)
+    faster = replace(p, feed_peak_speed=p.transfer_speed + 1.05 * (p.feed_peak_speed - p.transfer_speed))
     bad = Plan(faster, profile_from_tdc(faster), plan.key_angles, plan.placement, plan.solver)
     assert not verify(bad, case).passed
     tight = case.model_copy(update={"limits": case.limits.model_copy(update={"slider_accel_mm_s2": 3400.0})})

@@ -1,0 +1,125 @@
+"""Every motion law on one case, beside the time-optimal bound: ``pressplan laws``.
+
+Each law is solved and verified like ``pressplan solve`` (the case's placement); the figures of merit
+come from the verified plan's dense trajectory (uniform grid of at most 1 ms from TDC), except the
+peak crank jerk, which is the closed-form peak of the law (``planning.verify``). The bound is the
+case's time-optimal bound (with the crank-jerk limit when the case sets one).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from planning.bound import Bound, time_optimal_bound
+from planning.case import RPM, Case
+from planning.laws import LAWS
+from planning.optimize import PlanningError, Solution, solve
+from planning.report import binding, sample_profile
+from planning.verify import max_abs_jerk
+
+COLUMNS = (
+    ("law", "law", ""),
+    ("spm", "SPM", ".3f"),
+    ("share_of_bound_pct", "% of bound", ".1f"),
+    ("peak_crank_speed_rpm", "peak crank speed [rpm]", ".2f"),
+    ("peak_crank_accel_rad_s2", "peak crank accel [rad/s²]", ".3f"),
+    ("peak_crank_jerk_rad_s3", "peak crank jerk [rad/s³]", ".1f"),
+    ("peak_slider_jerk_mm_s3", "peak slider jerk [mm/s³]", ".0f"),
+    ("rms_crank_accel_rad_s2", "RMS crank accel [rad/s²]", ".3f"),
+    ("continuity", "continuous up to", ""),
+)
+
+
+def law_row(law: str, solution: Solution, case: Case, bound: Bound) -> dict[str, Any]:
+    """The figures of merit of one verified plan (engineering units in the keys)."""
+    plan = solution.plan
+    table = sample_profile(plan.profile, case.machine)
+    t, om, al = table[:, 0], table[:, 2], table[:, 3]
+    _, _, _, slider_jerk = case.machine.slider(np.radians(table[:, 1]), om * RPM, al, table[:, 4])
+    sq = al**2
+    mean_sq = float(np.sum(np.diff(t) * (sq[1:] + sq[:-1]) / 2)) / plan.period  # time average (trapezoids)
+    return {
+        "law": law,
+        "status": "verified",
+        "spm": plan.spm,
+        "cycle_time_s": plan.period,
+        "share_of_bound_pct": 100.0 * plan.spm / bound.spm,
+        "peak_crank_speed_rpm": float(np.max(om)),
+        "peak_crank_accel_rad_s2": float(np.max(np.abs(al))),
+        "peak_crank_jerk_rad_s3": max_abs_jerk(plan.profile),
+        "peak_slider_jerk_mm_s3": float(np.max(np.abs(slider_jerk))),
+        "rms_crank_accel_rad_s2": float(math.sqrt(mean_sq)),
+        "continuity": LAWS[law].continuity,
+        "law_parameter": float(plan.parameters.law_parameter) if LAWS[law].parameter else None,
+        "law_parameter_name": LAWS[law].parameter[0] if LAWS[law].parameter else None,
+        "placement": plan.placement,
+        "structure": plan.structure,
+        "binding_constraints": binding(solution),
+    }
+
+
+def compare_laws(case: Case, laws: tuple[str, ...] = tuple(LAWS)) -> tuple[dict[str, Any], dict[str, Solution]]:
+    """Solve ``case`` under each law; returns the comparison dictionary and the verified solutions.
+
+    A law without a verified plan gets a row with ``status`` ``failed: <reason>`` and no numbers;
+    the bound's failure raises :class:`PlanningError` (nothing to compare against)."""
+    bound = time_optimal_bound(case)
+    rows, solutions = [], {}
+    for law in laws:
+        variant = case.model_copy(update={"planner": case.planner.model_copy(update={"motion_law": law})})
+        try:
+            sol = solve(variant)
+        except PlanningError as exc:
+            rows.append({"law": law, "status": f"failed: {exc}", "continuity": LAWS[law].continuity})
+            continue
+        solutions[law] = sol
+        rows.append(law_row(law, sol, variant, bound))
+    return {
+        "case": case.name,
+        "placement": case.planner.placement,
+        "bound": bound.as_dict(),
+        "jerk_limited_bound": case.limits.crank_jerk_rad_s3 is not None,
+        "laws": rows,
+    }, solutions
+
+
+def laws_markdown(data: dict[str, Any]) -> str:
+    """The comparison as a Markdown table, with the bound in the last row."""
+    head = "| " + " | ".join(title for _, title, _ in COLUMNS) + " |"
+    rule = "|" + "|".join("---" if fmt == "" else "---:" for _, _, fmt in COLUMNS) + "|"
+    lines = [head, rule]
+    for row in data["laws"]:
+        if row["status"] != "verified":
+            lines.append(f"| {row['law']} | {row['status']} |" + " |" * (len(COLUMNS) - 2))
+            continue
+        cells = [format(row[key], fmt) if fmt else str(row[key]) for key, _, fmt in COLUMNS]
+        lines.append("| " + " | ".join(cells) + " |")
+    b = data["bound"]
+    kind = "jerk-limited bound" if data["jerk_limited_bound"] else "time-optimal bound"
+    lines.append(f"| *{kind}* | {b['spm']:.3f} | 100.0 | {b['peak_crank_speed_rpm']:.2f} | | | | | shape free |")
+    return "\n".join(lines) + "\n"
+
+
+def laws_text(data: dict[str, Any]) -> str:
+    """The console table of a comparison."""
+    b = data["bound"]
+    lines = [
+        f"{data['case']}: motion laws ({data['placement']} placement), bound {b['spm']:.3f} SPM"
+        + (" (with the crank-jerk limit)" if data["jerk_limited_bound"] else ""),
+        f"  {'law':<17} {'SPM':>7} {'% bound':>7} {'rpm max':>8} {'acc max':>8} {'jerk max':>9} "
+        f"{'slider jerk':>11} {'acc RMS':>8}  continuous up to",
+    ]
+    for r in data["laws"]:
+        if r["status"] != "verified":
+            lines.append(f"  {r['law']:<17} {r['status']}")
+            continue
+        lines.append(
+            f"  {r['law']:<17} {r['spm']:7.3f} {r['share_of_bound_pct']:7.1f} {r['peak_crank_speed_rpm']:8.2f} "
+            f"{r['peak_crank_accel_rad_s2']:8.3f} {r['peak_crank_jerk_rad_s3']:9.1f} "
+            f"{r['peak_slider_jerk_mm_s3']:11.0f} {r['rms_crank_accel_rad_s2']:8.3f}  {r['continuity']}"
+        )
+    lines.append("  units: rpm, rad/s^2, rad/s^3, mm/s^3; RMS over one cycle")
+    return "\n".join(lines)
