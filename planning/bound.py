@@ -55,6 +55,7 @@ class Bound:
     angle_deg: np.ndarray
     crank_speed_rpm: np.ndarray
     wall_time_s: float
+    crank_jerk_limit_rad_s3: float | None = None
 
     def as_dict(self) -> dict:
         return {
@@ -65,6 +66,7 @@ class Bound:
             "draw_speed_rpm": self.draw_speed_rpm,
             "peak_crank_speed_rpm": float(np.max(self.crank_speed_rpm)),
             "wall_time_s": self.wall_time_s,
+            "crank_jerk_limit_rad_s3": self.crank_jerk_limit_rad_s3,
             "method": "phase-plane direct transcription over crank angle, convex (global optimum)",
         }
 
@@ -161,4 +163,5 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
         angle_deg=np.degrees(th[:-1]) % 360.0,
         crank_speed_rpm=np.sqrt(s_opt) / RPM,
         wall_time_s=time.perf_counter() - t_start,
+        crank_jerk_limit_rad_s3=lim.crank_jerk_rad_s3,
     )

@@ -65,6 +65,11 @@ def _parser() -> argparse.ArgumentParser:
         "--points", type=_whole(2, 1_000_000), default=1440, metavar="N", help="grid intervals (default 1440)"
     )
     b.add_argument("--json", action="store_true", help="print JSON")
+    lw = sub.add_parser("laws", help="every motion law on the case, beside the time-optimal bound")
+    lw.add_argument("case", help="case file (YAML)")
+    lw.add_argument("--out", help="output folder (default: out/<case name>)")
+    lw.add_argument("--json", action="store_true", help="print laws.json instead of the table")
+    lw.add_argument("--format", choices=PLOT_FORMATS, default="png", help="figure format (default png)")
     pl = sub.add_parser("plot", help="redraw the figures of a finished output folder (no solve)")
     pl.add_argument("folder", help="output folder of `pressplan solve`")
     pl.add_argument("--format", choices=PLOT_FORMATS, default="png", help="figure format (default png)")
@@ -104,6 +109,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _sweep(case, args)
     if args.command == "bound":
         return _bound(case, args)
+    if args.command == "laws":
+        return _laws(case, args)
     return _solve(case, args)
 
 
@@ -255,9 +262,39 @@ def _bound(case, args) -> int:
         print(
             f"{case.name}: time-optimal bound {bound.spm:.3f} strokes/min, cycle {bound.cycle_time_s:.4f} s "
             f"({bound.points} intervals; peak crank speed {data['peak_crank_speed_rpm']:.2f} rpm, "
-            f"draw {bound.draw_speed_rpm:.3f} rpm, robot-window slack {bound.window_slack_s:.3f} s)"
+            f"draw {bound.draw_speed_rpm:.3f} rpm, robot-window slack {bound.window_slack_s:.3f} s"
+            + (f"; crank jerk <= {bound.crank_jerk_limit_rad_s3:g} rad/s^3)" if bound.crank_jerk_limit_rad_s3 else ")")
         )
     return EXIT_OK
+
+
+def _laws(case, args) -> int:
+    from planning.law_comparison import compare_laws, laws_markdown, laws_text
+    from planning.optimize import PlanningError
+    from planning.outputs import write_json
+    from planning.plots import laws_figure, save
+    from planning.report import TRAJECTORY_COLUMNS, sample_profile
+
+    out = _output_folder(case, args)
+    if isinstance(out, int):
+        return out
+    try:
+        data, solutions = compare_laws(case)
+    except PlanningError as exc:
+        return _fail(f"{args.case}: {exc}", EXIT_INFEASIBLE)
+    if not solutions:
+        return _fail(f"{args.case}: no motion law gives a verified plan", EXIT_INFEASIBLE)
+    curves = {}
+    for law, sol in solutions.items():
+        table = sample_profile(sol.plan.profile, case.machine)
+        curves[law] = {name: table[:, i] for i, name in enumerate(TRAJECTORY_COLUMNS)}
+    title = f"{case.name}: crank motion of each law ({data['placement']} placement)"
+    writers = {
+        "laws.json": lambda p: write_json(p, data),
+        "laws.md": lambda p: p.write_text(laws_markdown(data), encoding="utf-8"),
+        f"laws_overlay.{args.format}": lambda p: save(laws_figure(curves, title), p),
+    }
+    return _write_and_report(out, writers, data, laws_text(data), args.json)
 
 
 def _plot(args) -> int:

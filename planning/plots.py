@@ -228,3 +228,23 @@ def sweep_figure(rows: list[dict[str, Any]], fields: list[str], title: str) -> F
         ax.set_ylabel(fields[1])
     ax.set_title(title, fontsize=10)
     return fig
+
+
+def laws_figure(curves: dict[str, dict[str, np.ndarray]], title: str) -> Figure:
+    """Crank speed and crank acceleration against crank angle from TDC, one line per motion law.
+    ``curves``: law -> columns ``crank_angle_deg``, ``crank_speed_rpm``, ``crank_accel_rad_s2``."""
+    fig = Figure(figsize=(10, 7), dpi=90)
+    FigureCanvasAgg(fig)
+    top, bottom = fig.subplots(2, 1, sharex=True)
+    for law, c in curves.items():
+        top.plot(c["crank_angle_deg"], c["crank_speed_rpm"], lw=1.3, label=law)
+        bottom.plot(c["crank_angle_deg"], c["crank_accel_rad_s2"], lw=1.1, label=law)
+    top.set_ylabel("crank speed [rpm]")
+    bottom.set_ylabel("crank acceleration [rad/s²]")
+    bottom.set_xlabel("crank angle from TDC [deg]")
+    bottom.set_xlim(0.0, 360.0)
+    for ax in (top, bottom):
+        ax.grid(True, lw=0.3)
+    top.legend(fontsize=8, ncol=3)
+    top.set_title(title, fontsize=10)
+    return fig

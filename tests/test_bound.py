@@ -39,3 +39,34 @@ def test_bound_command(capsys):
     assert main(["bound", str(PUBLISHED_CASE), "--json", "--points", "720"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert BOUND_RANGE[0] <= data["spm"] <= BOUND_RANGE[1] and data["points"] >= 700
+
+
+SERVO_CASE = PUBLISHED_CASE.parent / "side-panel-servo-limits.yaml"
+
+
+@pytest.fixture(scope="module")
+def servo_case():
+    from planning.case_file import read_case
+
+    return read_case(SERVO_CASE)
+
+
+def test_jerk_limited_bound_converges_and_tightens(servo_case):
+    """With the case's crank-jerk limit the bound converges under refinement (steps halve: first order)
+    and lies below the bound without it."""
+    spm = [time_optimal_bound(servo_case, n).spm for n in (360, 720, 1440)]
+    steps = [abs(b - a) for a, b in zip(spm, spm[1:], strict=False)]
+    assert steps[1] < 0.6 * steps[0] and steps[1] < 0.015
+    free = servo_case.model_copy(update={"limits": servo_case.limits.model_copy(update={"crank_jerk_rad_s3": None})})
+    assert time_optimal_bound(free, 1440).spm > spm[-1] + 0.1
+
+
+def test_laws_against_the_jerk_limited_bound(servo_case):
+    """Issue 5: with a crank-jerk limit the best law reaches >= 95 % of the jerk-limited bound, and
+    no law exceeds the bound."""
+    from planning.law_comparison import compare_laws
+
+    data, _ = compare_laws(servo_case)
+    shares = [r["share_of_bound_pct"] for r in data["laws"] if r["status"] == "verified"]
+    assert len(shares) == 5 and data["jerk_limited_bound"]
+    assert max(shares) >= 95.0 and max(shares) <= 100.0

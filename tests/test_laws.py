@@ -1,0 +1,178 @@
+"""The motion laws: closed forms of every shape, one half of every law against its dense evaluation,
+continuity, splitting, and every law on every case (solved and verified)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from planning.case_file import read_case
+from planning.laws import LAWS
+from planning.laws.shapes import Cycloidal, Logistic, Quintic
+from planning.optimize import solve
+from planning.profile import Profile, split_segment
+from planning.verify import max_abs_jerk
+
+SHAPES = [Quintic(), Cycloidal(), Logistic(4.0), Logistic(5.0), Logistic(6.0), Logistic(2.0)]
+U = np.linspace(0.0, 1.0, 200_001)
+CASES = sorted((Path(__file__).resolve().parents[1] / "cases").glob("*.yaml"))
+
+
+@pytest.mark.parametrize("shape", SHAPES, ids=lambda s: f"{s.name}{getattr(s, 'flexible', '')}")
+def test_shape_boundary_values_and_symmetry(shape):
+    s, S, s1, s2 = shape.terms(U)
+    assert s[0] == pytest.approx(0, abs=1e-15) and s[-1] == pytest.approx(1, abs=1e-14)
+    assert s1[0] == pytest.approx(0, abs=1e-14) and s1[-1] == pytest.approx(0, abs=1e-13)
+    assert S[0] == pytest.approx(0, abs=1e-15) and S[-1] == pytest.approx(0.5, abs=1e-14)
+    assert np.max(np.abs(s + s[::-1] - 1)) < 1e-13  # point symmetry about u = 1/2
+    assert np.all(np.diff(s) >= -1e-15)  # monotone: the speed never overshoots its end value
+
+
+@pytest.mark.parametrize("shape", SHAPES, ids=lambda s: f"{s.name}{getattr(s, 'flexible', '')}")
+def test_shape_derivatives_are_consistent(shape):
+    """S' = s, s' and s'' match central differences of s and s' (step 5e-6: error O(h^2) ~ 1e-9)."""
+    s, S, s1, s2 = shape.terms(U)
+    h = U[1] - U[0]
+    assert np.max(np.abs((S[2:] - S[:-2]) / (2 * h) - s[1:-1])) < 1e-8
+    assert np.max(np.abs((s[2:] - s[:-2]) / (2 * h) - s1[1:-1])) < 1e-7
+    assert np.max(np.abs((s1[2:] - s1[:-2]) / (2 * h) - s2[1:-1])) < 1e-5 * max(1.0, np.max(np.abs(s2)))
+
+
+@pytest.mark.parametrize("shape", SHAPES[:5], ids=lambda s: f"{s.name}{getattr(s, 'flexible', '')}")
+def test_closed_form_peaks(shape):
+    """The stated peaks of s' and |s''| equal the maxima on a 200 001-point grid."""
+    _, _, s1, s2 = shape.terms(U)
+    assert float(shape.peak_rate()) == pytest.approx(np.max(s1), rel=1e-9)
+    assert float(shape.peak_jerk()) == pytest.approx(np.max(np.abs(s2)), rel=1e-8)
+
+
+def test_known_closed_forms():
+    assert Quintic().peak_rate() == 15 / 8 and Quintic().peak_jerk() == pytest.approx(5.773502691896258)
+    assert Cycloidal().peak_rate() == 2 and Cycloidal().peak_jerk() == pytest.approx(2 * math.pi)
+    assert LAWS["improved-s-curve"].peak_rate() == pytest.approx(18 / 11)  # 3/2 J T, J = dv / (11/3 T^2), T = D/4
+    assert LAWS["seven-segment"].peak_rate(1.0) == 2.0  # no plateau: triangular acceleration
+
+
+@pytest.mark.parametrize("shape", SHAPES[:5], ids=lambda s: f"{s.name}{getattr(s, 'flexible', '')}")
+def test_shapes_agree_in_numpy_and_casadi(shape):
+    u = ca.SX.sym("u")
+    f = ca.Function("f", [u], list(shape.terms(u)))
+    for x in (0.0, 0.13, 0.5, 0.91):
+        sym = [float(v) for v in f(x)]
+        num = [float(v) for v in shape.terms(np.array(x))]
+        assert sym == pytest.approx(num, rel=1e-13, abs=1e-14)
+
+
+def half_profile(law: str, v0: float, dv: float, D: float, param: float | None) -> Profile:
+    return Profile(tuple(LAWS[law].half("half", D, dv, param)), 0.0, v0)
+
+
+LAW_PARAMS = [
+    (law, p)
+    for law in LAWS
+    for p in ([0.2, 0.6, 1.0] if law == "seven-segment" else [4.0, 6.0] if law == "logistic" else [None])
+]
+
+
+@pytest.mark.parametrize("law,param", LAW_PARAMS, ids=lambda x: str(x))
+def test_one_half_of_every_law(law, param):
+    """Speed change, angle D (v0 + dv/2), zero acceleration at both ends, and the closed-form peak
+    acceleration and jerk of the law, against the dense evaluation of its segments."""
+    v0, dv, D = 1.3, 2.1, 0.37
+    prof = half_profile(law, v0, dv, D, param)
+    t = np.linspace(0, prof.duration, 100_001)
+    th, om, al, je = prof.at_time(t)
+    assert prof.duration == pytest.approx(D, rel=1e-15)
+    assert om[-1] == pytest.approx(v0 + dv, rel=1e-13)
+    assert th[-1] == pytest.approx(D * (v0 + dv / 2), rel=1e-13)
+    assert al[0] == pytest.approx(0, abs=1e-12) and al[-1] == pytest.approx(0, abs=1e-11)
+    rate = float(LAWS[law].peak_rate(param)) * dv / D
+    assert np.max(np.abs(al)) == pytest.approx(rate, rel=1e-6)
+    jerk = float(LAWS[law].peak_jerk(param)) * dv / D**2
+    assert max_abs_jerk(prof) == pytest.approx(jerk, rel=1e-12)
+    assert np.max(np.abs(je)) == pytest.approx(jerk, rel=1e-3)  # the grid may miss the exact peak
+
+
+@pytest.mark.parametrize("law", list(LAWS))
+def test_stated_continuity(law):
+    """A jerk-continuous law starts and ends its halves at zero jerk (it joins constant speed and the
+    opposite half smoothly); an acceleration-continuous one has a jerk step somewhere."""
+    param = LAWS[law].parameter[3] if LAWS[law].parameter else None
+    prof = half_profile(law, 1.0, 2.0, 0.4, param)
+    t = prof.knot_times
+    _, _, _, je = prof.at_time(np.concatenate([t[:-1], [t[-1] - 1e-12]]))
+    inner = prof.at_time(t[1:-1] - 1e-12)[3] if t.size > 2 else np.array([])
+    steps = np.concatenate([np.abs(je[[0, -1]]), np.abs(je[1:-1] - inner)])
+    if LAWS[law].continuity == "jerk":
+        assert np.max(steps) < 1e-6
+    else:
+        assert LAWS[law].continuity == "acceleration" and np.max(steps) > 1e-3
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    law=st.sampled_from(["quintic", "cycloidal", "logistic", "seven-segment", "improved-s-curve"]),
+    cut=st.floats(0.01, 0.99),
+)
+def test_splitting_a_half_keeps_its_motion(law, cut):
+    """A half cut in two (as at TDC) moves exactly as the whole."""
+    param = LAWS[law].parameter[3] if LAWS[law].parameter else None
+    whole = half_profile(law, 0.8, 1.7, 0.5, param)
+    segs = []
+    for seg in whole.segments:
+        tau = cut * float(seg.duration)
+        segs += list(split_segment(seg, tau))
+    pieces = Profile(tuple(segs), 0.0, 0.8)
+    t = np.linspace(0, whole.duration, 2001)
+    for a, b in zip(whole.at_time(t)[:3], pieces.at_time(t)[:3], strict=True):
+        assert np.max(np.abs(a - b)) < 1e-11
+
+
+@pytest.mark.parametrize("law", [law for law in LAWS if law != "improved-s-curve"])
+@pytest.mark.parametrize("path", CASES, ids=lambda p: p.stem)
+def test_every_law_solves_every_case(path, law):
+    """Every law gives a verified plan on every case (the improved S-curve: tests/test_cases.py)."""
+    case = read_case(path)
+    case = case.model_copy(update={"planner": case.planner.model_copy(update={"motion_law": law})})
+    sol = solve(case)
+    assert sol.verification.passed and sol.plan.motion_law == law
+    assert sol.plan.profile.segments[0].name.split(":")[0] in ("transfer", "return", "feed")
+
+
+def test_laws_command_and_the_readme_table(tmp_path, capsys):
+    """`pressplan laws` on the published case: a verified row per law, all below the bound, the files
+    written; the README's table is this command's laws.md (numbers within their printed digits)."""
+    from planning.cli import main
+
+    from .conftest import PUBLISHED_CASE, ROOT
+
+    assert main(["laws", str(PUBLISHED_CASE), "--out", str(tmp_path), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert {p.name for p in tmp_path.iterdir()} == {"laws.json", "laws.md", "laws_overlay.png"}
+    rows = {r["law"]: r for r in data["laws"]}
+    assert set(rows) == set(LAWS) and all(r["status"] == "verified" for r in rows.values())
+    assert all(r["spm"] <= data["bound"]["spm"] for r in rows.values())
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    block = readme.split("<!-- laws:begin -->")[1].split("<!-- laws:end -->")[0]
+    printed = {cells[0]: cells for cells in _table_rows(block)}
+    fresh = {cells[0]: cells for cells in _table_rows((tmp_path / "laws.md").read_text(encoding="utf-8"))}
+    assert printed.keys() == fresh.keys() and len(printed) == len(LAWS) + 1
+    for name, cells in fresh.items():
+        for a, b in zip(cells[1:], printed[name][1:], strict=True):
+            if a.replace(".", "").isdigit():
+                unit = 10.0 ** -len(a.split(".")[1]) if "." in a else 1.0
+                assert abs(float(a) - float(b)) <= unit, (name, a, b)  # the last printed digit may differ by 1
+            else:
+                assert a == b
+
+
+def _table_rows(markdown: str) -> list[list[str]]:
+    rows = [line.strip().strip("|").split("|") for line in markdown.splitlines() if line.startswith("|")]
+    return [[c.strip() for c in r] for r in rows[2:]]
