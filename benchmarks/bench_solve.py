@@ -2,8 +2,9 @@
 
 Measures (a) the in-process solve after a warm-up (the NLP already built), a cold ``pressplan solve``
 process beside a process that only imports casadi, numpy, matplotlib and yaml, and the NLP build
-alone; (b) a 41-point transfer-time sweep with 1 and 2 workers (whole process, points per second).
-Motion-law figures (c) come when there are other laws. Medians; run with
+alone; (b) a 41-point transfer-time sweep with 1 and 2 workers (whole process, points per second);
+(c) the SPM of every motion law and its share of the time-optimal bound, with each law's NLP build and
+solve time (``pressplan laws``). Medians; run with
 ``python benchmarks/bench_solve.py`` from the project root where pressplan is installed.
 """
 
@@ -40,7 +41,7 @@ def main() -> None:
 
     case = read_case(CASE)
     t = time.perf_counter()
-    _build()
+    _build("improved-s-curve")
     build = time.perf_counter() - t
     first = solve(case)  # warm-up: builds the cached NLP
     warm = []
@@ -74,6 +75,7 @@ def main() -> None:
                 ]
             )
             sweep_rows.append((workers, wall))
+    law_rows = _laws(case)
     med = statistics.median
     rows = [
         ("NLP build (once per process)", build),
@@ -102,10 +104,54 @@ def main() -> None:
         "|---|---:|",
         *[f"| {name} | {value:.3f} |" for name, value in rows],
         "",
+        "Motion laws on the same case (free placement), against the time-optimal bound "
+        f"({law_rows[0]['bound']:.3f} SPM, {law_rows[0]['bound_time']:.2f} s to compute):",
+        "",
+        "| law | SPM | % of bound | NLP build [s] | solve [s] |",
+        "|---|---:|---:|---:|---:|",
+        *[
+            f"| {r['law']} | {r['spm']:.3f} | {r['share']:.1f} | {r['build']:.2f} | {r['solve']:.2f} |"
+            for r in law_rows
+        ],
+        "",
     ]
     out = ROOT / "benchmarks" / "RESULTS.md"
     out.write_text("\n".join(lines))
     print("\n".join(lines))
+
+
+def _laws(case) -> list[dict]:
+    """(c): every law's SPM, share of the bound, NLP build time and (warm) solve time."""
+    from planning.bound import time_optimal_bound
+    from planning.laws import LAWS
+    from planning.nlp import cycle_nlp
+    from planning.optimize import solve
+
+    t = time.perf_counter()
+    bound = time_optimal_bound(case)
+    bound_time = time.perf_counter() - t
+    rows = []
+    for law in LAWS:
+        variant = case.model_copy(update={"planner": case.planner.model_copy(update={"motion_law": law})})
+        t = time.perf_counter()
+        cycle_nlp(law)
+        build = time.perf_counter() - t
+        t = time.perf_counter()
+        sol = solve(variant)
+        elapsed = time.perf_counter() - t
+        assert sol.verification.passed
+        rows.append(
+            {
+                "law": law,
+                "spm": sol.plan.spm,
+                "share": 100 * sol.plan.spm / bound.spm,
+                "build": build,
+                "solve": elapsed,
+                "bound": bound.spm,
+                "bound_time": bound_time,
+            }
+        )
+    return rows
 
 
 if __name__ == "__main__":
