@@ -132,7 +132,7 @@ def _laws(case) -> list[dict]:
     bound_time = time.perf_counter() - t
     rows = []
     for law in LAWS:
-        variant = case.model_copy(update={"planner": case.planner.model_copy(update={"motion_law": law})})
+        variant = case.with_law(law)
         t = time.perf_counter()
         cycle_nlp(law)
         build = time.perf_counter() - t

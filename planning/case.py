@@ -16,7 +16,7 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from planning.laws import DEFAULT_LAW, LawName
+from planning.laws import DEFAULT_LAW, LAWS, LawName
 from press.kinematics import CrankSlider
 
 RPM = 2.0 * math.pi / 60.0  # [rad/s] per rpm
@@ -92,10 +92,12 @@ class LimitsModel(_Model):
 
 
 class PlannerModel(_Model):
-    """``motion_law`` and ``placement`` of the key points (free | published)."""
+    """``motion_law``, ``placement`` of the key points (free | published) and ``law_parameter``: the
+    law's shape parameter held fixed (seven-segment jerk share, logistic flexible); omitted: optimised."""
 
     motion_law: LawName = DEFAULT_LAW
     placement: Literal["free", "published"] = "free"
+    law_parameter: Positive | None = None
 
 
 class PublishedKeyPoint(_Model):
@@ -163,6 +165,13 @@ class Case(_Model):
         k = self.key_points
         return np.radians([k.closing_deg, k.draw_start_deg, k.draw_end_deg, k.opening_deg])
 
+    def with_law(self, law: str) -> Case:
+        """The same case under motion law ``law``; a fixed ``law_parameter`` is kept for the same law only."""
+        if law == self.planner.motion_law:
+            return self
+        planner = self.planner.model_copy(update={"motion_law": law, "law_parameter": None})
+        return self.model_copy(update={"planner": planner})
+
 
 KEY_POINT_NAMES = ("closing", "draw_start", "draw_end", "opening")
 KEY_POINT_FIELDS = ("closing_deg", "draw_start_deg", "draw_end_deg", "opening_deg")
@@ -229,6 +238,16 @@ def cross_checks(case: Case) -> None:
             f"must be below the slider height at the draw start ({h2:.1f} mm)",
             case.limits.die_height_mm,
         )
+    fixed = case.planner.law_parameter
+    if fixed is not None:
+        law = LAWS[case.planner.motion_law]
+        if law.parameter is None:
+            raise CaseError("planner.law_parameter", f"the {law.name} law has no shape parameter", fixed)
+        lo, hi = law.valid
+        if not lo <= fixed <= hi:
+            raise CaseError(
+                "planner.law_parameter", f"{law.parameter[0]} of the {law.name} law must lie in [{lo:g}, {hi:g}]", fixed
+            )
     top = case.limits.crank_speed_rpm
     if top is not None and top <= case.limits.min_crank_speed_rpm:
         raise CaseError(

@@ -146,7 +146,7 @@ def _solve(case, args) -> int:
     from planning.report import result_dict, summary_text
 
     if args.law:
-        case = case.model_copy(update={"planner": case.planner.model_copy(update={"motion_law": args.law})})
+        case = case.with_law(args.law)
     out = _output_folder(case, args)
     if isinstance(out, int):
         return out
@@ -170,7 +170,7 @@ def _compare(case, args) -> int:
     if case.published is None or case.published.solution is None:
         return _fail(f"{args.case}: published.solution: the case has no published solution to compare", EXIT_INPUT)
     # the paper's notation describes its own law: compare under the improved S-curve
-    case = case.model_copy(update={"planner": case.planner.model_copy(update={"motion_law": "improved-s-curve"})})
+    case = case.with_law("improved-s-curve")
     out = _output_folder(case, args)
     if isinstance(out, int):
         return out
@@ -220,9 +220,7 @@ def _sweep(case, args) -> int:
         ensure_writable(out)
     except OutputError as exc:
         return _fail(str(exc), EXIT_INPUT)
-    base = case.model_dump(exclude_none=True)
-    if args.law:
-        base.setdefault("planner", {})["motion_law"] = args.law
+    base = (case.with_law(args.law) if args.law else case).model_dump(exclude_none=True)
     tty = sys.stderr.isatty()
 
     def progress(done: int, total: int, failed: int) -> None:

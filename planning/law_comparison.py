@@ -69,7 +69,7 @@ def compare_laws(case: Case, laws: tuple[str, ...] = tuple(LAWS)) -> tuple[dict[
     bound = time_optimal_bound(case)
     rows, solutions = [], {}
     for law in laws:
-        variant = case.model_copy(update={"planner": case.planner.model_copy(update={"motion_law": law})})
+        variant = case.with_law(law)
         try:
             sol = solve(variant)
         except PlanningError as exc:

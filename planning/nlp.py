@@ -35,7 +35,7 @@ import numpy as np
 
 from planning.cycle import CycleParameters, cycle_segments
 from planning.laws import DEFAULT_LAW, get_law
-from planning.profile import Segment, advance_segment, knot_states
+from planning.profile import Segment, advance, advance_segment, knot_states, shape_part
 from press.kinematics import height_derivatives
 
 Placement = Literal["free", "published"]
@@ -113,13 +113,19 @@ class ConstraintBlock:
 
 
 def _angle_at(t: ca.SX, starts: list, states: list, segs: list[Segment]) -> tuple[ca.SX, ca.SX]:
-    """Closed-form crank angle and speed at time ``t`` [s] over the segments (clip formulation)."""
-    theta, omega = states[0][0], states[0][1]
-    for start, st, seg in zip(starts, states, segs, strict=True):
-        tau = ca.fmin(ca.fmax(t - start, 0), seg.duration)
-        th, om, _, _ = advance_segment(seg, 0.0, st[1], st[2], tau)
-        theta += th
-        omega += om - st[1]
+    """Closed-form crank angle and speed at time ``t`` [s] over the segments (clip formulation): the
+    linear-jerk parts as one vector, the shape terms of shaped segments added one by one."""
+    T = ca.vertcat(*[seg.duration for seg in segs])
+    tau = ca.fmin(ca.fmax(t - ca.vertcat(*starts), 0), T)
+    omega0 = ca.vertcat(*[st[1] for st in states])
+    alpha0 = ca.vertcat(*[st[2] for st in states])
+    j0, j1 = ca.vertcat(*[seg.j0 for seg in segs]), ca.vertcat(*[seg.j1 for seg in segs])
+    th, om, _, _ = advance(0.0, omega0, alpha0, j0, j1, tau)
+    theta, omega = states[0][0] + ca.sum1(th), states[0][1] + ca.sum1(om - omega0)
+    for k, seg in enumerate(segs):
+        if seg.shape is not None:
+            dth, dom, _, _ = shape_part(seg, tau[k])
+            theta, omega = theta + dth, omega + dom
     return theta, omega
 
 

@@ -170,7 +170,13 @@ def _bounds(case: Case, w2_lo: float, w2_hi: float, p: np.ndarray) -> tuple[np.n
     for k in HALVES:
         lo[i[f"{k}_duration"]] = MIN_HALF_S
     law = get_law(case.planner.motion_law)
-    lo[i["law_parameter"]], hi[i["law_parameter"]] = law.parameter[1:3] if law.parameter else (0.0, 0.0)
+    fixed = case.planner.law_parameter
+    if law.parameter is None:
+        lo[i["law_parameter"]] = hi[i["law_parameter"]] = 0.0
+    elif fixed is not None:
+        lo[i["law_parameter"]] = hi[i["law_parameter"]] = fixed
+    else:
+        lo[i["law_parameter"]], hi[i["law_parameter"]] = law.parameter[1:3]
     for k in ("die_down", "die_up"):
         if p[PARAMETER_INDEX[f"{k}_active"]] == 0.0:
             lo[i[f"{k}_time"]] = hi[i[f"{k}_time"]] = 0.0

@@ -140,7 +140,7 @@ def test_splitting_a_half_keeps_its_motion(law, cut):
 def test_every_law_solves_every_case(path, law):
     """Every law gives a verified plan on every case (the improved S-curve: tests/test_cases.py)."""
     case = read_case(path)
-    case = case.model_copy(update={"planner": case.planner.model_copy(update={"motion_law": law})})
+    case = case.with_law(law)
     sol = solve(case)
     assert sol.verification.passed and sol.plan.motion_law == law
     assert sol.plan.profile.segments[0].name.split(":")[0] in ("transfer", "return", "feed")

@@ -29,20 +29,22 @@ from dataclasses import dataclass, field
 from typing import Any, Literal, get_args
 
 from planning.laws import improved_scurve as sc
-from planning.laws.shapes import Cycloidal, Logistic, Quintic
+from planning.laws.shapes import LOGISTIC_MIN_FLEXIBLE, Cycloidal, Logistic, Quintic
 from planning.profile import Segment, shape_segment
 
 
 @dataclass(frozen=True)
 class MotionLaw:
     """A motion law. ``parameter``: ``(name, low, high, start)`` of its shape parameter when it has
-    one (optimised by the NLP within the bounds), else None. ``samples``: slider-acceleration samples
-    the NLP takes per segment of a half (the dense verification decides between them)."""
+    one (optimised by the NLP within the bounds unless the case fixes it within ``valid``), else
+    None. ``samples``: slider-acceleration samples the NLP takes per segment of a half (the dense
+    verification decides between them)."""
 
     name: str
     continuity: str  # "acceleration" or "jerk": the highest derivative of the speed that is continuous
     source: str
     parameter: tuple[str, float, float, float] | None = None
+    valid: tuple[float, float] = (0.0, 0.0)  # where a fixed shape parameter (planner.law_parameter) may lie
     samples: int = 5
     one_jerk_per_curve: bool = False  # Eq. 14: both halves of an S-curve share one jerk
     notes: str = field(default="", compare=False)
@@ -94,9 +96,18 @@ LAWS: dict[str, MotionLaw] = {
     law.name: law
     for law in (
         MotionLaw("improved-s-curve", "acceleration", "paper 003, Eqs. 10-21", one_jerk_per_curve=True),
-        MotionLaw("seven-segment", "acceleration", "seeds 000, 002, 004", ("jerk_share", 0.2, 1.0, 0.6)),
+        MotionLaw(
+            "seven-segment", "acceleration", "seeds 000, 002, 004", ("jerk_share", 0.2, 1.0, 0.6), valid=(0.01, 1.0)
+        ),
         MotionLaw("quintic", "jerk", "seed 001", samples=20),
-        MotionLaw("logistic", "acceleration", "seed 000, Eq. 4", ("flexible", 4.0, 6.0, 5.0), samples=20),
+        MotionLaw(
+            "logistic",
+            "acceleration",
+            "seed 000, Eq. 4",
+            ("flexible", 4.0, 6.0, 5.0),
+            samples=20,
+            valid=(LOGISTIC_MIN_FLEXIBLE, 30.0),
+        ),
         MotionLaw("cycloidal", "jerk", "cam design", samples=20),
     )
 }
