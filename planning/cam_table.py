@@ -16,6 +16,7 @@ import math
 
 import numpy as np
 
+from planning.laws import LAWS
 from planning.plan import Plan
 
 CAM_COLUMNS = ("master_deg", "crank_angle_deg", "dcrank_dmaster", "d2crank_dmaster2", "d3crank_dmaster3")
@@ -44,7 +45,15 @@ def cam_header(plan: Plan, case_name: str, points: int) -> str:
             "# units: master_deg, crank_angle_deg [deg]; dcrank_dmaster [deg/deg]; d2crank_dmaster2 [deg/deg^2]; "
             "d3crank_dmaster3 [deg/deg^3]",
             "# angle datum: crank angle from top dead centre (TDC = 0 deg), increasing with rotation",
-            "# continuity: crank position, speed and acceleration continuous (C2), cyclic over the stroke; "
-            f"jerk steps at segment knots ({plan.motion_law}, {len(plan.profile.segments)} segments)",
+            "# continuity: " + _continuity(plan),
         ]
     )
+
+
+def _continuity(plan: Plan) -> str:
+    """The header's continuity statement, from the plan's motion law."""
+    law = LAWS[plan.motion_law]
+    where = f"({plan.motion_law}, {len(plan.profile.segments)} segments)"
+    if law.continuity == "jerk":
+        return f"crank position, speed, acceleration and jerk continuous (C3), cyclic over the stroke {where}"
+    return f"crank position, speed and acceleration continuous (C2), cyclic over the stroke; jerk steps {where}"

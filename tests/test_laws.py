@@ -176,3 +176,34 @@ def test_laws_command_and_the_readme_table(tmp_path, capsys):
 def _table_rows(markdown: str) -> list[list[str]]:
     rows = [line.strip().strip("|").split("|") for line in markdown.splitlines() if line.startswith("|")]
     return [[c.strip() for c in r] for r in rows[2:]]
+
+
+@pytest.mark.parametrize("law", ["quintic", "cycloidal"])
+def test_jerk_continuous_laws_give_jerk_continuous_plans(case, law):
+    """Across every knot of a solved cycle the crank jerk of a jerk-continuous law does not step (it
+    changes by at most 2e-9 s times its rate, far below 1e-5 rad/s^3)."""
+    prof = solve(case.with_law(law)).plan.profile
+    t = prof.knot_times[1:-1]
+    jump = prof.at_time(t + 1e-9)[3] - prof.at_time(t - 1e-9)[3]
+    assert np.max(np.abs(jump)) < 1e-5
+    steps = solve(case).plan.profile  # the improved S-curve's jerk does step: the check can fail
+    t = steps.knot_times[1:-1]
+    assert np.max(np.abs(steps.at_time(t + 1e-9)[3] - steps.at_time(t - 1e-9)[3])) > 1.0
+
+
+def test_solve_and_sweep_take_a_law(tmp_path, capsys):
+    from planning.cli import main
+
+    from .conftest import PUBLISHED_CASE
+
+    assert main(["solve", str(PUBLISHED_CASE), "--law", "quintic", "--no-plots", "--out", str(tmp_path / "s")]) == 0
+    result = json.loads((tmp_path / "s" / "result.json").read_text())
+    assert result["motion_law"] == "quintic" and result["verified"] and result["paper_solution"] is None
+    assert "C3" in (tmp_path / "s" / "cam_table.csv").read_text().splitlines()[5]
+    args = ["sweep", str(PUBLISHED_CASE), "--law", "seven-segment", "--vary", "process.transfer_time_s=1.8:2.2:3"]
+    assert main([*args, "--workers", "1", "--out", str(tmp_path / "w")]) == 0
+    rows = (tmp_path / "w" / "sweep.csv").read_text().splitlines()
+    assert len(rows) == 4 and all(",verified," in r for r in rows[1:])
+    spm_at_2s = float(rows[2].split(",")[2])  # transfer time 2.0 s: the case itself, under seven-segment
+    assert spm_at_2s == pytest.approx(solve(read_case(PUBLISHED_CASE).with_law("seven-segment")).plan.spm, abs=1e-6)
+    capsys.readouterr()

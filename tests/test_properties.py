@@ -119,3 +119,11 @@ def test_relaxing_a_limit_never_costs_strokes(data, relax):
         relaxed["process"]["draw_speed_rpm"] = float(base.plan.parameters.draw_speed) * 60 / (2 * math.pi)
     better = solve(case_from_data(relaxed), warm=base.plan)
     assert better.plan.spm >= base.plan.spm - 1e-9
+
+
+@settings(PROFILE, max_examples=12)
+@given(data=CASES, law=st.sampled_from(["seven-segment", "quintic", "logistic", "cycloidal"]))
+def test_random_press_under_every_law_ends_verified_or_clean(data, law):
+    data = json.loads(json.dumps(data))
+    data.setdefault("planner", {})["motion_law"] = law
+    event(f"{law}: {outcome(data)}")
