@@ -1,9 +1,11 @@
 """The orchestrator: case -> NLP parameters -> multi-start IPOPT solves -> verified plan.
 
 Initial guesses are built from the case alone (never from published numbers): a transfer speed,
-peak speeds near the constant-speed acceleration bound, and sub-segment lengths that sweep the
-angles between the key points. ``free`` placement starts also from the ``published`` placement's
-solution, so it is never worse than that structure, and keeps the best plan that verifies.
+peak speeds near the constant-speed acceleration bound, and half durations that sweep the angles
+between the key points (the same for every motion law: each half of every law sweeps
+``D (v_start + v_end) / 2``). The NLP is the one of the case's motion law (``planner.motion_law``).
+``free`` placement starts also from the ``published`` placement's solution, so it is never worse
+than that structure, and keeps the best plan that verifies.
 """
 
 from __future__ import annotations
@@ -185,7 +187,7 @@ def _bounds(case: Case, w2_lo: float, w2_hi: float, p: np.ndarray) -> tuple[np.n
 
 def scales_for(case: Case) -> np.ndarray:
     """Variable scales from the press's own characteristic time ``T* = sqrt(R / A)`` [s] and speed
-    ``W* = sqrt(A / (R + R^2/L))`` [rad/s] (A the slider-acceleration limit): speeds ~ W*, sub-segment
+    ``W* = sqrt(A / (R + R^2/L))`` [rad/s] (A the slider-acceleration limit): speeds ~ W*,
     durations of the halves ~ T*, stage times ~ 10 T*. The factors make the variables O(1) for a
     press cycle of the usual proportions; they span orders of magnitude from a small fast press to a
     heavy slow one."""
