@@ -138,11 +138,14 @@ def test_splitting_a_half_keeps_its_motion(law, cut):
 @pytest.mark.parametrize("law", [law for law in LAWS if law != "improved-s-curve"])
 @pytest.mark.parametrize("path", CASES, ids=lambda p: p.stem)
 def test_every_law_solves_every_case(path, law):
-    """Every law gives a verified plan on every case (the improved S-curve: tests/test_cases.py)."""
-    case = read_case(path)
-    case = case.with_law(law)
-    sol = solve(case)
+    """Every law gives a verified plan on every case under both placements, free never worse (the
+    improved S-curve: tests/test_cases.py)."""
+    case = read_case(path).with_law(law)
+    published = solve(case, "published")
+    sol = solve(case, "free")
+    assert published.verification.passed and published.plan.motion_law == law
     assert sol.verification.passed and sol.plan.motion_law == law
+    assert sol.plan.spm >= published.plan.spm - 1e-9
     assert sol.plan.profile.segments[0].name.split(":")[0] in ("transfer", "return", "feed")
 
 
