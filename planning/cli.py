@@ -273,21 +273,18 @@ def _laws(case, args) -> int:
     from planning.optimize import PlanningError
     from planning.outputs import write_json
     from planning.plots import laws_figure, save
-    from planning.report import TRAJECTORY_COLUMNS, sample_profile
+    from planning.report import TRAJECTORY_COLUMNS
 
     out = _output_folder(case, args)
     if isinstance(out, int):
         return out
     try:
-        data, solutions = compare_laws(case)
+        data, tables = compare_laws(case)
     except PlanningError as exc:
         return _fail(f"{args.case}: {exc}", EXIT_INFEASIBLE)
-    if not solutions:
+    if not tables:
         return _fail(f"{args.case}: no motion law gives a verified plan", EXIT_INFEASIBLE)
-    curves = {}
-    for law, sol in solutions.items():
-        table = sample_profile(sol.plan.profile, case.machine)
-        curves[law] = {name: table[:, i] for i, name in enumerate(TRAJECTORY_COLUMNS)}
+    curves = {law: dict(zip(TRAJECTORY_COLUMNS, table.T, strict=True)) for law, table in tables.items()}
     title = f"{case.name}: crank motion of each law ({data['placement']} placement)"
     writers = {
         "laws.json": lambda p: write_json(p, data),

@@ -75,21 +75,16 @@ class CycleParameters:
 
     def peak_accelerations(self) -> list[Any]:
         """Peak |crank acceleration| [rad/s^2] of each half, in :data:`HALVES` order."""
-        law = get_law(self.motion_law)
-        out = []
-        for name in HALVES:
-            D, dv = self.half(name)
-            out.append(law.peak_rate(self.law_parameter) * RISING[name] * dv / D)
-        return out
+        rate = get_law(self.motion_law).peak_rate(self.law_parameter)
+        return [rate * RISING[name] * dv / D for name, (D, dv) in self._halves()]
 
     def peak_jerks(self) -> list[Any]:
         """Peak |crank jerk| [rad/s^3] of each half, in :data:`HALVES` order."""
-        law = get_law(self.motion_law)
-        out = []
-        for name in HALVES:
-            D, dv = self.half(name)
-            out.append(law.peak_jerk(self.law_parameter) * RISING[name] * dv / D**2)
-        return out
+        jerk = get_law(self.motion_law).peak_jerk(self.law_parameter)
+        return [jerk * RISING[name] * dv / D**2 for name, (D, dv) in self._halves()]
+
+    def _halves(self) -> list[tuple[str, tuple[Any, Any]]]:
+        return [(name, self.half(name)) for name in HALVES]
 
     # improved S-curve only: the paper's jerks and sub-segment lengths (Eqs. 10, 13)
     @property

@@ -33,10 +33,10 @@ COLUMNS = (
 )
 
 
-def law_row(law: str, solution: Solution, case: Case, bound: Bound) -> dict[str, Any]:
-    """The figures of merit of one verified plan (engineering units in the keys)."""
+def law_row(law: str, solution: Solution, case: Case, bound: Bound, table: np.ndarray) -> dict[str, Any]:
+    """The figures of merit of one verified plan (engineering units in the keys); ``table``: its
+    trajectory from :func:`planning.report.sample_profile`."""
     plan = solution.plan
-    table = sample_profile(plan.profile, case.machine)
     t, om, al = table[:, 0], table[:, 2], table[:, 3]
     _, _, _, slider_jerk = case.machine.slider(np.radians(table[:, 1]), om * RPM, al, table[:, 4])
     sq = al**2
@@ -61,13 +61,14 @@ def law_row(law: str, solution: Solution, case: Case, bound: Bound) -> dict[str,
     }
 
 
-def compare_laws(case: Case, laws: tuple[str, ...] = tuple(LAWS)) -> tuple[dict[str, Any], dict[str, Solution]]:
-    """Solve ``case`` under each law; returns the comparison dictionary and the verified solutions.
+def compare_laws(case: Case, laws: tuple[str, ...] = tuple(LAWS)) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
+    """Solve ``case`` under each law; returns the comparison dictionary and, per law with a verified
+    plan, its trajectory (columns :data:`planning.report.TRAJECTORY_COLUMNS`).
 
     A law without a verified plan gets a row with ``status`` ``failed: <reason>`` and no numbers;
     the bound's failure raises :class:`PlanningError` (nothing to compare against)."""
     bound = time_optimal_bound(case)
-    rows, solutions = [], {}
+    rows, tables = [], {}
     for law in laws:
         variant = case.with_law(law)
         try:
@@ -75,15 +76,15 @@ def compare_laws(case: Case, laws: tuple[str, ...] = tuple(LAWS)) -> tuple[dict[
         except PlanningError as exc:
             rows.append({"law": law, "status": f"failed: {exc}", "continuity": LAWS[law].continuity})
             continue
-        solutions[law] = sol
-        rows.append(law_row(law, sol, variant, bound))
+        tables[law] = sample_profile(sol.plan.profile, variant.machine)
+        rows.append(law_row(law, sol, variant, bound, tables[law]))
     return {
         "case": case.name,
         "placement": case.planner.placement,
         "bound": bound.as_dict(),
         "jerk_limited_bound": case.limits.crank_jerk_rad_s3 is not None,
         "laws": rows,
-    }, solutions
+    }, tables
 
 
 def laws_markdown(data: dict[str, Any]) -> str:

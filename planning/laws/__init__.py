@@ -67,13 +67,9 @@ class MotionLaw:
 
     def shape(self, param: Any = None):
         """The normalised shape of a one-segment law (``planning.laws.shapes``)."""
-        if self.name == "quintic":
-            return Quintic()
-        if self.name == "cycloidal":
-            return Cycloidal()
-        if self.name == "logistic":
-            return Logistic(param)
-        raise ValueError(f"{self.name} is not a one-segment law")
+        if self.name not in SHAPES:
+            raise ValueError(f"{self.name} is not a one-segment law")
+        return SHAPES[self.name](param)
 
     def peak_rate(self, param: Any = None) -> Any:
         """Peak |acceleration| of a half in units of ``|dv| / D``."""
@@ -92,6 +88,11 @@ class MotionLaw:
         return self.shape(param).peak_jerk()
 
 
+SHAPES = {  # one-segment laws: shape from the law's parameter
+    "quintic": lambda _: Quintic(),
+    "cycloidal": lambda _: Cycloidal(),
+    "logistic": Logistic,
+}
 LAWS: dict[str, MotionLaw] = {
     law.name: law
     for law in (
