@@ -35,9 +35,9 @@ def timed(cmd: list[str]) -> float:
 def main() -> None:
     import casadi
 
-    from planning.case_file import read_case
-    from planning.nlp import _build
-    from planning.optimize import solve
+    from planning.model.case_file import read_case
+    from planning.solver.nlp import _build
+    from planning.solver.optimize import solve
 
     case = read_case(CASE)
     t = time.perf_counter()
@@ -122,10 +122,10 @@ def main() -> None:
 
 def _laws(case) -> list[dict]:
     """(c): every law's SPM, share of the bound, NLP build time and (warm) solve time."""
-    from planning.bound import time_optimal_bound
-    from planning.laws import LAWS
-    from planning.nlp import cycle_nlp
-    from planning.optimize import solve
+    from planning.model.laws import LAWS
+    from planning.solver.bound import time_optimal_bound
+    from planning.solver.nlp import cycle_nlp
+    from planning.solver.optimize import solve
 
     t = time.perf_counter()
     bound = time_optimal_bound(case)

@@ -13,7 +13,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import NoReturn
 
-from planning.laws import LAWS
+from planning.model.laws import LAWS
 
 EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = 0, 2, 3
 PLOT_FORMATS = ("png", "svg", "pdf")
@@ -91,27 +91,52 @@ def _whole(lo: int, hi: int):
     return parse
 
 
+class CommandError(Exception):
+    """A command that cannot go on: ``str()`` is its one-line message, ``code`` its exit status."""
+
+    def __init__(self, message: str, code: int = EXIT_INPUT):
+        super().__init__(message)
+        self.code = code
+
+
+def _exit_code(exc: Exception, case_path: str | None) -> tuple[str, int] | None:
+    """The one place where outcomes become exit statuses: ``(message, code)`` for a known error."""
+    from planning.model.case_file import CaseFileError
+    from planning.reports.folder import OutputError
+    from planning.solver.outcomes import PlanningError
+    from planning.sweep import SweepError
+
+    if isinstance(exc, CommandError):
+        return str(exc), exc.code
+    if isinstance(exc, (CaseFileError, OutputError, SweepError)):
+        return str(exc), EXIT_INPUT
+    if isinstance(exc, PlanningError):  # no feasible or no verified plan
+        return f"{case_path}: {exc}", EXIT_INFEASIBLE
+    return None
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     args = _parser().parse_args(argv)
-    if args.command == "plot":
-        return _plot(args)
-    from planning.case_file import CaseFileError, read_case
-
+    command = {
+        "check": _check,
+        "solve": _solve,
+        "compare": _compare,
+        "sweep": _sweep,
+        "bound": _bound,
+        "laws": _laws,
+        "plot": _plot,
+    }[args.command]
     try:
-        case = read_case(args.case)
-    except CaseFileError as exc:
-        return _fail(str(exc), EXIT_INPUT)
-    if args.command == "check":
-        return _check(case, args)
-    if args.command == "compare":
-        return _compare(case, args)
-    if args.command == "sweep":
-        return _sweep(case, args)
-    if args.command == "bound":
-        return _bound(case, args)
-    if args.command == "laws":
-        return _laws(case, args)
-    return _solve(case, args)
+        if args.command == "plot":
+            return command(args)
+        from planning.model.case_file import read_case
+
+        return command(read_case(args.case), args)
+    except Exception as exc:
+        known = _exit_code(exc, getattr(args, "case", None))
+        if known is None:
+            raise
+        return _fail(*known)
 
 
 def _fail(message: str, code: int) -> int:
@@ -120,42 +145,34 @@ def _fail(message: str, code: int) -> int:
 
 
 def _check(case, args) -> int:
-    from planning.check import check_case, check_text
+    from planning.reports.check import check_case, check_text
 
     report = check_case(case)
     print(json.dumps(report, indent=2) if args.json else check_text(report))
     return EXIT_OK if all(c["passed"] for c in report["checks"]) else EXIT_INFEASIBLE
 
 
-def _output_folder(case, args) -> Path | int:
-    """``--out`` or ``out/<case name>``, checked writable before any solving; an exit code if not."""
-    from planning.case import output_name
-    from planning.outputs import OutputError, ensure_writable
+def _output_folder(case, args) -> Path:
+    """``--out`` or ``out/<case name>``, checked writable before any solving."""
+    from planning.model.case import output_name
+    from planning.reports.folder import ensure_writable
 
     out = Path(args.out) if args.out else Path("out") / output_name(case)
-    try:
-        ensure_writable(out)
-    except OutputError as exc:
-        return _fail(str(exc), EXIT_INPUT)
+    ensure_writable(out)
     return out
 
 
 def _solve(case, args) -> int:
-    from planning.optimize import PlanningError, solve
-    from planning.outputs import solution_writers
-    from planning.report import result_dict, summary_text
+    from planning.reports.outputs import solution_writers
+    from planning.reports.report import result_dict, summary_text
+    from planning.solver.optimize import solve
 
     if args.law:
         case = case.with_law(args.law)
     out = _output_folder(case, args)
-    if isinstance(out, int):
-        return out
-    try:
-        solution = solve(case, args.placement)
-    except PlanningError as exc:
-        return _fail(f"{args.case}: {exc}", EXIT_INFEASIBLE)
+    solution = solve(case, args.placement)
     if not solution.verification.passed:  # solve() returns only verified plans; belt and braces
-        return _fail(f"{args.case}: unverified plan not written", EXIT_INFEASIBLE)
+        raise CommandError(f"{args.case}: unverified plan not written", EXIT_INFEASIBLE)
     plot_format = None if args.no_plots else args.format
     writers = solution_writers(solution, case, cam_points=args.cam_points, plot_format=plot_format)
     result = result_dict(solution, case)
@@ -163,22 +180,18 @@ def _solve(case, args) -> int:
 
 
 def _compare(case, args) -> int:
-    from planning.compare import comparison, comparison_markdown, comparison_text
-    from planning.optimize import PlanningError, solve
-    from planning.outputs import write_json
+    from planning.model.laws.improved_scurve import ImprovedSCurve
+    from planning.reports.compare import comparison, comparison_markdown, comparison_text
+    from planning.reports.folder import write_json
+    from planning.solver.optimize import solve
 
     if case.published is None or case.published.solution is None:
-        return _fail(f"{args.case}: published.solution: the case has no published solution to compare", EXIT_INPUT)
+        raise CommandError(f"{args.case}: published.solution: the case has no published solution to compare")
     # the paper's notation describes its own law: compare under the improved S-curve
-    case = case.with_law("improved-s-curve")
+    case = case.with_law(ImprovedSCurve.name)
     out = _output_folder(case, args)
-    if isinstance(out, int):
-        return out
-    try:
-        ours_published = solve(case, "published")
-        ours_free = solve(case, "free")
-    except PlanningError as exc:
-        return _fail(f"{args.case}: {exc}", EXIT_INFEASIBLE)
+    ours_published = solve(case, "published")
+    ours_free = solve(case, "free")
     data = comparison(case, ours_published, ours_free)
     writers = {
         "comparison.json": lambda p: write_json(p, data),
@@ -189,12 +202,9 @@ def _compare(case, args) -> int:
 
 def _write_and_report(out: Path, writers: dict, data: dict, text: str, as_json: bool) -> int:
     """Write the files all or nothing, then print ``data`` as JSON or ``text`` with the files written."""
-    from planning.outputs import OutputError, write_atomic
+    from planning.reports.folder import write_atomic
 
-    try:
-        files = write_atomic(out, writers)
-    except OutputError as exc:
-        return _fail(str(exc), EXIT_INPUT)
+    files = write_atomic(out, writers)
     if as_json:
         print(json.dumps(data, indent=2))
     else:
@@ -204,22 +214,16 @@ def _write_and_report(out: Path, writers: dict, data: dict, text: str, as_json: 
 
 
 def _sweep(case, args) -> int:
-    import planning.optimize  # noqa: F401 - loaded once here, inherited by forked workers
-    from planning.outputs import OutputError, ensure_writable
-    from planning.plots import save, sweep_figure
-    from planning.sweep import SweepError, parse_vary, run_sweep
+    import planning.solver.optimize  # noqa: F401 - loaded once here, inherited by forked workers
+    from planning.reports.folder import ensure_writable
+    from planning.reports.plots import save, sweep_figure
+    from planning.sweep import parse_vary, run_sweep
 
-    try:
-        varies = [parse_vary(v) for v in args.vary]
-    except SweepError as exc:
-        return _fail(str(exc), EXIT_INPUT)
+    varies = [parse_vary(v) for v in args.vary]
     if len({v.field for v in varies}) != len(varies):
-        return _fail("--vary: each field at most once", EXIT_INPUT)
+        raise CommandError("--vary: each field at most once")
     out = Path(args.out)
-    try:
-        ensure_writable(out)
-    except OutputError as exc:
-        return _fail(str(exc), EXIT_INPUT)
+    ensure_writable(out)
     base = (case.with_law(args.law) if args.law else case).model_dump(exclude_none=True)
     tty = sys.stderr.isatty()
 
@@ -228,10 +232,7 @@ def _sweep(case, args) -> int:
             bar = "#" * int(30 * done / total)
             print(f"\rsweep [{bar:<30}] {done}/{total} points, {failed} without a plan", end="", file=sys.stderr)
 
-    try:
-        result = run_sweep(base, args.case, varies, out, args.workers, args.scheduler, args.placement, progress)
-    except SweepError as exc:
-        return _fail(str(exc), EXIT_INPUT)
+    result = run_sweep(base, args.case, varies, out, args.workers, args.scheduler, args.placement, progress)
     if tty:
         print(file=sys.stderr)
     rows = result.rows
@@ -248,13 +249,9 @@ def _sweep(case, args) -> int:
 
 
 def _bound(case, args) -> int:
-    from planning.bound import time_optimal_bound
-    from planning.optimize import PlanningError
+    from planning.solver.bound import time_optimal_bound
 
-    try:
-        bound = time_optimal_bound(case, args.points)
-    except PlanningError as exc:
-        return _fail(f"{args.case}: {exc}", EXIT_INFEASIBLE)
+    bound = time_optimal_bound(case, args.points)
     data = {"case": case.name, **bound.as_dict()}
     if args.json:
         print(json.dumps(data, indent=2))
@@ -269,21 +266,15 @@ def _bound(case, args) -> int:
 
 
 def _laws(case, args) -> int:
-    from planning.law_comparison import compare_laws, laws_markdown, laws_text
-    from planning.optimize import PlanningError
-    from planning.outputs import write_json
-    from planning.plots import laws_figure, save
-    from planning.report import TRAJECTORY_COLUMNS
+    from planning.reports.folder import write_json
+    from planning.reports.law_comparison import compare_laws, laws_markdown, laws_text
+    from planning.reports.plots import laws_figure, save
+    from planning.reports.report import TRAJECTORY_COLUMNS
 
     out = _output_folder(case, args)
-    if isinstance(out, int):
-        return out
-    try:
-        data, tables = compare_laws(case)
-    except PlanningError as exc:
-        return _fail(f"{args.case}: {exc}", EXIT_INFEASIBLE)
+    data, tables = compare_laws(case)
     if not tables:
-        return _fail(f"{args.case}: no motion law gives a verified plan", EXIT_INFEASIBLE)
+        raise CommandError(f"{args.case}: no motion law gives a verified plan", EXIT_INFEASIBLE)
     curves = {law: dict(zip(TRAJECTORY_COLUMNS, table.T, strict=True)) for law, table in tables.items()}
     title = f"{case.name}: crank motion of each law ({data['placement']} placement)"
     writers = {
@@ -295,15 +286,13 @@ def _laws(case, args) -> int:
 
 
 def _plot(args) -> int:
-    from planning.outputs import OutputError, plot_writers, write_atomic
+    from planning.reports.folder import write_atomic
+    from planning.reports.outputs import plot_writers
 
     folder = Path(args.folder)
     if not (folder / "result.json").is_file():
-        return _fail(f"{folder}: no result.json here (run `pressplan solve` first)", EXIT_INPUT)
-    try:
-        files = write_atomic(folder, plot_writers(folder, args.format))
-    except OutputError as exc:
-        return _fail(str(exc), EXIT_INPUT)
+        raise CommandError(f"{folder}: no result.json here (run `pressplan solve` first)")
+    files = write_atomic(folder, plot_writers(folder, args.format))
     print(f"wrote {', '.join(str(f) for f in files)}")
     return EXIT_OK
 

@@ -1,7 +1,7 @@
 """Parameter sweeps: the full grid over dotted case fields, each point solved and verified.
 
 The grid is cut into contiguous blocks of at most :data:`BLOCK_POINTS` points. A block is solved in
-order, each point starting from its neighbour's plan (``solve(..., warm=..., follow=True)``); the first
+order, each point starting from its neighbour's plan (``solve(..., neighbour=..., follow=True)``); the first
 point of a block gets the full multi-start. The blocks go to local worker processes or to a Dask
 distributed cluster; the cut depends on the grid alone, so both give the same rows. Rows are appended
 to ``sweep.csv`` as blocks finish, so a sweep that is stopped resumes with the points it lacks. A
@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 from pydantic import BaseModel
 
-from planning.case import Case
+from planning.model.case import Case
 
 BLOCK_POINTS = 6
 ROW_FIELDS = ("spm", "cycle_time_s", "status", "binding", "solve_time_s", "message")
@@ -120,18 +120,19 @@ def solve_block(
     label: str,
 ) -> list[dict[str, Any]]:
     """Solve a block of grid points in order, each from its neighbour's plan; one row per point."""
-    from planning.case_file import CaseFileError, case_from_data
-    from planning.optimize import PlanningError, solve
+    from planning.model.case_file import CaseFileError, case_from_data
+    from planning.solver.optimize import solve
+    from planning.solver.outcomes import PlanningError
 
     rows = []
-    warm = None
+    previous = None  # the plan of the point before: the next point starts from it
     for index, values in points:
         row: dict[str, Any] = {"index": index, **dict(zip(fields, values, strict=True))}
         t = time.perf_counter()
         try:
             case = case_from_data(point_data(base, fields, values), f"{label}[{index}]")
-            sol = solve(case, placement, warm=warm, follow=warm is not None)
-            warm = sol.plan
+            sol = solve(case, placement, neighbour=previous, follow=previous is not None)
+            previous = sol.plan
             row.update(_solved_row(sol), plan=sol.plan)
         except CaseFileError as exc:
             row.update(status="bad input", message=str(exc))
@@ -145,7 +146,7 @@ def solve_block(
 
 
 def _solved_row(sol) -> dict[str, Any]:
-    from planning.report import binding
+    from planning.reports.report import binding
 
     return {
         "spm": sol.plan.spm,
@@ -186,9 +187,10 @@ def repair(
     answer here, so the point is never left worse than it. Passes alternate in direction until
     nothing changes. Returns how many re-solves improved a point.
     """
-    from planning.case_file import CaseFileError, case_from_data
-    from planning.optimize import PlanningError, solve
-    from planning.verify import verify
+    from planning.model.case_file import CaseFileError, case_from_data
+    from planning.solver.optimize import solve
+    from planning.solver.outcomes import PlanningError
+    from planning.solver.verify import verify
 
     improved = 0
     for k in range(passes):
@@ -207,7 +209,7 @@ def repair(
                 if not same or not verify(plan, case).passed:
                     continue
                 try:
-                    sol = solve(case, placement, warm=plan, follow=True)
+                    sol = solve(case, placement, neighbour=plan, follow=True)
                 except PlanningError:
                     continue
                 if current is None or sol.plan.spm > current + 1e-9:

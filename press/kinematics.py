@@ -30,21 +30,14 @@ from typing import Any, Literal
 
 import numpy as np
 
+from press.backend import math_module
+
 Model = Literal["exact", "series"]
-
-
-def _backend(x: Any) -> Any:
-    """The math module that fits ``x``: casadi for CasADi symbols, numpy otherwise."""
-    if type(x).__module__.startswith("casadi"):
-        import casadi
-
-        return casadi
-    return np
 
 
 def height(theta: Any, R: float, L: float, model: Model = "exact") -> Any:
     """Slider height above BDC [mm] at crank angle ``theta`` [rad]; ``R``, ``L`` [mm]."""
-    m = _backend(theta)
+    m = math_module(theta)
     if model == "series":
         return R * (1 + m.cos(theta)) + R**2 / (4 * L) * (1 - m.cos(2 * theta))  # Eq. 1, x = pi - theta
     s = m.sin(theta)
@@ -56,7 +49,7 @@ def height_derivatives(theta: Any, R: float, L: float, model: Model = "exact") -
 
     Returns ``(dh/dtheta [mm/rad], d2h/dtheta2 [mm/rad^2], d3h/dtheta3 [mm/rad^3])``.
     """
-    m = _backend(theta)
+    m = math_module(theta)
     s, c = m.sin(theta), m.cos(theta)
     s2, c2 = m.sin(2 * theta), m.cos(2 * theta)
     if model == "series":

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from planning.case_file import read_case
-from planning.optimize import solve
+from planning.model.case_file import read_case
+from planning.solver.optimize import solve
 
 ROOT = Path(__file__).resolve().parents[1]
 PUBLISHED_CASE = ROOT / "cases" / "wang2023-side-panel.yaml"

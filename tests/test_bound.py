@@ -6,8 +6,8 @@ import json
 
 import pytest
 
-from planning.bound import time_optimal_bound
 from planning.cli import main
+from planning.solver.bound import time_optimal_bound
 
 from .conftest import PUBLISHED_CASE
 
@@ -46,7 +46,7 @@ SERVO_CASE = PUBLISHED_CASE.parent / "side-panel-servo-limits.yaml"
 
 @pytest.fixture(scope="module")
 def servo_case():
-    from planning.case_file import read_case
+    from planning.model.case_file import read_case
 
     return read_case(SERVO_CASE)
 
@@ -64,7 +64,7 @@ def test_jerk_limited_bound_converges_and_tightens(servo_case):
 def test_laws_against_the_jerk_limited_bound(servo_case):
     """Issue 5: with a crank-jerk limit the best law reaches >= 95 % of the jerk-limited bound, and
     no law exceeds the bound."""
-    from planning.law_comparison import compare_laws
+    from planning.reports.law_comparison import compare_laws
 
     data, _ = compare_laws(servo_case)
     shares = [r["share_of_bound_pct"] for r in data["laws"] if r["status"] == "verified"]

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from planning.case_file import CaseFileError, read_case
 from planning.cli import main
+from planning.model.case_file import CaseFileError, read_case
 
 BAD = sorted((Path(__file__).parent / "data" / "bad").glob("*.yaml"))
 SPECIAL = {"empty.yaml": "empty", "binary.yaml": "binary"}

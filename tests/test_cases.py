@@ -6,9 +6,9 @@ from pathlib import Path
 
 import pytest
 
-from planning.case_file import read_case
-from planning.optimize import solve
-from planning.report import trajectory
+from planning.model.case_file import read_case
+from planning.reports.report import trajectory
+from planning.solver.optimize import solve
 
 CASES = sorted((Path(__file__).resolve().parents[1] / "cases").glob("*.yaml"))
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from planning.cli import main
-from planning.report import TRAJECTORY_COLUMNS
+from planning.reports.report import TRAJECTORY_COLUMNS
 
 from .conftest import PUBLISHED_CASE
 
@@ -144,11 +144,13 @@ def test_case_file_is_never_written(tmp_path):
 
 def test_solver_success_but_failed_verification_is_exit_3(monkeypatch, tmp_path, capsys):
     """No false successes: when every plan fails the dense check, nothing is written and exit is 3."""
-    import planning.optimize as optimize
-    from planning.verify import Check, Verification
+    import planning.solver.optimize as optimize
+    from planning.solver.verify import Check, CheckId, Verification
 
     def failing(plan, case):
-        return Verification((Check("|slider acceleration|", 9999.0, 3500.0, "mm/s^2", "max", False),), 1e-3, 10)
+        return Verification(
+            (Check("|slider acceleration|", 9999.0, 3500.0, "mm/s^2", "max", False, CheckId.SLIDER_ACCEL),), 1e-3, 10
+        )
 
     monkeypatch.setattr(optimize, "verify", failing)
     out = tmp_path / "o"
@@ -161,12 +163,11 @@ def test_solver_success_but_failed_verification_is_exit_3(monkeypatch, tmp_path,
 def test_last_iterate_names_the_violated_constraint():
     import numpy as np
 
-    from planning.nlp import cycle_nlp
-    from planning.optimize import _violation
+    from planning.solver.nlp import cycle_nlp
 
     nlp = cycle_nlp()
     lbg, ubg = nlp.bounds("free")
     g = np.where(np.isfinite(lbg), lbg, np.where(np.isfinite(ubg), ubg, 0.0))
     block = next(b for b in nlp.blocks if b.name == "transfer time")
     g[block.start] = -0.7  # 0.7 s short of the transfer time
-    assert _violation(nlp, "free", g) == ("transfer time", 0.7)
+    assert nlp.worst_violation("free", g) == ("transfer time", 0.7)

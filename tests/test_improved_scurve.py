@@ -7,8 +7,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from planning.laws import improved_scurve as sc
-from planning.profile import Profile
+from planning.model.laws import improved_scurve as sc
+from planning.model.profile import Profile
 
 
 def curve(v_s=1.0, J=30.0, T_a=0.1, T_d=0.13, T1=0.2, T10=0.3):

@@ -13,12 +13,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from planning.case_file import read_case
-from planning.laws import LAWS
-from planning.laws.shapes import Cycloidal, Logistic, Quintic
-from planning.optimize import solve
-from planning.profile import Profile, split_segment
-from planning.verify import max_abs_jerk
+from planning.model.case_file import read_case
+from planning.model.laws import LAWS
+from planning.model.laws.shapes import Cycloidal, Logistic, Quintic
+from planning.model.profile import Profile, split_segment
+from planning.solver.optimize import solve
+from planning.solver.verify import max_abs_jerk
 
 SHAPES = [Quintic(), Cycloidal(), Logistic(4.0), Logistic(5.0), Logistic(6.0), Logistic(2.0)]
 U = np.linspace(0.0, 1.0, 200_001)
@@ -104,7 +104,7 @@ def test_one_half_of_every_law(law, param):
 def test_stated_continuity(law):
     """A jerk-continuous law starts and ends its halves at zero jerk (it joins constant speed and the
     opposite half smoothly); an acceleration-continuous one has a jerk step somewhere."""
-    param = LAWS[law].parameter[3] if LAWS[law].parameter else None
+    param = LAWS[law].parameter.start if LAWS[law].parameter else None
     prof = half_profile(law, 1.0, 2.0, 0.4, param)
     t = prof.knot_times
     _, _, _, je = prof.at_time(np.concatenate([t[:-1], [t[-1] - 1e-12]]))
@@ -123,7 +123,7 @@ def test_stated_continuity(law):
 )
 def test_splitting_a_half_keeps_its_motion(law, cut):
     """A half cut in two (as at TDC) moves exactly as the whole."""
-    param = LAWS[law].parameter[3] if LAWS[law].parameter else None
+    param = LAWS[law].parameter.start if LAWS[law].parameter else None
     whole = half_profile(law, 0.8, 1.7, 0.5, param)
     segs = []
     for seg in whole.segments:

@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from planning.bound import time_optimal_bound
-from planning.case_file import read_case
-from planning.optimize import solve
+from planning.model.case_file import read_case
+from planning.solver.bound import time_optimal_bound
+from planning.solver.optimize import solve
 
 CASE = Path(__file__).resolve().parents[1] / "cases" / "side-panel-servo-limits.yaml"
 

@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from planning.cam_table import CAM_COLUMNS
 from planning.cli import main
-from planning.plots import read_table
+from planning.reports.cam_table import CAM_COLUMNS
+from planning.reports.plots import read_table
 
 from .conftest import PUBLISHED_CASE
 

@@ -13,10 +13,11 @@ import pytest
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
-from planning.case_file import CaseFileError, case_from_data
-from planning.optimize import PlanningError, solve
-from planning.outputs import solution_writers
-from planning.report import result_dict, trajectory
+from planning.model.case_file import CaseFileError, case_from_data
+from planning.reports.outputs import solution_writers
+from planning.reports.report import result_dict, trajectory
+from planning.solver.optimize import solve
+from planning.solver.outcomes import PlanningError
 
 from .random_cases import CASES, CASES_DRAW_SPEED_FREE, CASES_DRAW_SPEED_GIVEN, seeded_case
 
@@ -117,7 +118,7 @@ def test_relaxing_a_limit_never_costs_strokes(data, relax):
         relaxed["limits"]["min_crank_speed_rpm"] = 0.5
     if "draw_speed_rpm" not in relaxed["process"]:  # keep the draw speed the first plan used
         relaxed["process"]["draw_speed_rpm"] = float(base.plan.parameters.draw_speed) * 60 / (2 * math.pi)
-    better = solve(case_from_data(relaxed), warm=base.plan)
+    better = solve(case_from_data(relaxed), neighbour=base.plan)
     assert better.plan.spm >= base.plan.spm - 1e-9
 
 

@@ -8,10 +8,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from planning.case import RPM
-from planning.plan import Plan, profile_from_tdc
-from planning.report import trajectory
-from planning.verify import verify
+from planning.model.case import RPM
+from planning.model.plan import Plan, profile_from_tdc
+from planning.reports.report import trajectory
+from planning.solver.verify import verify
 
 # The paper's worked case reaches "11.7 strokes/min" (one decimal): the published placement must land
 # within 11.6-11.8 (issue 3). Free placement: at least 12.06, the level of a 12.12 plan found earlier.

@@ -12,8 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from planning.case_file import read_case
 from planning.cli import main
+from planning.model.case_file import read_case
 from planning.sweep import SweepError, Vary, grid, neighbours, parse_vary, run_sweep
 
 from .conftest import PUBLISHED_CASE

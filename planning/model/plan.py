@@ -7,9 +7,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from planning.cycle import CycleParameters, cycle_segments
-from planning.laws import improved_scurve as sc
-from planning.profile import Profile, advance_segment, knot_states, split_segment
+from planning.model.case import Placement
+from planning.model.cycle import CycleParameters, cycle_segments
+from planning.model.laws import DEFAULT_LAW
+from planning.model.laws import improved_scurve as sc
+from planning.model.profile import Profile, advance_segment, knot_states, split_segment
 
 
 @dataclass(frozen=True)
@@ -34,9 +36,9 @@ class Plan:
     parameters: CycleParameters
     profile: Profile
     key_angles: tuple[float, float, float, float]
-    placement: str
+    placement: Placement
     solver: SolverInfo
-    motion_law: str = "improved-s-curve"
+    motion_law: str = DEFAULT_LAW
     structure: dict[str, str] = field(default_factory=dict)
     nlp_values: dict[str, float] = field(default_factory=dict, repr=False)  # the NLP variables (warm starts)
 
@@ -76,7 +78,7 @@ class Plan:
         J [rpm/s^2] the feed jerk (the return jerk is reported separately as ``J_return``).
         """
         p = self.parameters
-        if self.motion_law != "improved-s-curve":
+        if self.motion_law != sc.ImprovedSCurve.name:
             raise ValueError("the paper's notation describes improved-s-curve plans only")
         n = sc.SUBSEGMENTS
         tk = self.profile.knot_times

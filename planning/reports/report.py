@@ -1,6 +1,6 @@
 """Plain-data views of a solved plan: the result dictionary, the dense trajectory, the summary text.
 
-Every output file is a function of a :class:`~planning.optimize.Solution` and its case; nothing here
+Every output file is a function of a :class:`~planning.solver.optimize.Solution` and its case; nothing here
 solves or verifies again.
 """
 
@@ -11,11 +11,12 @@ from typing import Any
 
 import numpy as np
 
-from planning.case import KEY_POINT_NAMES, RPM, Case
-from planning.cycle import HALVES
-from planning.optimize import Solution
-from planning.profile import Profile
-from planning.verify import MAX_STEP_S
+from planning.model.case import KEY_POINT_NAMES, RPM, Case
+from planning.model.cycle import HALVES
+from planning.model.laws.improved_scurve import ImprovedSCurve
+from planning.model.profile import Profile
+from planning.solver.optimize import Solution
+from planning.solver.verify import MAX_STEP_S
 from press.kinematics import CrankSlider
 
 TRAJECTORY_COLUMNS = (
@@ -133,7 +134,7 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
         "limits": case.limits.model_dump(),
         "key_points": key_points(solution, case),
         "segments": segments(solution),
-        "paper_solution": plan.paper_solution() if plan.motion_law == "improved-s-curve" else None,
+        "paper_solution": plan.paper_solution() if plan.motion_law == ImprovedSCurve.name else None,
         "verification": {
             "passed": ver.passed,
             "step_s": ver.step_s,

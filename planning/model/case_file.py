@@ -1,4 +1,4 @@
-"""Reading a case file (YAML) into a validated :class:`~planning.case.Case` (the only case I/O)."""
+"""Reading a case file (YAML) into a validated :class:`~planning.model.case.Case` (the only case I/O)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from typing import Any
 import yaml
 from pydantic import BaseModel, ValidationError
 
-from planning.case import Case, CaseError, cross_checks
+from planning.model.case import Case, CaseError, cross_checks, show_value
 
 MAX_BYTES = 1_000_000
 
@@ -94,12 +94,7 @@ def _pydantic_line(exc: ValidationError, data: Any, label: str) -> str:
         return f"{label}: {field}: missing required field"
     msg = err["msg"]
     msg = msg[0].lower() + msg[1:] if msg else kind
-    return f"{label}: {field}: {msg} (got {_show(value)})"
-
-
-def _show(value: Any) -> str:
-    text = repr(value) if isinstance(value, str) else str(value)
-    return text if len(text) <= 60 else text[:57] + "..."
+    return f"{label}: {field}: {msg} (got {show_value(value)})"
 
 
 def _fields_at(model: type[BaseModel], path: list[str]) -> list[str]:

@@ -8,7 +8,7 @@ Stages, in the order the optimizer lays them out (time 0 at the end of the draw,
     feed     w1 -> wm1 -> w2: accel half (D_fa), decel half (D_fd), ends at theta2
     draw     constant w2 from theta2 to theta3, duration (theta3 - theta2) / w2
 
-Each half follows the motion law (``planning.laws``). The cycle closes after exactly 2 pi when the
+Each half follows the motion law (``planning.model.laws``). The cycle closes after exactly 2 pi when the
 angle of every stage adds up (a constraint of the NLP). Time in the written plan starts at TDC, as
 in the paper's Figs. 7-9.
 """
@@ -18,9 +18,9 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from planning.laws import get_law
-from planning.laws import improved_scurve as sc
-from planning.profile import Segment
+from planning.model.laws import DEFAULT_LAW, get_law
+from planning.model.laws import improved_scurve as sc
+from planning.model.profile import Segment
 
 STAGES = ("return", "transfer", "feed", "draw")
 HALVES = ("feed_accel", "feed_decel", "return_accel", "return_decel")
@@ -49,7 +49,7 @@ class CycleParameters:
     law_parameter: Any
     draw_start: Any
     draw_end: Any
-    motion_law: str = "improved-s-curve"
+    motion_law: str = DEFAULT_LAW
 
     def as_dict(self) -> dict[str, Any]:
         """Field name -> value."""

@@ -21,9 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planning.case import RPM, Case, PublishedSolution
-from planning.laws import improved_scurve as sc
-from planning.profile import Profile, Segment
+from planning.model.case import RPM, Case, PublishedSolution
+from planning.model.laws import improved_scurve as sc
+from planning.model.profile import Profile, Segment
 
 
 def half_unit(value: float) -> float:

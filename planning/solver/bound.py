@@ -35,10 +35,13 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from planning.case import RPM, Case
-from planning.optimize import PlanningError, precheck
+from planning.model.case import RPM, Case
+from planning.solver.ipopt import NLPSolver
+from planning.solver.optimize import precheck
+from planning.solver.outcomes import Infeasible, NoPlanFound
 
 DEFAULT_POINTS = 1440
+BOUND_OPTIONS = {"ipopt.max_iter": 3000}  # added to the wrapper's base options
 
 
 @dataclass(frozen=True)
@@ -83,7 +86,8 @@ def angle_grid(case: Case, points: int) -> np.ndarray:
 
 
 def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
-    """The bound for ``case`` on a grid of about ``points`` intervals; :class:`PlanningError` if none."""
+    """The bound for ``case`` on a grid of about ``points`` intervals; raises a
+    :class:`~planning.solver.outcomes.PlanningError` if there is none."""
     t_start = time.perf_counter()
     w2_lo, w2_hi = precheck(case)
     th = angle_grid(case, points)
@@ -132,24 +136,20 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
     low = (h[:-1] <= lim.die_height_mm) & (np.abs(d1[:-1]) > 0)
     ubx_s[low] = np.minimum(ubx_s[low], (lim.die_speed_mm_s / np.abs(d1[:-1][low])) ** 2)
     if np.any(ubx_s < lbx_s):
-        raise PlanningError("infeasible", "the die-height speed limit leaves no crank speed above the minimum")
+        raise Infeasible(
+            "the die-height speed limit leaves no crank speed above the minimum", limit="limits.die_speed_mm_s"
+        )
     x = ca.vertcat(s, tau)
     nlp = {"x": x, "f": ca.sum1(tau), "g": ca.vertcat(*g)}
-    opts = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.tol": 1e-10, "ipopt.max_iter": 3000}
-    solver = ca.nlpsol("bound", "ipopt", nlp, opts)
+    solver = NLPSolver("bound", nlp, BOUND_OPTIONS)
     s0 = np.clip(np.full(n, (0.5 * (w2_lo + w2_hi)) ** 2), lbx_s, np.where(np.isfinite(ubx_s), ubx_s, np.inf))
     x0 = np.concatenate([s0, 2 * dth / (2 * np.sqrt(s0))])
-    res = solver(
-        x0=x0,
-        lbx=np.concatenate([lbx_s, np.zeros(n)]),
-        ubx=np.concatenate([ubx_s, np.full(n, np.inf)]),
-        lbg=np.concatenate(lbg),
-        ubg=np.concatenate(ubg),
-    )
-    status = solver.stats()["return_status"]
-    if status not in ("Solve_Succeeded", "Solved_To_Acceptable_Level"):
-        raise PlanningError("infeasible", f"the time-optimal bound did not converge ({status})")
-    xs = np.array(res["x"]).ravel()
+    lbx = np.concatenate([lbx_s, np.zeros(n)])
+    ubx = np.concatenate([ubx_s, np.full(n, np.inf)])
+    res = solver.solve(x0, lbx, ubx, np.concatenate(lbg), np.concatenate(ubg))
+    if not res.success:
+        raise NoPlanFound(f"the time-optimal bound did not converge ({res.return_status})")
+    xs = res.x
     s_opt, tau_opt = np.maximum(xs[:n], 0.0), xs[n:]
     s_next_opt = np.roll(s_opt, -1)
     motion = 2 * dth / (np.sqrt(s_opt) + np.sqrt(s_next_opt))

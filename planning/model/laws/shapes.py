@@ -16,18 +16,10 @@ numpy arrays and CasADi symbols (the parameter of a shape may be a CasADi symbol
 from __future__ import annotations
 
 import math
-import sys
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-
-
-def _lib(*values: Any):
-    """``casadi`` when any value is symbolic, else ``numpy`` (elementwise exp, sin, cos, log). CasADi is
-    not imported here: a symbolic value means it already is."""
-    ca = sys.modules.get("casadi")
-    return ca if ca is not None and any(isinstance(v, (ca.SX, ca.MX)) for v in values) else np
+from press.backend import math_module
 
 
 @dataclass(frozen=True)
@@ -68,7 +60,7 @@ class Cycloidal:
     continuity: str = "jerk"
 
     def terms(self, u: Any) -> tuple[Any, Any, Any, Any]:
-        m = _lib(u)
+        m = math_module(u)
         w = 2 * math.pi
         s = u - m.sin(w * u) / w
         S = u**2 / 2 - (1 - m.cos(w * u)) / w**2
@@ -102,7 +94,7 @@ class Logistic:
     continuity: str = "acceleration"
 
     def _g(self, z: Any) -> Any:
-        return 1 / (1 + _lib(z).exp(-z))
+        return 1 / (1 + math_module(z).exp(-z))
 
     def _norm(self) -> tuple[Any, Any, Any]:
         a = self.flexible
@@ -112,7 +104,7 @@ class Logistic:
 
     def terms(self, u: Any) -> tuple[Any, Any, Any, Any]:
         a = self.flexible
-        m = _lib(u, a)
+        m = math_module(u, a)
         g0, c, N = self._norm()
         z = a * (2 * u - 1)
         g = self._g(z)

@@ -24,7 +24,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from planning.profile import Segment
+from planning.model.laws.base import MotionLaw
+from planning.model.profile import Segment
 
 SPEED_GAIN = 11.0 / 3.0  # Eq. 13: v_max - v_s = 11/3 J T_a^2
 ANGLE_GAIN = 22.0 / 3.0  # angle of a half beyond the start speed: 22/3 J T^3
@@ -95,3 +96,23 @@ def subsegment_time(dv: Any, a_max: Any) -> Any:
 def constant_time(T_f: Any, a_max: Any, a_min: Any, T_a: Any) -> Any:
     """Eq. 18: length [s] of each constant segment when both are equal and the total is ``T_f`` [s]."""
     return T_f / 2.0 - 2.0 * (a_max - a_min) * T_a / a_max
+
+
+class ImprovedSCurve(MotionLaw):
+    """The improved S-curve as a motion law: a half is four sub-segments of ``D / 4`` (Eq. 10) whose
+    jerk makes the speed change (Eq. 13); both halves of an S-curve share one jerk (Eq. 14)."""
+
+    name = "improved-s-curve"
+    continuity = "acceleration"
+    source = "paper 003, Eqs. 10-21"
+    one_jerk_per_curve = True
+
+    def half(self, prefix: str, duration: Any, dv: Any, param: Any = None) -> list[Segment]:
+        T = duration / SUBSEGMENTS
+        return accel_half(T, dv / (SPEED_GAIN * T**2), prefix)
+
+    def peak_rate(self, param: Any = None) -> Any:
+        return PEAK_ACCEL * SUBSEGMENTS / SPEED_GAIN  # Eq. 21 with J from Eq. 13: 18/11
+
+    def peak_jerk(self, param: Any = None) -> Any:
+        return SUBSEGMENTS**2 / SPEED_GAIN  # J = dv / (11/3 (D/4)^2)

@@ -2,7 +2,7 @@
 
 Each law is solved and verified like ``pressplan solve`` (the case's placement); the figures of merit
 come from the verified plan's dense trajectory (uniform grid of at most 1 ms from TDC), except the
-peak crank jerk, which is the closed-form peak of the law (``planning.verify``). The bound is the
+peak crank jerk, which is the closed-form peak of the law (``planning.solver.verify``). The bound is the
 case's time-optimal bound (with the crank-jerk limit when the case sets one).
 """
 
@@ -13,12 +13,13 @@ from typing import Any
 
 import numpy as np
 
-from planning.bound import Bound, time_optimal_bound
-from planning.case import RPM, Case
-from planning.laws import LAWS
-from planning.optimize import PlanningError, Solution, solve
-from planning.report import binding, sample_profile
-from planning.verify import max_abs_jerk
+from planning.model.case import RPM, Case
+from planning.model.laws import LAWS
+from planning.reports.report import binding, sample_profile
+from planning.solver.bound import Bound, time_optimal_bound
+from planning.solver.optimize import Solution, solve
+from planning.solver.outcomes import PlanningError
+from planning.solver.verify import max_abs_jerk
 
 COLUMNS = (
     ("law", "law", ""),
@@ -35,7 +36,7 @@ COLUMNS = (
 
 def law_row(law: str, solution: Solution, case: Case, bound: Bound, table: np.ndarray) -> dict[str, Any]:
     """The figures of merit of one verified plan (engineering units in the keys); ``table``: its
-    trajectory from :func:`planning.report.sample_profile`."""
+    trajectory from :func:`planning.reports.report.sample_profile`."""
     plan = solution.plan
     t, om, al = table[:, 0], table[:, 2], table[:, 3]
     _, _, _, slider_jerk = case.machine.slider(np.radians(table[:, 1]), om * RPM, al, table[:, 4])
@@ -54,7 +55,7 @@ def law_row(law: str, solution: Solution, case: Case, bound: Bound, table: np.nd
         "rms_crank_accel_rad_s2": float(math.sqrt(mean_sq)),
         "continuity": LAWS[law].continuity,
         "law_parameter": float(plan.parameters.law_parameter) if LAWS[law].parameter else None,
-        "law_parameter_name": LAWS[law].parameter[0] if LAWS[law].parameter else None,
+        "law_parameter_name": LAWS[law].parameter.name if LAWS[law].parameter else None,
         "placement": plan.placement,
         "structure": plan.structure,
         "binding_constraints": binding(solution),
@@ -63,7 +64,7 @@ def law_row(law: str, solution: Solution, case: Case, bound: Bound, table: np.nd
 
 def compare_laws(case: Case, laws: tuple[str, ...] = tuple(LAWS)) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     """Solve ``case`` under each law; returns the comparison dictionary and, per law with a verified
-    plan, its trajectory (columns :data:`planning.report.TRAJECTORY_COLUMNS`).
+    plan, its trajectory (columns :data:`planning.reports.report.TRAJECTORY_COLUMNS`).
 
     A law without a verified plan gets a row with ``status`` ``failed: <reason>`` and no numbers;
     the bound's failure raises :class:`PlanningError` (nothing to compare against)."""

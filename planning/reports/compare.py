@@ -1,5 +1,5 @@
 """``pressplan compare``: the published solution beside ours, quantity by quantity, and the
-published numbers checked against each other (``planning.published``)."""
+published numbers checked against each other (``planning.reports.source_solution``)."""
 
 from __future__ import annotations
 
@@ -8,10 +8,10 @@ from typing import Any
 
 import numpy as np
 
-from planning.case import KEY_POINT_NAMES, Case, PublishedSolution
-from planning.optimize import Solution
-from planning.published import consistency, rebuild_profile, transfer_speed_rpm
-from planning.report import key_points
+from planning.model.case import KEY_POINT_NAMES, Case, PublishedSolution
+from planning.reports.report import key_points
+from planning.reports.source_solution import consistency, rebuild_profile, transfer_speed_rpm
+from planning.solver.optimize import Solution
 
 SYMBOLS = {
     "x1_s": ("x1", "s", "start of the feed acceleration"),

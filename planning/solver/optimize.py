@@ -12,35 +12,34 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, replace
-from typing import Literal
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from planning.case import RPM, Case, draw_speed_bounds
-from planning.cycle import HALVES
-from planning.laws import get_law
-from planning.laws import improved_scurve as sc
-from planning.nlp import PARAMETER_INDEX, PARAMETERS, VARIABLE_INDEX, VARIABLES, CycleNLP, cycle_nlp
-from planning.plan import Plan, SolverInfo, params_from_numbers, profile_from_tdc
-from planning.verify import ACCEL_CHECK, Verification, verify
+from planning.model.case import RPM, Case, Placement, draw_speed_bounds
+from planning.model.cycle import HALVES
+from planning.model.laws import get_law
+from planning.model.laws import improved_scurve as sc
+from planning.model.plan import Plan, SolverInfo, params_from_numbers, profile_from_tdc
+from planning.solver.nlp import (
+    PARAMETER_INDEX,
+    PARAMETERS,
+    VARIABLE_INDEX,
+    VARIABLES,
+    CycleNLP,
+    cycle_nlp,
+    values_of,
+    variable_scales,
+)
+from planning.solver.outcomes import Attempt, Infeasible, NoPlanFound, Unverified
+from planning.solver.verify import CheckId, Verification, verify
 
-Placement = Literal["free", "published"]
 ACCEL_BACKOFF = 5e-4  # the NLP keeps |slider acceleration| <= (1 - backoff) * limit at its samples
 MIN_HALF_S = 4e-3  # [s] lower bound on the duration of a half (1 ms per improved-S-curve sub-segment)
 MAX_TIME_S = 600.0  # [s] upper bound on any time variable
 REFINEMENTS = 3  # re-solves with a lowered sampled acceleration limit
 NO_LIMIT = 1e9  # stands for an absent motor limit in the NLP's parameters
 AGREE_S = 1e-6  # [s] two starts whose best periods agree this closely have found the same optimum
-
-
-class PlanningError(Exception):
-    """No verified plan. ``kind`` is ``infeasible`` (limits cannot be met) or ``unverified``."""
-
-    def __init__(self, kind: str, reason: str):
-        self.kind = kind
-        self.reason = reason
-        super().__init__(f"{kind}: {reason}")
 
 
 @dataclass(frozen=True)
@@ -54,37 +53,43 @@ class Solution:
 def precheck(case: Case) -> tuple[float, float]:
     """Cheap necessary conditions before any NLP; returns the draw-speed bounds ``(lo, hi)`` [rad/s].
 
-    Raises :class:`PlanningError` (infeasible) naming the limit that makes the case impossible.
+    Raises :class:`Infeasible` naming the limit that makes the case impossible.
     """
     bounds = draw_speed_bounds(case)
     w_min = case.limits.min_crank_speed_rpm * RPM
     th1, _, _, th4 = case.key_angles
     window = th1 + 2 * math.pi - th4
     if window / w_min < case.process.transfer_time_s:
-        raise PlanningError(
-            "infeasible",
+        raise Infeasible(
             f"transfer_time_s = {case.process.transfer_time_s:g} cannot be met: at min_crank_speed_rpm = "
             f"{case.limits.min_crank_speed_rpm:g} the crank crosses the {math.degrees(window):.1f} deg from "
             f"theta4 to theta1 in at most {window / w_min:.3f} s",
+            limit="process.transfer_time_s",
+            value=case.process.transfer_time_s,
+            needed=window / w_min,
         )
     w_given = case.process.draw_speed_rpm
     if w_given is not None:
         w2 = w_given * RPM
         if w2 > bounds["slider_accel"] * (1 + 1e-12):
             a_draw = case.limits.slider_accel_mm_s2 * (w2 / bounds["slider_accel"]) ** 2
-            raise PlanningError(
-                "infeasible",
+            raise Infeasible(
                 f"at the draw speed {w_given:g} rpm the slider acceleration in the draw reaches "
                 f"{a_draw:.0f} mm/s^2 > slider_accel_mm_s2 = {case.limits.slider_accel_mm_s2:g}",
+                limit="limits.slider_accel_mm_s2",
+                value=case.limits.slider_accel_mm_s2,
+                needed=a_draw,
             )
         return w2, w2
     hi = min(bounds.values())
     if hi < w_min:
         name = min(bounds, key=bounds.get)
-        raise PlanningError(
-            "infeasible",
+        raise Infeasible(
             f"the {name.replace('_', ' ')} limit allows a draw speed of at most {hi / RPM:.3f} rpm, "
             f"below min_crank_speed_rpm = {case.limits.min_crank_speed_rpm:g}",
+            limit="limits.min_crank_speed_rpm",
+            value=case.limits.min_crank_speed_rpm,
+            needed=hi / RPM,
         )
     return w_min, hi
 
@@ -152,7 +157,7 @@ def _guess(case: Case, w2: float, w1: float, peak_share: float, inside: float) -
         "return_accel_duration": D_ra,
         "return_decel_duration": D_rd,
         "transfer_dwell": T_c,
-        "law_parameter": law.parameter[3] if law.parameter else 0.0,
+        "law_parameter": law.parameter.start if law.parameter else 0.0,
         "closing_time": t1,
         "opening_time": t4,
         "die_down_time": 0.5 * (t1 + t_feed_end),
@@ -178,55 +183,11 @@ def _bounds(case: Case, w2_lo: float, w2_hi: float, p: np.ndarray) -> tuple[np.n
     elif fixed is not None:
         lo[i["law_parameter"]] = hi[i["law_parameter"]] = fixed
     else:
-        lo[i["law_parameter"]], hi[i["law_parameter"]] = law.parameter[1:3]
+        lo[i["law_parameter"]], hi[i["law_parameter"]] = law.parameter.low, law.parameter.high
     for k in ("die_down", "die_up"):
         if p[PARAMETER_INDEX[f"{k}_active"]] == 0.0:
             lo[i[f"{k}_time"]] = hi[i[f"{k}_time"]] = 0.0
     return lo, hi
-
-
-def scales_for(case: Case) -> np.ndarray:
-    """Variable scales from the press's own characteristic time ``T* = sqrt(R / A)`` [s] and speed
-    ``W* = sqrt(A / (R + R^2/L))`` [rad/s] (A the slider-acceleration limit): speeds ~ W*,
-    durations of the halves ~ T*, stage times ~ 10 T*. The factors make the variables O(1) for a
-    press cycle of the usual proportions; they span orders of magnitude from a small fast press to a
-    heavy slow one."""
-    R, L, A = case.press.crank_radius_mm, case.press.rod_length_mm, case.limits.slider_accel_mm_s2
-    t_star = math.sqrt(R / A)
-    w_star = math.sqrt(A / (R + R**2 / L))
-    unit = {"speed": 0.42 * w_star, "half": 1.12 * t_star, "time": 2.8 * t_star, "shape": 1.0}
-    kinds = {f"{k}_duration": "half" for k in HALVES}
-    kinds.update({f"{k}_speed": "speed" for k in ("transfer", "draw", "feed_peak", "return_peak")})
-    kinds["law_parameter"] = "shape"
-    return np.array([unit[kinds.get(k, "time")] for k, _ in VARIABLES])
-
-
-def _run(
-    nlp: CycleNLP,
-    placement: Placement,
-    x0: dict[str, float],
-    p: np.ndarray,
-    lbx: np.ndarray,
-    ubx: np.ndarray,
-    multipliers: tuple[np.ndarray, np.ndarray] | None = None,
-):
-    """One IPOPT solve; ``p`` = case parameters + variable scales, ``lbx``/``ubx`` physical bounds.
-    With ``multipliers`` (of a nearby solve) the warm-start solver is used. Returns the values, the
-    constraint values, IPOPT's statistics and the multipliers."""
-    scales = p[len(PARAMETERS) :]
-    x0v = np.clip(np.array([x0[k] for k, _ in VARIABLES]), lbx, ubx) / scales
-    lbg, ubg = nlp.bounds(placement)
-    args = {"x0": x0v, "p": p, "lbx": lbx / scales, "ubx": ubx / scales, "lbg": lbg, "ubg": ubg}
-    solver = nlp.solver
-    if multipliers is not None:
-        solver = nlp.warm_solver()
-        args.update(lam_x0=multipliers[0], lam_g0=multipliers[1])
-    res = solver(**args)
-    stats = solver.stats()
-    x = np.clip(np.array(res["x"]).ravel() * scales, lbx, ubx)  # IPOPT relaxes bounds by ~1e-8
-    g = np.array(res["g"]).ravel()
-    lam = (np.array(res["lam_x"]).ravel(), np.array(res["lam_g"]).ravel())
-    return {k: float(x[j]) for j, (k, _) in enumerate(VARIABLES)}, g, stats, lam
 
 
 def _plan(case: Case, values: dict[str, float], placement: Placement, info: SolverInfo) -> Plan:
@@ -250,72 +211,56 @@ def _fits(plan: Plan, case: Case, placement: Placement, w2_lo: float, w2_hi: flo
     return bool(same_angles and same_law and fits_placement and w2_lo - 1e-12 <= w2 <= w2_hi + 1e-12)
 
 
-def _violation(nlp: CycleNLP, placement: Placement, g: np.ndarray) -> tuple[str, float]:
-    """The constraint block with the largest violation at the last iterate."""
-    lbg, ubg = nlp.bounds(placement)
-    viol = np.maximum(lbg - g, 0) + np.maximum(g - ubg, 0)
-    worst = max(nlp.blocks, key=lambda b: float(np.max(viol[b.start : b.stop], initial=0.0)))
-    return worst.name, float(np.max(viol[worst.start : worst.stop], initial=0.0))
+@dataclass
+class _Search:
+    """The state of one :func:`solve`: the case and its compiled NLP, the variable bounds and scales,
+    the best verified plan so far, and the totals the answer reports."""
 
-
-def solve(case: Case, placement: Placement | None = None, warm: Plan | None = None, follow: bool = False) -> Solution:
-    """The fastest verified cycle for ``case``; raises :class:`PlanningError` when there is none.
-
-    ``warm``: a plan of a neighbouring case (a sweep, a relaxed limit). It is verified against this
-    case as it stands (when its placement fits and its key angles and draw speed are this case's) and
-    its NLP values start the multi-start, so the answer is never worse than ``warm`` where ``warm``
-    is feasible here. ``follow``: with a fitting ``warm`` plan, solve from it alone and return what
-    that start finds when it verifies (a sweep following its neighbours); otherwise the full
-    multi-start runs.
-    """
-    placement = placement or case.planner.placement
-    t_start = time.perf_counter()
-    w2_lo, w2_hi = precheck(case)
-    p = nlp_parameters(case)
-    w2 = w2_hi
-    th1, _, _, th4 = case.key_angles
-    w_min = case.limits.min_crank_speed_rpm * RPM
-    w_transfer = max((th1 + 2 * math.pi - th4) / case.process.transfer_time_s, 1.5 * w_min)
-
+    case: Case
+    placement: Placement
+    nlp: CycleNLP
+    parameters: np.ndarray  # of the case, :data:`PARAMETERS` order
+    lbx: np.ndarray
+    ubx: np.ndarray
+    scale: np.ndarray
+    draw_speed_range: tuple[float, float]  # [rad/s]
+    t_start: float
     best: Solution | None = None
-    failures: list[str] = []
-    iterations = 0
-    starts = 0
+    attempts: list[Attempt] = field(default_factory=list)
+    iterations: int = 0
+    starts: int = 0
 
-    def attempt(x0: dict[str, float], as_placement: Placement) -> tuple[dict[str, float], float] | None:
+    def attempt(self, x0: dict[str, float], placement: Placement) -> tuple[dict[str, float], float] | None:
         """Solve from ``x0``; if only the dense slider-acceleration check fails, lower the NLP's
         sampled limit by the measured overshoot and re-solve warm (at most ``REFINEMENTS`` times).
         Returns the verified values and period, or None."""
-        nonlocal best, iterations, starts
-        q = p.copy()
+        q = self.parameters.copy()
         values = x0
-        lam = None
-        starts += 1
+        multipliers = None
+        self.starts += 1
         for _ in range(REFINEMENTS + 1):
-            values, g, stats, lam = _run(nlp, as_placement, values, q, lbx, ubx, lam)
-            iterations += int(stats["iter_count"])
-            status = str(stats["return_status"])
-            if status not in ("Solve_Succeeded", "Solved_To_Acceptable_Level"):
-                name, amount = _violation(nlp, as_placement, g)
-                failures.append(f"solver stopped ({status}); worst constraint: {name} (violated by {amount:.3g})")
+            res = self.nlp.solve(values, q, self.lbx, self.ubx, placement, self.scale, multipliers)
+            values, multipliers = values_of(res), res.multipliers
+            self.iterations += res.iterations
+            if not res.success:
+                block, amount = self.nlp.worst_violation(placement, res.g)
+                self.attempts.append(Attempt(solver_status=res.return_status, worst_block=block, violation=amount))
                 return None
-            info = SolverInfo(iterations, time.perf_counter() - t_start, starts, status)
-            plan = _plan(case, values, as_placement, info)
-            check = verify(plan, case)
+            info = SolverInfo(self.iterations, time.perf_counter() - self.t_start, self.starts, res.return_status)
+            plan = _plan(self.case, values, placement, info)
+            check = verify(plan, self.case)
             if check.passed:
-                if best is None or plan.period < best.plan.period - 1e-9:
-                    best = Solution(plan, check)
+                if self.best is None or plan.period < self.best.plan.period - 1e-9:
+                    self.best = Solution(plan, check)
                 return values, plan.period
             bad = check.failures()
-            failures.append(
-                f"verification failed: {bad[0].name} = {bad[0].value:.6g} {bad[0].unit} (limit {bad[0].limit:.6g})"
-            )
-            if [c.name for c in bad] != [ACCEL_CHECK]:
+            self.attempts.append(Attempt(check=bad[0]))
+            if [c.id for c in bad] != [CheckId.SLIDER_ACCEL]:
                 return None
             q[PARAMETER_INDEX["accel_limit"]] *= (bad[0].limit / bad[0].value) * (1 - 1e-5)
         return None
 
-    def multi_start(x0s: list[dict[str, float]], as_placement: Placement) -> dict[str, float] | None:
+    def multi_start(self, x0s: list[dict[str, float]], placement: Placement) -> dict[str, float] | None:
         """Run the starts in order until the two best verified ones agree on the period (the optimum
         is confirmed) or the starts run out; the values of the best verified start."""
         found: list[tuple[float, dict[str, float]]] = []
@@ -325,7 +270,7 @@ def solve(case: Case, placement: Placement | None = None, warm: Plan | None = No
             if any(np.allclose(key, other, rtol=1e-9, atol=1e-12) for other in tried):
                 continue  # the same start again would only repeat its answer
             tried.append(key)
-            out = attempt(x0, as_placement)
+            out = self.attempt(x0, placement)
             if out is None:
                 continue
             found.append((out[1], out[0]))
@@ -334,51 +279,105 @@ def solve(case: Case, placement: Placement | None = None, warm: Plan | None = No
                 break
         return found[0][1] if found else None
 
-    nlp = cycle_nlp(case.planner.motion_law)
-    lbx, ubx = _bounds(case, w2_lo, w2_hi, p)
-    p = np.concatenate([p, scales_for(case)])
-    if warm is not None and _fits(warm, case, placement, w2_lo, w2_hi):
-        check = verify(warm, case)
-        if check.passed:
-            best = Solution(warm, check)
-    if warm is not None and warm.motion_law != case.planner.motion_law:
-        warm = None  # another law's plan neither answers this case nor starts its NLP
-    warm_values = [warm.nlp_values] if warm is not None and warm.nlp_values else []
-    same_rule = warm is not None and (warm.placement == placement or placement == "free")
-    if follow and warm_values and same_rule and attempt(warm_values[0], warm.placement) is not None:
-        return _finished(best, iterations, starts, t_start, placement)
-    published_starts = [_guess(case, w2, w_transfer, share, 1.0) for share in (0.9, 0.6)]
-    published_starts.append(_guess(case, w2, 0.5 * (w_transfer + w_min), 0.75, 1.0))
-    if warm is not None and warm.placement == "published":
-        published_starts = warm_values + published_starts
-    pub_values = multi_start(published_starts, "published")
-    if placement == "free":
-        free_starts = list(warm_values) if warm is not None and warm.placement == "free" else []
-        free_starts += [pub_values] if pub_values is not None else []  # a feasible start of the free problem
-        free_starts.append(_guess(case, w2, w_transfer, 0.9, 1.5))
-        free_starts.append(_guess(case, w2, 2 * w_min, 0.95, 2.0))
-        multi_start(free_starts, "free")
-    return _finished(best, iterations, starts, t_start, placement, failures)
+    def answer(self) -> Solution:
+        """The best verified plan with the solver's totals; else the typed error: a converged plan
+        that failed the dense check is the finding (:class:`Unverified`), otherwise :class:`NoPlanFound`."""
+        if self.best is None:
+            found = [a for a in self.attempts if a.check is not None]
+            if found:
+                raise Unverified("no plan meets the limits: " + found[0].describe(), found[0].check)
+            last = self.attempts[-1].describe() if self.attempts else "no start"
+            raise NoPlanFound("no plan meets the limits: " + last, tuple(self.attempts))
+        plan = self.best.plan
+        if self.placement == "free" and plan.placement == "published":
+            # the published structure is one of the free structures: report it as the free answer
+            plan = replace(plan, placement="free")
+        info = SolverInfo(self.iterations, time.perf_counter() - self.t_start, self.starts, plan.solver.status)
+        return Solution(replace(plan, solver=info), self.best.verification)
 
 
-def _finished(
-    best: Solution | None,
-    iterations: int,
-    starts: int,
-    t_start: float,
-    placement: Placement,
-    failures: list[str] | None = None,
+def solve(
+    case: Case, placement: Placement | None = None, neighbour: Plan | None = None, follow: bool = False
 ) -> Solution:
-    """The answer of :func:`solve`: the best verified plan with the solver's totals, or the error."""
-    if best is None:
-        failures = failures or []
-        found = [f for f in failures if f.startswith("verification")]
-        if found:  # a converged plan failed the dense check: that finding is the answer
-            raise PlanningError("unverified", "no plan meets the limits: " + found[0])
-        raise PlanningError("infeasible", "no plan meets the limits: " + (failures[-1] if failures else "no start"))
-    plan = best.plan
-    if placement == "free" and plan.placement == "published":
-        # the published structure is one of the free structures: report it as the free answer
-        plan = replace(plan, placement="free")
-    info = SolverInfo(iterations, time.perf_counter() - t_start, starts, plan.solver.status)
-    return Solution(replace(plan, solver=info), best.verification)
+    """The fastest verified cycle for ``case``; raises a :class:`PlanningError` when there is none.
+
+    ``neighbour``: a plan of a neighbouring case (a sweep, a relaxed limit). It is verified against
+    this case as it stands (when its placement fits and its key angles and draw speed are this
+    case's) and its NLP values start the multi-start, so the answer is never worse than ``neighbour``
+    where ``neighbour`` is feasible here. ``follow``: with a fitting ``neighbour``, solve from it alone
+    and return what that start finds when it verifies (a sweep following its neighbours); otherwise
+    the full multi-start runs.
+    """
+    search = _prepare(case, placement or case.planner.placement)
+    neighbour = _adopt(search, neighbour)
+    if follow and _follow(search, neighbour):
+        return search.answer()
+    published = search.multi_start(_published_starts(search, neighbour), "published")
+    if search.placement == "free":
+        search.multi_start(_free_starts(search, neighbour, published), "free")
+    return search.answer()
+
+
+def _prepare(case: Case, placement: Placement) -> _Search:
+    """Prechecks, the case's parameters, the variable bounds and scales, the law's compiled NLP."""
+    t_start = time.perf_counter()
+    w2_lo, w2_hi = precheck(case)
+    p = nlp_parameters(case)
+    lbx, ubx = _bounds(case, w2_lo, w2_hi, p)
+    lim = case.limits
+    scale = variable_scales(case.press.crank_radius_mm, case.press.rod_length_mm, lim.slider_accel_mm_s2)
+    nlp = cycle_nlp(case.planner.motion_law)
+    return _Search(case, placement, nlp, p, lbx, ubx, scale, (w2_lo, w2_hi), t_start)
+
+
+def _adopt(search: _Search, neighbour: Plan | None) -> Plan | None:
+    """A neighbour plan that fits and verifies here is the first answer; the neighbour when its NLP
+    values can start this case's NLP (same law), else None."""
+    if neighbour is None:
+        return None
+    if _fits(neighbour, search.case, search.placement, *search.draw_speed_range):
+        check = verify(neighbour, search.case)
+        if check.passed:
+            search.best = Solution(neighbour, check)
+    if neighbour.motion_law != search.case.planner.motion_law or not neighbour.nlp_values:
+        return None  # another law's plan neither answers this case nor starts its NLP
+    return neighbour
+
+
+def _follow(search: _Search, neighbour: Plan | None) -> bool:
+    """Solve from the neighbour's values alone (same placement rule); whether that verified."""
+    if neighbour is None or not (neighbour.placement == search.placement or search.placement == "free"):
+        return False
+    return search.attempt(neighbour.nlp_values, neighbour.placement) is not None
+
+
+def _transfer_speeds(case: Case) -> tuple[float, float]:
+    """``(w_transfer, w_min)`` [rad/s]: the speed that just meets the transfer time (at least 1.5 times
+    the minimum) and the minimum crank speed."""
+    th1, _, _, th4 = case.key_angles
+    w_min = case.limits.min_crank_speed_rpm * RPM
+    return max((th1 + 2 * math.pi - th4) / case.process.transfer_time_s, 1.5 * w_min), w_min
+
+
+def _published_starts(search: _Search, neighbour: Plan | None) -> list[dict[str, float]]:
+    """Starts of the published placement: the neighbour's values when it has that placement, then
+    guesses from the case."""
+    case, w2 = search.case, search.draw_speed_range[1]
+    w_transfer, w_min = _transfer_speeds(case)
+    starts = [_guess(case, w2, w_transfer, share, 1.0) for share in (0.9, 0.6)]
+    starts.append(_guess(case, w2, 0.5 * (w_transfer + w_min), 0.75, 1.0))
+    if neighbour is not None and neighbour.placement == "published":
+        starts = [neighbour.nlp_values] + starts
+    return starts
+
+
+def _free_starts(search: _Search, neighbour: Plan | None, published: dict[str, float] | None) -> list[dict[str, float]]:
+    """Starts of the free placement: the neighbour's values when it has that placement, the best
+    published-placement plan (a feasible start of the free problem), then guesses from the case."""
+    case, w2 = search.case, search.draw_speed_range[1]
+    w_transfer, w_min = _transfer_speeds(case)
+    starts = [neighbour.nlp_values] if neighbour is not None and neighbour.placement == "free" else []
+    starts += [published] if published is not None else []
+    starts.append(_guess(case, w2, w_transfer, 0.9, 1.5))
+    starts.append(_guess(case, w2, 2 * w_min, 0.95, 2.0))
+    return starts

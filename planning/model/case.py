@@ -16,10 +16,11 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from planning.laws import DEFAULT_LAW, LAWS, LawName
+from planning.model.laws import DEFAULT_LAW, LAWS, LawName
 from press.kinematics import CrankSlider
 
 RPM = 2.0 * math.pi / 60.0  # [rad/s] per rpm
+Placement = Literal["free", "published"]  # where theta1 / theta4 may fall (the paper's Fig. 6, or anywhere)
 
 
 class CaseError(ValueError):
@@ -35,11 +36,12 @@ class CaseError(ValueError):
     def line(self, file: str | None = None) -> str:
         """One line ``FILE: field: message (got VALUE)``."""
         parts = [p for p in (file, self.field) if p]
-        got = f" (got {_show(self.value)})" if self.has_value else ""
+        got = f" (got {show_value(self.value)})" if self.has_value else ""
         return ": ".join(parts + [f"{self.message}{got}"])
 
 
-def _show(value: Any) -> str:
+def show_value(value: Any) -> str:
+    """A value as an error message quotes it: strings quoted, at most 60 characters."""
     text = repr(value) if isinstance(value, str) else str(value)
     return text if len(text) <= 60 else text[:57] + "..."
 
@@ -96,7 +98,7 @@ class PlannerModel(_Model):
     law's shape parameter held fixed (seven-segment jerk share, logistic flexible); omitted: optimised."""
 
     motion_law: LawName = DEFAULT_LAW
-    placement: Literal["free", "published"] = "free"
+    placement: Placement = "free"
     law_parameter: Positive | None = None
 
 
@@ -243,10 +245,12 @@ def cross_checks(case: Case) -> None:
         law = LAWS[case.planner.motion_law]
         if law.parameter is None:
             raise CaseError("planner.law_parameter", f"the {law.name} law has no shape parameter", fixed)
-        lo, hi = law.valid
+        lo, hi = law.parameter.valid
         if not lo <= fixed <= hi:
             raise CaseError(
-                "planner.law_parameter", f"{law.parameter[0]} of the {law.name} law must lie in [{lo:g}, {hi:g}]", fixed
+                "planner.law_parameter",
+                f"{law.parameter.name} of the {law.name} law must lie in [{lo:g}, {hi:g}]",
+                fixed,
             )
     top = case.limits.crank_speed_rpm
     if top is not None and top <= case.limits.min_crank_speed_rpm:

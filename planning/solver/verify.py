@@ -7,26 +7,49 @@ tolerances below (the README's numerical contract). Only a plan whose checks all
 
 from __future__ import annotations
 
+import enum
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from planning.case import RPM, Case
-from planning.plan import Plan
+from planning.model.case import RPM, Case
+from planning.model.plan import Plan
 
 MAX_STEP_S = 1e-3  # [s] dense grid step (at most)
 REL_TOL = 1e-6  # relative tolerance on every limit
 ANGLE_TOL = 1e-6  # [rad] key angles and cycle closure
 TIME_TOL = 1e-6  # [s] transfer time
 SPEED_TOL = 1e-9  # [rad/s] continuity and constant-speed draw
-ACCEL_CHECK = "|slider acceleration|"
 CONTINUITY_TOL = 1e-9  # [rad/s, rad/s^2] jump allowed at a knot (beyond the O(eps^2) remainder)
+
+
+class CheckId(str, enum.Enum):
+    """Stable identifiers of the verification checks (the display names may change; these do not)."""
+
+    FINITE = "finite"
+    CYCLE_ANGLE = "cycle_angle"
+    SPEED_CLOSES = "speed_closes"
+    ACCEL_CLOSES = "accel_closes"
+    SPEED_CONTINUOUS = "speed_continuous"
+    ACCEL_CONTINUOUS = "accel_continuous"
+    KEY_ANGLES = "key_angles"
+    TRANSFER_TIME = "transfer_time"
+    SAFETY_HEIGHT = "safety_height"
+    DRAW_CONSTANT = "draw_constant_speed"
+    DRAW_START_SPEED = "draw_start_speed"
+    DIE_SPEED = "die_speed"
+    SLIDER_ACCEL = "slider_accel"
+    CRANK_SPEED = "crank_speed_limit"
+    CRANK_ACCEL = "crank_accel_limit"
+    CRANK_JERK = "crank_jerk_limit"
+    MIN_CRANK_SPEED = "min_crank_speed"
 
 
 @dataclass(frozen=True)
 class Check:
-    """One verified constraint: measured ``value`` against ``limit`` (``kind`` max|min|equal) in ``unit``."""
+    """One verified constraint ``id`` (display ``name``): measured ``value`` against ``limit`` (``kind``
+    max|min|equal) in ``unit``."""
 
     name: str
     value: float
@@ -34,6 +57,7 @@ class Check:
     unit: str
     kind: str
     passed: bool
+    id: CheckId = field(compare=False)
 
     @property
     def margin(self) -> float:
@@ -45,7 +69,10 @@ class Check:
         return -abs(self.value - self.limit)
 
     def as_dict(self) -> dict:
-        return {**asdict(self), "margin": self.margin}
+        """The check as ``result.json`` writes it (display name, value, limit, unit, kind, passed, margin)."""
+        out = asdict(self)
+        del out["id"]
+        return {**out, "margin": self.margin}
 
 
 @dataclass(frozen=True)
@@ -82,7 +109,7 @@ def verify(plan: Plan, case: Case) -> Verification:
     h, v, a, _ = machine.slider(th, om, al, je)
     checks: list[Check] = []
 
-    def add(name: str, value: float, limit: float, unit: str, kind: str, tol: float) -> None:
+    def add(check_id: CheckId, name: str, value: float, limit: float, unit: str, kind: str, tol: float) -> None:
         value, limit = float(value), float(limit)
         if not math.isfinite(value):
             ok = False
@@ -92,15 +119,23 @@ def verify(plan: Plan, case: Case) -> Verification:
             ok = value >= limit - tol
         else:
             ok = abs(value - limit) <= tol
-        checks.append(Check(name, value, limit, unit, kind, ok))
+        checks.append(Check(name, value, limit, unit, kind, ok, check_id))
 
     finite = bool(np.all(np.isfinite(np.concatenate([th, om, al, h, v, a]))))
-    add("trajectory finite", 1.0 if finite else math.nan, 1.0, "", "equal", 0.0)
+    add(CheckId.FINITE, "trajectory finite", 1.0 if finite else math.nan, 1.0, "", "equal", 0.0)
     # the cycle closes: 360 deg, same speed and acceleration at both ends
     end = prof.at_time(np.array([0.0, P]))
-    add("cycle angle", math.degrees(end[0][1] - end[0][0]), 360.0, "deg", "equal", math.degrees(ANGLE_TOL))
-    add("speed closes", (end[1][1] - end[1][0]) / RPM, 0.0, "rpm", "equal", SPEED_TOL / RPM)
-    add("acceleration closes", end[2][1] - end[2][0], 0.0, "rad/s^2", "equal", 1e-6)
+    add(
+        CheckId.CYCLE_ANGLE,
+        "cycle angle",
+        math.degrees(end[0][1] - end[0][0]),
+        360.0,
+        "deg",
+        "equal",
+        math.degrees(ANGLE_TOL),
+    )
+    add(CheckId.SPEED_CLOSES, "speed closes", (end[1][1] - end[1][0]) / RPM, 0.0, "rpm", "equal", SPEED_TOL / RPM)
+    add(CheckId.ACCEL_CLOSES, "acceleration closes", end[2][1] - end[2][0], 0.0, "rad/s^2", "equal", 1e-6)
     # continuity at the knots: across a knot t_k, omega(t_k + e) - omega(t_k - e) = 2 e alpha + O(e^2 |jerk|)
     # and alpha(t_k + e) - alpha(t_k - e) = e (j_left + j_right) + O(e^2 |dj/dt|); a jump would add its
     # full size. e stays within both neighbouring segments; the remainders are bounded from their jerks.
@@ -113,17 +148,42 @@ def verify(plan: Plan, case: Case) -> Verification:
         j1_max = max(_max_jerk_rate(s) for s in prof.segments)
         jump_w = float(np.max(np.abs(right[1] - left[1] - 2 * eps * prof.at_time(knots)[2])))
         jump_a = float(np.max(np.abs(right[2] - left[2] - eps * (left[3] + right[3]))))
-        add("crank speed continuous at knots", jump_w, 0.0, "rad/s", "equal", CONTINUITY_TOL + 1e-14 * j_max)
-        add("crank acceleration continuous at knots", jump_a, 0.0, "rad/s^2", "equal", CONTINUITY_TOL + 1e-14 * j1_max)
+        add(
+            CheckId.SPEED_CONTINUOUS,
+            "crank speed continuous at knots",
+            jump_w,
+            0.0,
+            "rad/s",
+            "equal",
+            CONTINUITY_TOL + 1e-14 * j_max,
+        )
+        add(
+            CheckId.ACCEL_CONTINUOUS,
+            "crank acceleration continuous at knots",
+            jump_a,
+            0.0,
+            "rad/s^2",
+            "equal",
+            CONTINUITY_TOL + 1e-14 * j1_max,
+        )
     # key angles and the transfer window
     key_t = plan.key_times()
     th_key = prof.at_time(key_t)[0]
     err = float(np.max(np.abs(th_key - np.array(plan.key_angles))))
-    add("key angles reached", math.degrees(err), 0.0, "deg", "equal", math.degrees(ANGLE_TOL))
+    add(CheckId.KEY_ANGLES, "key angles reached", math.degrees(err), 0.0, "deg", "equal", math.degrees(ANGLE_TOL))
     t1, t2, t3, t4 = key_t
-    add("transfer time theta4 -> theta1", t1 + P - t4, case.process.transfer_time_s, "s", "min", TIME_TOL)
+    add(
+        CheckId.TRANSFER_TIME,
+        "transfer time theta4 -> theta1",
+        t1 + P - t4,
+        case.process.transfer_time_s,
+        "s",
+        "min",
+        TIME_TOL,
+    )
     window = (t >= t4) | (t <= t1)
     add(
+        CheckId.SAFETY_HEIGHT,
         "slider at or above the safety height from theta4 to theta1",
         float(np.min(h[window])),
         case.process.safety_height_mm,
@@ -135,10 +195,17 @@ def verify(plan: Plan, case: Case) -> Verification:
     draw = (t >= t2) & (t <= t3)
     w2 = float(plan.parameters.draw_speed)
     add(
-        "draw at constant crank speed", float(np.max(np.abs(om[draw] - w2))) / RPM, 0.0, "rpm", "equal", SPEED_TOL / RPM
+        CheckId.DRAW_CONSTANT,
+        "draw at constant crank speed",
+        float(np.max(np.abs(om[draw] - w2))) / RPM,
+        0.0,
+        "rpm",
+        "equal",
+        SPEED_TOL / RPM,
     )
     v2 = abs(float(machine.slider(plan.key_angles[1], w2)[1]))
     add(
+        CheckId.DRAW_START_SPEED,
         "slider speed at the draw start",
         v2,
         lim.draw_start_speed_mm_s,
@@ -151,6 +218,7 @@ def verify(plan: Plan, case: Case) -> Verification:
     v_cross = [abs(s) for s in _slider_speed_at_angles(plan, case, crossings)]
     v_die = max(([float(np.max(np.abs(v[low])))] if low.any() else [0.0]) + v_cross)
     add(
+        CheckId.DIE_SPEED,
         "slider speed at or below the die height",
         v_die,
         lim.die_speed_mm_s,
@@ -159,17 +227,30 @@ def verify(plan: Plan, case: Case) -> Verification:
         REL_TOL * lim.die_speed_mm_s,
     )
     add(
-        ACCEL_CHECK, float(np.max(np.abs(a))), lim.slider_accel_mm_s2, "mm/s^2", "max", REL_TOL * lim.slider_accel_mm_s2
+        CheckId.SLIDER_ACCEL,
+        "|slider acceleration|",
+        float(np.max(np.abs(a))),
+        lim.slider_accel_mm_s2,
+        "mm/s^2",
+        "max",
+        REL_TOL * lim.slider_accel_mm_s2,
     )
     motor = (
-        ("crank speed <= crank_speed_rpm", lim.crank_speed_rpm, float(np.max(om)) / RPM, "rpm"),
-        ("|crank acceleration| <= crank_accel_rad_s2", lim.crank_accel_rad_s2, float(np.max(np.abs(al))), "rad/s^2"),
-        ("|crank jerk| <= crank_jerk_rad_s3", lim.crank_jerk_rad_s3, max_abs_jerk(prof), "rad/s^3"),
+        (CheckId.CRANK_SPEED, "crank speed <= crank_speed_rpm", lim.crank_speed_rpm, float(np.max(om)) / RPM, "rpm"),
+        (
+            CheckId.CRANK_ACCEL,
+            "|crank acceleration| <= crank_accel_rad_s2",
+            lim.crank_accel_rad_s2,
+            float(np.max(np.abs(al))),
+            "rad/s^2",
+        ),
+        (CheckId.CRANK_JERK, "|crank jerk| <= crank_jerk_rad_s3", lim.crank_jerk_rad_s3, max_abs_jerk(prof), "rad/s^3"),
     )
-    for name, limit, value, unit in motor:
+    for check_id, name, limit, value, unit in motor:
         if limit is not None:
-            add(name, value, limit, unit, "max", REL_TOL * limit)
+            add(check_id, name, value, limit, unit, "max", REL_TOL * limit)
     add(
+        CheckId.MIN_CRANK_SPEED,
         "crank speed (forward, never stops)",
         float(np.min(om)) / RPM,
         lim.min_crank_speed_rpm,

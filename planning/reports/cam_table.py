@@ -16,8 +16,8 @@ import math
 
 import numpy as np
 
-from planning.laws import LAWS
-from planning.plan import Plan
+from planning.model.laws import LAWS
+from planning.model.plan import Plan
 
 CAM_COLUMNS = ("master_deg", "crank_angle_deg", "dcrank_dmaster", "d2crank_dmaster2", "d3crank_dmaster3")
 DEFAULT_POINTS = 3600

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from planning.case import KEY_POINT_NAMES, RPM, Case, draw_speed_bounds
+from planning.model.case import KEY_POINT_NAMES, RPM, Case, draw_speed_bounds
 
 
 def check_case(case: Case) -> dict[str, Any]:

@@ -1,12 +1,13 @@
-"""The CasADi nonlinear program of one press cycle under a motion law (all CasADi lives here).
+"""The CasADi nonlinear program of one press cycle under a motion law.
 
 Built once per process and law, then reused: every number of a case, and the scale of every decision
-variable, enters as a parameter and the placement structure is a pair of constraint rows whose bounds
-are set per solve, so a sweep, a multi-start or the other placement only calls the compiled solver
-again. Decision variables are scaled to O(1): the four speeds w1, w2, wm1, wm2, the durations of the
-four halves, the transfer dwell, the law's shape parameter and the times of the key points.
+variable (:func:`variable_scales`, applied by the solver wrapper ``planning.solver.ipopt``), enters as a
+parameter and the placement structure is a pair of constraint rows whose bounds are set per solve, so a
+sweep, a multi-start or the other placement only calls the compiled solver again. Decision variables are
+scaled to O(1): the four speeds w1, w2, wm1, wm2, the durations of the four halves, the transfer dwell,
+the law's shape parameter and the times of the key points.
 
-Time 0 of the NLP is the end of the draw (theta3); the stages follow as in ``planning.cycle``. The
+Time 0 of the NLP is the end of the draw (theta3); the stages follow as in ``planning.model.cycle``. The
 crank angle at any time t before the draw is evaluated in closed form as
 ``theta(t) = theta3 + sum_k D_k(clip(t - s_k, 0, T_k))``, with ``D_k`` the angle swept ``tau`` into
 segment k. The clip makes theta(t) continuously differentiable in t and in every segment variable
@@ -26,40 +27,52 @@ acceleration and jerk of every half.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import math
+from dataclasses import dataclass
 from functools import cache
-from typing import Literal
 
 import casadi as ca
 import numpy as np
 
-from planning.cycle import CycleParameters, cycle_segments
-from planning.laws import DEFAULT_LAW, get_law
-from planning.profile import Segment, advance, advance_segment, knot_states, shape_part
+from planning.model.case import Placement
+from planning.model.cycle import CycleParameters, cycle_segments
+from planning.model.laws import DEFAULT_LAW, get_law
+from planning.model.profile import Segment, advance, advance_segment, knot_states, shape_part
+from planning.solver.ipopt import NLPResult, NLPSolver
 from press.kinematics import height_derivatives
 
-Placement = Literal["free", "published"]
-
-# Decision variables: name, default scale (physical = scale * scaled; the scales are NLP parameters
-# set per case from the magnitude of its first initial guess, this default where that is zero)
-VARIABLES: tuple[tuple[str, float], ...] = (
-    ("transfer_speed", 1.0),  # w1 [rad/s]
-    ("draw_speed", 1.0),  # w2 [rad/s]
-    ("feed_peak_speed", 1.0),  # wm1 [rad/s]
-    ("return_peak_speed", 1.0),  # wm2 [rad/s]
-    ("feed_accel_duration", 0.4),  # [s] each half
-    ("feed_decel_duration", 0.4),
-    ("return_accel_duration", 0.4),
-    ("return_decel_duration", 0.4),
-    ("transfer_dwell", 1.0),  # [s]
-    ("law_parameter", 1.0),  # the motion law's shape parameter (fixed at 0 when it has none)
-    ("closing_time", 1.0),  # t1 from the end of the draw [s]
-    ("opening_time", 1.0),  # t4
-    ("die_down_time", 1.0),  # time of the descending die-height crossing
-    ("die_up_time", 1.0),  # time of the ascending die-height crossing
+# Decision variables and the kind of scale each is measured in (see :func:`variable_scales`)
+VARIABLES: tuple[tuple[str, str], ...] = (
+    ("transfer_speed", "speed"),  # w1 [rad/s]
+    ("draw_speed", "speed"),  # w2 [rad/s]
+    ("feed_peak_speed", "speed"),  # wm1 [rad/s]
+    ("return_peak_speed", "speed"),  # wm2 [rad/s]
+    ("feed_accel_duration", "half"),  # [s] each half
+    ("feed_decel_duration", "half"),
+    ("return_accel_duration", "half"),
+    ("return_decel_duration", "half"),
+    ("transfer_dwell", "time"),  # [s]
+    ("law_parameter", "shape"),  # the motion law's shape parameter (fixed at 0 when it has none)
+    ("closing_time", "time"),  # t1 from the end of the draw [s]
+    ("opening_time", "time"),  # t4
+    ("die_down_time", "time"),  # time of the descending die-height crossing
+    ("die_up_time", "time"),  # time of the ascending die-height crossing
 )
 VARIABLE_INDEX = {name: i for i, (name, _) in enumerate(VARIABLES)}
-SCALES = np.array([s for _, s in VARIABLES])
+
+
+def variable_scales(crank_radius_mm: float, rod_length_mm: float, slider_accel_mm_s2: float) -> np.ndarray:
+    """Variable scales from the press's own characteristic time ``T* = sqrt(R / A)`` [s] and speed
+    ``W* = sqrt(A / (R + R^2/L))`` [rad/s] (A the slider-acceleration limit): speeds ~ W*,
+    durations of the halves ~ T*, stage times ~ 10 T*. The factors make the variables O(1) for a
+    press cycle of the usual proportions; they span orders of magnitude from a small fast press to a
+    heavy slow one."""
+    R, L, A = crank_radius_mm, rod_length_mm, slider_accel_mm_s2
+    t_star = math.sqrt(R / A)
+    w_star = math.sqrt(A / (R + R**2 / L))
+    unit = {"speed": 0.42 * w_star, "half": 1.12 * t_star, "time": 2.8 * t_star, "shape": 1.0}
+    return np.array([unit[kind] for _, kind in VARIABLES])
+
 
 # Parameters of a case, in inside units
 PARAMETERS: tuple[str, ...] = (
@@ -84,20 +97,9 @@ PARAMETERS: tuple[str, ...] = (
 )
 PARAMETER_INDEX = {name: i for i, name in enumerate(PARAMETERS)}
 
-IPOPT_OPTIONS = {
-    "ipopt.print_level": 0,
-    "print_time": False,
-    "ipopt.sb": "yes",
-    "ipopt.tol": 1e-10,
+CYCLE_OPTIONS = {  # added to the wrapper's base options
     "ipopt.constr_viol_tol": 1e-10,
     "ipopt.max_iter": 400,  # a start that has not converged by then is dropped (others remain)
-}
-WARM_OPTIONS = {
-    "ipopt.warm_start_init_point": "yes",
-    "ipopt.mu_init": 1e-6,
-    "ipopt.warm_start_bound_push": 1e-9,
-    "ipopt.warm_start_mult_bound_push": 1e-9,
-    "ipopt.warm_start_slack_bound_push": 1e-9,
 }
 SAMPLES_PER_SUBSEGMENT = 5
 SAMPLES_CONSTANT = 20
@@ -134,23 +136,11 @@ class CycleNLP:
     """The compiled NLP; see the module docstring. ``published_rows`` pin theta1 and theta4 to the
     points of the published structure; they are left unbounded for the free placement."""
 
-    solver: ca.Function
+    program: NLPSolver
     lbg: np.ndarray
     ubg: np.ndarray
     blocks: tuple[ConstraintBlock, ...]
     published_rows: slice
-    problem: dict = field(repr=False, default_factory=dict)
-    options: dict = field(repr=False, default_factory=dict)
-    _warm: ca.Function | None = field(repr=False, default=None)
-
-    def warm_solver(self) -> ca.Function:
-        """The same NLP with IPOPT set up for a warm start from a nearby solution and its multipliers
-        (built on first use): re-solves after a small change of a parameter take a few iterations."""
-        if self._warm is None:
-            opts = dict(self.options)
-            opts.update(WARM_OPTIONS)
-            self._warm = ca.nlpsol("press_cycle_warm", "ipopt", self.problem, opts)
-        return self._warm
 
     def bounds(self, placement: Placement) -> tuple[np.ndarray, np.ndarray]:
         """``(lbg, ubg)`` for ``placement``."""
@@ -158,6 +148,35 @@ class CycleNLP:
         pinned = 0.0 if placement == "published" else np.inf
         lbg[self.published_rows], ubg[self.published_rows] = -pinned, pinned
         return lbg, ubg
+
+    def solve(
+        self,
+        start: dict[str, float],
+        case_parameters: np.ndarray,
+        lbx: np.ndarray,
+        ubx: np.ndarray,
+        placement: Placement,
+        scale: np.ndarray,
+        warm_start: tuple[np.ndarray, np.ndarray] | None = None,
+    ) -> NLPResult:
+        """One IPOPT solve from the variable values ``start`` (physical units) for the case parameters
+        (:data:`PARAMETERS` order), physical bounds ``lbx``/``ubx`` and the variables' ``scale``;
+        ``warm_start``: the multipliers of a nearby solve."""
+        lbg, ubg = self.bounds(placement)
+        x0 = np.array([start[k] for k, _ in VARIABLES])
+        return self.program.solve(x0, lbx, ubx, lbg, ubg, p=case_parameters, scale=scale, warm_start=warm_start)
+
+    def worst_violation(self, placement: Placement, g: np.ndarray) -> tuple[str, float]:
+        """The constraint block with the largest violation at ``g`` (the last iterate)."""
+        lbg, ubg = self.bounds(placement)
+        viol = np.maximum(lbg - g, 0) + np.maximum(g - ubg, 0)
+        worst = max(self.blocks, key=lambda b: float(np.max(viol[b.start : b.stop], initial=0.0)))
+        return worst.name, float(np.max(viol[worst.start : worst.stop], initial=0.0))
+
+
+def values_of(result: NLPResult) -> dict[str, float]:
+    """The variables of a solve by name."""
+    return {k: float(result.x[j]) for j, (k, _) in enumerate(VARIABLES)}
 
 
 def _build(law_name: str) -> CycleNLP:
@@ -285,8 +304,8 @@ def _build(law_name: str) -> CycleNLP:
     add("crank jerk limit", ca.vertcat(*params.peak_jerks()) / q["crank_jerk_max"], -np.inf, 1.0)
 
     nlp = {"x": x, "p": p, "f": params.period, "g": ca.vertcat(*g)}
-    solver = ca.nlpsol("press_cycle_" + law_name.replace("-", "_"), "ipopt", nlp, IPOPT_OPTIONS)
-    return CycleNLP(solver, np.array(lb), np.array(ub), tuple(blocks), published_rows, nlp, IPOPT_OPTIONS)
+    program = NLPSolver("press_cycle_" + law_name.replace("-", "_"), nlp, CYCLE_OPTIONS)
+    return CycleNLP(program, np.array(lb), np.array(ub), tuple(blocks), published_rows)
 
 
 @cache

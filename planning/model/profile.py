@@ -8,7 +8,7 @@ segments, each a duration ``T`` [s] with a jerk that is linear in the local time
     omega(tau) = omega0 + alpha0 tau + j0 tau^2 / 2 + j1 tau^3 / 6
     theta(tau) = theta0 + omega0 tau + alpha0 tau^2 / 2 + j0 tau^3 / 6 + j1 tau^4 / 24
 
-plus, for the laws that are not piecewise polynomial in jerk (``planning.laws.shapes``), a shape
+plus, for the laws that are not piecewise polynomial in jerk (``planning.model.laws.shapes``), a shape
 term: a speed change ``dv`` [rad/s] along a normalised shape ``s(u)`` over a span ``D`` [s], of which
 the segment covers ``u`` from ``u0`` to ``u0 + T / D`` (``u0 > 0`` only for a piece split off a half).
 The shape term is added as its remainder beyond the start state, so the start state is always the

@@ -1,0 +1,48 @@
+"""Motion laws: how the crank speed changes between two constant speeds, behind one interface.
+
+A press cycle (``planning.model.cycle``) has four *halves*: the feed S-curve rises from the transfer speed to
+its peak and falls to the draw speed, the return S-curve rises from the draw speed to its peak and
+falls to the transfer speed. A motion law turns one half -- duration ``D`` [s], speed change ``dv``
+[rad/s], optionally its shape parameter -- into closed-form segments (``planning.model.profile``), and states
+its peak acceleration and jerk in closed form (for the drive limits) and its continuity.
+
+=================  ====================================================  ===========================
+law                one half                                              continuous up to
+=================  ====================================================  ===========================
+improved-s-curve   paper 003 Eq. 10: four sub-segments of D/4, linear     acceleration (jerk steps)
+                   jerk; one jerk for both halves of an S-curve (Eq. 14)
+seven-segment      seeds 000/002/004: jerk phase r D/2, constant          acceleration (jerk steps)
+                   acceleration (1 - r) D, jerk phase r D/2; r optimised
+quintic            seed 001: s = 10u^3 - 15u^4 + 6u^5                     jerk
+logistic           seed 000 Eq. 4 with its end slope removed, flexible a  acceleration (small jerk steps)
+cycloidal          cam classic, acceleration 1 - cos(2 pi u)              jerk
+=================  ====================================================  ===========================
+
+Each law is a class (``base.MotionLaw``) in a file of its own; this module is the registry. The
+peak speed between the halves is a point (no constant-speed segment at the peak); the seven-
+segment law's degenerate cases -- the plateau vanishes at ``r = 1``, the constant-speed segments at
+the ends vanish when the optimizer sets them to zero -- are all inside its parameter range.
+"""
+
+from __future__ import annotations
+
+from typing import Literal, get_args
+
+from planning.model.laws.base import MotionLaw, ShapeParameter
+from planning.model.laws.improved_scurve import ImprovedSCurve
+from planning.model.laws.one_segment import CycloidalLaw, LogisticLaw, QuinticLaw
+from planning.model.laws.seven_segment import SevenSegment
+
+LAWS: dict[str, MotionLaw] = {
+    law.name: law for law in (ImprovedSCurve(), SevenSegment(), QuinticLaw(), LogisticLaw(), CycloidalLaw())
+}
+DEFAULT_LAW = ImprovedSCurve.name
+LawName = Literal["improved-s-curve", "seven-segment", "quintic", "logistic", "cycloidal"]
+assert set(get_args(LawName)) == set(LAWS)
+
+__all__ = ["DEFAULT_LAW", "LAWS", "LawName", "MotionLaw", "ShapeParameter", "get_law"]
+
+
+def get_law(name: str) -> MotionLaw:
+    """The law called ``name`` (:data:`LAWS`)."""
+    return LAWS[name]

@@ -1,0 +1,66 @@
+"""The interface every motion law implements, and the named type of a law's shape parameter."""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+from planning.model.profile import Segment
+
+
+@dataclass(frozen=True)
+class ShapeParameter:
+    """A law's shape parameter: ``name``; ``low`` .. ``high`` where the NLP optimises it from ``start``;
+    ``valid_low`` .. ``valid_high`` where a fixed value (``planner.law_parameter``) may lie."""
+
+    name: str
+    low: float
+    high: float
+    start: float
+    valid_low: float
+    valid_high: float
+
+    @property
+    def valid(self) -> tuple[float, float]:
+        """``(valid_low, valid_high)``."""
+        return self.valid_low, self.valid_high
+
+
+class MotionLaw(ABC):
+    """A motion law: how the crank speed changes over one half of an S-curve.
+
+    Class attributes: ``name``, ``continuity`` (``"acceleration"`` or ``"jerk"``: the highest derivative
+    of the speed that is continuous), ``source``, ``parameter`` (a :class:`ShapeParameter` or None),
+    ``samples`` (slider-acceleration samples the NLP takes per segment of a half; the dense
+    verification decides between them), ``one_jerk_per_curve`` (Eq. 14: both halves of an S-curve
+    share one jerk). Every method works on floats, numpy arrays and CasADi symbols.
+    """
+
+    name: ClassVar[str]
+    continuity: ClassVar[str]
+    source: ClassVar[str]
+    parameter: ClassVar[ShapeParameter | None] = None
+    samples: ClassVar[int] = 5
+    one_jerk_per_curve: ClassVar[bool] = False
+
+    @abstractmethod
+    def half(self, prefix: str, duration: Any, dv: Any, param: Any = None) -> list[Segment]:
+        """Segments of one half: speed change ``dv`` [rad/s] (either sign) in ``duration`` [s]."""
+
+    @abstractmethod
+    def peak_rate(self, param: Any = None) -> Any:
+        """Peak |acceleration| of a half in units of ``|dv| / D``."""
+
+    @abstractmethod
+    def peak_jerk(self, param: Any = None) -> Any:
+        """Peak |jerk| of a half in units of ``|dv| / D^2``."""
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}()"
+
+    def __eq__(self, other: object) -> bool:
+        return type(self) is type(other)
+
+    def __hash__(self) -> int:
+        return hash(type(self))

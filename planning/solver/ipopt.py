@@ -1,0 +1,149 @@
+"""IPOPT behind one interface: the options, the call, the success test, scaling and warm starts.
+
+Every NLP of the project (the cycle NLP of each motion law, the time-optimal bound) is compiled once
+into an :class:`NLPSolver` and solved through :meth:`NLPSolver.solve`, which returns an
+:class:`NLPResult` with a typed status, the values in physical units, the constraint values, the
+multipliers, the iteration count and the wall time. This module and the modules that build CasADi
+expressions for it (``planning.solver.nlp``, ``planning.solver.bound``) are the only ones that import
+CasADi.
+
+Scaling: a problem may read a per-solve scale vector from the end of its parameter vector
+(physical value = scale * decision variable). :meth:`NLPSolver.solve` then takes the physical start
+and bounds, divides them by the scale, appends the scale to the parameters and multiplies the answer
+back, so callers only see physical values.
+"""
+
+from __future__ import annotations
+
+import enum
+import time
+from dataclasses import dataclass, field
+
+import casadi as ca
+import numpy as np
+
+BASE_OPTIONS = {
+    "ipopt.print_level": 0,
+    "print_time": False,
+    "ipopt.sb": "yes",
+    "ipopt.tol": 1e-10,
+}
+WARM_START_OPTIONS = {  # a start from a nearby solution and its multipliers: a few iterations
+    "ipopt.warm_start_init_point": "yes",
+    "ipopt.mu_init": 1e-6,
+    "ipopt.warm_start_bound_push": 1e-9,
+    "ipopt.warm_start_mult_bound_push": 1e-9,
+    "ipopt.warm_start_slack_bound_push": 1e-9,
+}
+
+
+class NLPStatus(enum.Enum):
+    """How IPOPT ended, grouped by what it means for the caller."""
+
+    SOLVED = "solved"  # Solve_Succeeded
+    ACCEPTABLE = "acceptable"  # Solved_To_Acceptable_Level
+    ITERATION_LIMIT = "iteration limit"  # Maximum_Iterations_Exceeded, Maximum_CpuTime_Exceeded, ...
+    LOCALLY_INFEASIBLE = "locally infeasible"  # Infeasible_Problem_Detected (a local statement only)
+    FAILED = "failed"  # anything else: restoration failed, numerical trouble, ...
+
+    @classmethod
+    def from_ipopt(cls, return_status: str) -> NLPStatus:
+        """The status for IPOPT's ``return_status`` string."""
+        if return_status == "Solve_Succeeded":
+            return cls.SOLVED
+        if return_status == "Solved_To_Acceptable_Level":
+            return cls.ACCEPTABLE
+        if return_status.startswith("Maximum_") or return_status == "Maximum_Iterations_Exceeded":
+            return cls.ITERATION_LIMIT
+        if return_status == "Infeasible_Problem_Detected":
+            return cls.LOCALLY_INFEASIBLE
+        return cls.FAILED
+
+
+@dataclass(frozen=True)
+class NLPResult:
+    """One IPOPT solve. ``x``: the variables in physical units, clipped to their bounds (IPOPT relaxes
+    bounds by about 1e-8); ``g``: the constraint values; ``multipliers``: ``(lam_x, lam_g)`` as the solver
+    sees them (for a warm start of the same problem); ``objective``; ``iterations``; ``wall_time_s`` [s];
+    ``return_status``: IPOPT's own words."""
+
+    status: NLPStatus
+    return_status: str
+    x: np.ndarray
+    g: np.ndarray
+    multipliers: tuple[np.ndarray, np.ndarray] = field(repr=False)
+    objective: float
+    iterations: int
+    wall_time_s: float
+
+    @property
+    def success(self) -> bool:
+        """Converged (to the requested or the acceptable tolerance)."""
+        return self.status in (NLPStatus.SOLVED, NLPStatus.ACCEPTABLE)
+
+
+class NLPSolver:
+    """IPOPT on one CasADi problem ``{"x", "p", "f", "g"}``, compiled once and solved many times.
+
+    ``options`` are added to :data:`BASE_OPTIONS`; the warm-start variant (same problem, IPOPT set up
+    for a start from a nearby solution's multipliers) is built on first use.
+    """
+
+    def __init__(self, name: str, problem: dict, options: dict | None = None):
+        self.name = name
+        self.problem = problem
+        self.options = {**BASE_OPTIONS, **(options or {})}
+        self._cold = ca.nlpsol(name, "ipopt", problem, self.options)
+        self._warm: ca.Function | None = None
+
+    def _warm_function(self) -> ca.Function:
+        if self._warm is None:
+            self._warm = ca.nlpsol(f"{self.name}_warm", "ipopt", self.problem, {**self.options, **WARM_START_OPTIONS})
+        return self._warm
+
+    def solve(
+        self,
+        x0: np.ndarray,
+        lbx: np.ndarray,
+        ubx: np.ndarray,
+        lbg: np.ndarray,
+        ubg: np.ndarray,
+        p: np.ndarray | None = None,
+        scale: np.ndarray | None = None,
+        warm_start: tuple[np.ndarray, np.ndarray] | None = None,
+    ) -> NLPResult:
+        """Solve from ``x0`` within ``lbx .. ubx`` (physical units) and ``lbg .. ubg``.
+
+        ``scale``: the variables' scales when the problem reads them from the end of ``p``;
+        ``warm_start``: the multipliers of a nearby solve of this problem (its :attr:`NLPResult.multipliers`).
+        """
+        t0 = time.perf_counter()
+        lbx, ubx = np.asarray(lbx, dtype=float), np.asarray(ubx, dtype=float)
+        unit = np.ones(lbx.shape) if scale is None else np.asarray(scale, dtype=float)
+        args = {
+            "x0": np.clip(np.asarray(x0, dtype=float), lbx, ubx) / unit,
+            "lbx": lbx / unit,
+            "ubx": ubx / unit,
+            "lbg": lbg,
+            "ubg": ubg,
+        }
+        if p is not None or scale is not None:
+            parts = [np.asarray(p, dtype=float)] if p is not None else []
+            args["p"] = np.concatenate(parts + ([unit] if scale is not None else []))
+        solver = self._cold
+        if warm_start is not None:
+            solver = self._warm_function()
+            args.update(lam_x0=warm_start[0], lam_g0=warm_start[1])
+        res = solver(**args)
+        stats = solver.stats()
+        return_status = str(stats["return_status"])
+        return NLPResult(
+            status=NLPStatus.from_ipopt(return_status),
+            return_status=return_status,
+            x=np.clip(np.array(res["x"]).ravel() * unit, lbx, ubx),
+            g=np.array(res["g"]).ravel(),
+            multipliers=(np.array(res["lam_x"]).ravel(), np.array(res["lam_g"]).ravel()),
+            objective=float(res["f"]),
+            iterations=int(stats["iter_count"]),
+            wall_time_s=time.perf_counter() - t0,
+        )

@@ -1,0 +1,95 @@
+"""What a solve ends with when there is no verified plan: one exception type per outcome.
+
+Each carries data, not only text: the case field that cannot be met, the value, what would be needed;
+or the verification check that failed. The CLI maps the types to exit codes in one place
+(``planning.cli``); a sweep writes ``kind`` into its status column.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, ClassVar
+
+if TYPE_CHECKING:
+    from planning.solver.verify import Check
+
+
+class PlanningError(Exception):
+    """No verified plan for a case. ``kind`` names the outcome, ``reason`` is the one-line message."""
+
+    kind: ClassVar[str] = "failed"
+
+    def __init__(self, reason: str):
+        self.reason = reason
+        super().__init__(f"{self.kind}: {reason}")
+
+
+class Infeasible(PlanningError):
+    """A limit provably cannot be met (found before or without solving).
+
+    ``limit``: the dotted case field that cannot be met (None when several conflict); ``value``: its
+    value in the case; ``needed``: what it would have to be, when one number says it; ``angle_deg``:
+    where on the cycle, when one angle says it.
+    """
+
+    kind = "infeasible"
+
+    def __init__(
+        self,
+        reason: str,
+        limit: str | None = None,
+        value: float | None = None,
+        needed: float | None = None,
+        angle_deg: float | None = None,
+    ):
+        super().__init__(reason)
+        self.limit = limit
+        self.value = value
+        self.needed = needed
+        self.angle_deg = angle_deg
+
+
+class NoPlanFound(PlanningError):
+    """Every start of the solver stopped without a plan (``attempts`` say how each ended)."""
+
+    kind = "infeasible"
+
+    def __init__(self, reason: str, attempts: tuple[Attempt, ...] = ()):
+        super().__init__(reason)
+        self.attempts = attempts
+
+
+class Unverified(PlanningError):
+    """The solver converged but the dense verification rejected the plan: ``check`` is the first
+    failed check (its value, limit and unit)."""
+
+    kind = "unverified"
+
+    def __init__(self, reason: str, check: Check):
+        super().__init__(reason)
+        self.check = check
+
+
+@dataclass(frozen=True)
+class Attempt:
+    """How one start of the cycle NLP ended without a verified plan.
+
+    ``solver_status``: IPOPT's return status when it stopped unconverged (else None), with the
+    constraint block ``worst_block`` violated most and by how much (``violation``); ``check``: the
+    failed verification check when it converged to a plan that did not verify.
+    """
+
+    solver_status: str | None = None
+    worst_block: str = ""
+    violation: float = 0.0
+    check: Check | None = None
+
+    def describe(self) -> str:
+        """One line: what stopped this start."""
+        if self.check is not None:
+            c = self.check
+            return f"verification failed: {c.name} = {c.value:.6g} {c.unit} (limit {c.limit:.6g})"
+        return (
+            f"solver stopped ({self.solver_status}); worst constraint: {self.worst_block} "
+            f"(violated by {self.violation:.3g})"
+        )
