@@ -146,7 +146,8 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
     x0 = np.concatenate([s0, 2 * dth / (2 * np.sqrt(s0))])
     lbx = np.concatenate([lbx_s, np.zeros(n)])
     ubx = np.concatenate([ubx_s, np.full(n, np.inf)])
-    res = solver.solve(x0, lbx, ubx, np.concatenate(lbg), np.concatenate(ubg))
+    # the optimum as IPOPT returns it: the grid's speeds are read with max(s, 0) below
+    res = solver.solve(x0, lbx, ubx, np.concatenate(lbg), np.concatenate(ubg), clip_to_bounds=False)
     if not res.success:
         raise NoPlanFound(f"the time-optimal bound did not converge ({res.return_status})")
     xs = res.x

@@ -62,8 +62,8 @@ class NLPStatus(enum.Enum):
 
 @dataclass(frozen=True)
 class NLPResult:
-    """One IPOPT solve. ``x``: the variables in physical units, clipped to their bounds (IPOPT relaxes
-    bounds by about 1e-8); ``g``: the constraint values; ``multipliers``: ``(lam_x, lam_g)`` as the solver
+    """One IPOPT solve. ``x``: the variables in physical units, clipped to their bounds unless asked not
+    to (IPOPT relaxes bounds by about 1e-8); ``g``: the constraint values; ``multipliers``: ``(lam_x, lam_g)`` as the solver
     sees them (for a warm start of the same problem); ``objective``; ``iterations``; ``wall_time_s`` [s];
     ``return_status``: IPOPT's own words."""
 
@@ -111,11 +111,14 @@ class NLPSolver:
         p: np.ndarray | None = None,
         scale: np.ndarray | None = None,
         warm_start: tuple[np.ndarray, np.ndarray] | None = None,
+        clip_to_bounds: bool = True,
     ) -> NLPResult:
         """Solve from ``x0`` within ``lbx .. ubx`` (physical units) and ``lbg .. ubg``.
 
         ``scale``: the variables' scales when the problem reads them from the end of ``p``;
-        ``warm_start``: the multipliers of a nearby solve of this problem (its :attr:`NLPResult.multipliers`).
+        ``warm_start``: the multipliers of a nearby solve of this problem (its :attr:`NLPResult.multipliers`);
+        ``clip_to_bounds``: clip the answer into ``lbx .. ubx`` (IPOPT relaxes bounds by about 1e-8), or
+        return it as IPOPT found it.
         """
         t0 = time.perf_counter()
         lbx, ubx = np.asarray(lbx, dtype=float), np.asarray(ubx, dtype=float)
@@ -136,11 +139,12 @@ class NLPSolver:
             args.update(lam_x0=warm_start[0], lam_g0=warm_start[1])
         res = solver(**args)
         stats = solver.stats()
+        x = np.array(res["x"]).ravel() * unit
         return_status = str(stats["return_status"])
         return NLPResult(
             status=NLPStatus.from_ipopt(return_status),
             return_status=return_status,
-            x=np.clip(np.array(res["x"]).ravel() * unit, lbx, ubx),
+            x=np.clip(x, lbx, ubx) if clip_to_bounds else x,
             g=np.array(res["g"]).ravel(),
             multipliers=(np.array(res["lam_x"]).ravel(), np.array(res["lam_g"]).ravel()),
             objective=float(res["f"]),
