@@ -63,9 +63,9 @@ class NLPStatus(enum.Enum):
 @dataclass(frozen=True)
 class NLPResult:
     """One IPOPT solve. ``x``: the variables in physical units, clipped to their bounds unless asked not
-    to (IPOPT relaxes bounds by about 1e-8); ``g``: the constraint values; ``multipliers``: ``(lam_x, lam_g)`` as the solver
-    sees them (for a warm start of the same problem); ``objective``; ``iterations``; ``wall_time_s`` [s];
-    ``return_status``: IPOPT's own words."""
+    to (IPOPT relaxes bounds by about 1e-8); ``g``: the constraint values; ``multipliers``:
+    ``(lam_x, lam_g)`` as the solver sees them (for a warm start of the same problem); ``objective``;
+    ``iterations``; ``wall_time_s`` [s]; ``return_status``: IPOPT's own words."""
 
     status: NLPStatus
     return_status: str
