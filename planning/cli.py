@@ -16,6 +16,7 @@ from typing import NoReturn
 from planning.model.laws import LAWS
 
 EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = 0, 2, 3
+EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143  # Ctrl-C, SIGTERM (128 + the signal number)
 PLOT_FORMATS = ("png", "svg", "pdf")
 
 
@@ -112,6 +113,9 @@ def _exit_code(exc: Exception, case_path: str | None) -> tuple[str, int] | None:
         return str(exc), EXIT_INPUT
     if isinstance(exc, PlanningError):  # no feasible or no verified plan
         return f"{case_path}: {exc}", EXIT_INFEASIBLE
+    if isinstance(exc, OSError):  # a file or folder the command needs cannot be used
+        where = exc.filename if exc.filename is not None else case_path
+        return f"{where}: {exc.strerror or exc}", EXIT_INPUT
     return None
 
 
@@ -152,44 +156,47 @@ def _check(case, args) -> int:
     return EXIT_OK if all(c["passed"] for c in report["checks"]) else EXIT_INFEASIBLE
 
 
-def _output_folder(case, args) -> Path:
-    """``--out`` or ``out/<case name>``, checked writable before any solving."""
+def _output_folder(case, args, owned: tuple[str, ...]) -> Path:
+    """``--out`` or ``out/<case name>``, checked before any solving: writable, and not holding the case
+    file under a name the command writes (``owned``)."""
     from planning.model.case import output_name
-    from planning.reports.folder import ensure_writable
+    from planning.reports.folder import check_case_outside, ensure_writable
 
     out = Path(args.out) if args.out else Path("out") / output_name(case)
     ensure_writable(out)
+    check_case_outside(out, args.case, owned)
     return out
 
 
 def _solve(case, args) -> int:
+    from planning.reports.folder import SOLVE_FILES
     from planning.reports.outputs import solution_writers
     from planning.reports.report import result_dict, summary_text
     from planning.solver.optimize import solve
 
     if args.law:
         case = case.with_law(args.law)
-    out = _output_folder(case, args)
+    out = _output_folder(case, args, SOLVE_FILES)
     solution = solve(case, args.placement)
     if not solution.verification.passed:  # solve() returns only verified plans; belt and braces
         raise CommandError(f"{args.case}: unverified plan not written", EXIT_INFEASIBLE)
     plot_format = None if args.no_plots else args.format
     writers = solution_writers(solution, case, cam_points=args.cam_points, plot_format=plot_format)
     result = result_dict(solution, case)
-    return _write_and_report(out, writers, result, summary_text(result), args.json)
+    return _write_and_report(out, writers, result, summary_text(result), args, SOLVE_FILES)
 
 
 def _compare(case, args) -> int:
     from planning.model.laws.improved_scurve import ImprovedSCurve
     from planning.reports.compare import comparison, comparison_markdown, comparison_text
-    from planning.reports.folder import write_json
+    from planning.reports.folder import COMPARE_FILES, write_json
     from planning.solver.optimize import solve
 
     if case.published is None or case.published.solution is None:
         raise CommandError(f"{args.case}: published.solution: the case has no published solution to compare")
     # the paper's notation describes its own law: compare under the improved S-curve
     case = case.with_law(ImprovedSCurve.name)
-    out = _output_folder(case, args)
+    out = _output_folder(case, args, COMPARE_FILES)
     ours_published = solve(case, "published")
     ours_free = solve(case, "free")
     data = comparison(case, ours_published, ours_free)
@@ -197,15 +204,16 @@ def _compare(case, args) -> int:
         "comparison.json": lambda p: write_json(p, data),
         "comparison.md": lambda p: p.write_text(comparison_markdown(data), encoding="utf-8"),
     }
-    return _write_and_report(out, writers, data, comparison_text(data), args.json)
+    return _write_and_report(out, writers, data, comparison_text(data), args, COMPARE_FILES)
 
 
-def _write_and_report(out: Path, writers: dict, data: dict, text: str, as_json: bool) -> int:
-    """Write the files all or nothing, then print ``data`` as JSON or ``text`` with the files written."""
+def _write_and_report(out: Path, writers: dict, data: dict, text: str, args, owned: tuple[str, ...]) -> int:
+    """Replace the command's files in ``out`` as a whole (never the case file), then print ``data`` as
+    JSON or ``text`` with the files written."""
     from planning.reports.folder import write_atomic
 
-    files = write_atomic(out, writers)
-    if as_json:
+    files = write_atomic(out, writers, owned, keep=args.case)
+    if args.json:
         print(json.dumps(data, indent=2))
     else:
         print(text)
@@ -266,15 +274,16 @@ def _bound(case, args) -> int:
 
 
 def _laws(case, args) -> int:
-    from planning.reports.folder import write_json
+    from planning.reports.folder import LAWS_FILES, write_json
     from planning.reports.law_comparison import compare_laws, laws_markdown, laws_text
     from planning.reports.plots import laws_figure, save
     from planning.reports.report import TRAJECTORY_COLUMNS
 
-    out = _output_folder(case, args)
+    out = _output_folder(case, args, LAWS_FILES)
     data, tables = compare_laws(case)
-    if not tables:
-        raise CommandError(f"{args.case}: no motion law gives a verified plan", EXIT_INFEASIBLE)
+    if not tables:  # each law's own reason, on the one line
+        reasons = "; ".join(f"{r['law']}: {r['status'].removeprefix('failed: ')}" for r in data["laws"])
+        raise CommandError(f"{args.case}: no motion law gives a verified plan ({reasons})", EXIT_INFEASIBLE)
     curves = {law: dict(zip(TRAJECTORY_COLUMNS, table.T, strict=True)) for law, table in tables.items()}
     title = f"{case.name}: crank motion of each law ({data['placement']} placement)"
     writers = {
@@ -282,7 +291,7 @@ def _laws(case, args) -> int:
         "laws.md": lambda p: p.write_text(laws_markdown(data), encoding="utf-8"),
         f"laws_overlay.{args.format}": lambda p: save(laws_figure(curves, title), p),
     }
-    return _write_and_report(out, writers, data, laws_text(data), args.json)
+    return _write_and_report(out, writers, data, laws_text(data), args, LAWS_FILES)
 
 
 def _plot(args) -> int:
@@ -297,9 +306,31 @@ def _plot(args) -> int:
     return EXIT_OK
 
 
+class _Terminated(BaseException):
+    """SIGTERM, raised in the main thread so that clean-up (worker processes, temporary folders) runs."""
+
+
+def _on_sigterm(signum, frame) -> NoReturn:  # noqa: ANN001 - a signal handler's signature
+    raise _Terminated
+
+
 def run() -> None:
-    """Console-script entry point."""
-    sys.exit(main())
+    """Console-script entry point: Ctrl-C ends with one line and exit 130, SIGTERM with exit 143; numpy's
+    RuntimeWarnings are never printed (every result is checked for finiteness where it matters)."""
+    import signal
+    import warnings
+
+    warnings.simplefilter("ignore", RuntimeWarning)
+    signal.signal(signal.SIGTERM, _on_sigterm)
+    try:
+        code = main()
+    except KeyboardInterrupt:
+        print("pressplan: interrupted", file=sys.stderr)
+        code = EXIT_INTERRUPTED
+    except _Terminated:
+        print("pressplan: terminated", file=sys.stderr)
+        code = EXIT_TERMINATED
+    sys.exit(code)
 
 
 if __name__ == "__main__":

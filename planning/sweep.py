@@ -241,6 +241,39 @@ class SweepResult:
     repaired: int = 0
 
 
+def _read_spec(path: Path, out: Path) -> Any:
+    """The sweep definition an earlier run wrote (None when there is none)."""
+    if not path.exists():
+        return None
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise SweepError(f"{out}: sweep.json cannot be read ({_reason(exc)}); choose another --out") from None
+
+
+def _earlier_rows(path: Path, out: Path, count: int) -> dict[int, dict[str, Any]]:
+    """Rows of an earlier run of this sweep by grid index; a table that is not this sweep's is an error."""
+    try:
+        rows = _read_rows(path)
+    except (OSError, ValueError, csv.Error) as exc:
+        raise SweepError(f"{out}: sweep.csv cannot be read ({_reason(exc)}); choose another --out") from None
+    earlier = {}
+    for n, row in enumerate(rows, start=2):
+        if not row.get("status"):
+            continue
+        text = row.get("index")
+        if text is None or not text.isdigit() or int(text) >= count:
+            raise SweepError(
+                f"{out}: sweep.csv line {n}: index {text!r} is not a point of this sweep; choose another --out"
+            )
+        earlier[int(text)] = row
+    return earlier
+
+
+def _reason(exc: Exception) -> str:
+    return getattr(exc, "strerror", None) or " ".join(str(exc).split())[:100]
+
+
 def _read_rows(path: Path) -> list[dict[str, Any]]:
     if not path.exists():
         return []
@@ -269,14 +302,14 @@ def run_sweep(
         "placement": placement,
     }
     spec_path, csv_path = out / "sweep.json", out / "sweep.csv"
-    if spec_path.exists() and json.loads(spec_path.read_text(encoding="utf-8")) != spec:
+    if _read_spec(spec_path, out) not in (None, spec):
         raise SweepError(f"{out}: holds a different sweep (sweep.json); choose another --out")
     spec_path.write_text(json.dumps(spec, indent=2) + "\n", encoding="utf-8")
-    done = {int(r["index"]) for r in _read_rows(csv_path) if r.get("status")}
+    earlier = _earlier_rows(csv_path, out, len(points))
+    done = set(earlier)
     pending = [i for i in range(len(points)) if i not in done]
     columns = ["index", *fields, *ROW_FIELDS]
     new_file = not csv_path.exists() or csv_path.stat().st_size == 0
-    earlier = {int(r["index"]): r for r in _read_rows(csv_path) if r.get("status")}
     failed = sum(1 for r in earlier.values() if r["status"] != "verified")
     finished = len(done)
     fresh: dict[int, dict[str, Any]] = {}
@@ -343,7 +376,22 @@ def _execute(base, fields, work, placement, label, workers, scheduler) -> Iterat
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
     ctx = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
-    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_signals)
+    try:
         futures = [pool.submit(solve_block, base, fields, blk, placement, label) for blk in work]
         for fut in as_completed(futures):
             yield fut.result()
+    except BaseException:  # Ctrl-C, SIGTERM, a failed write: no worker outlives the sweep
+        for process in list(getattr(pool, "_processes", {}).values()):
+            process.terminate()
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    pool.shutdown()
+
+
+def _worker_signals() -> None:
+    """In a worker process: Ctrl-C is the parent's to handle; SIGTERM (from the parent) just ends it."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)

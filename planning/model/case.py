@@ -50,16 +50,29 @@ class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False, frozen=True)
 
 
-Positive = Annotated[float, Field(gt=0)]
-NonNegative = Annotated[float, Field(ge=0)]
-Angle = Annotated[float, Field(ge=0, lt=360)]
+# Every number of a case lies in a stated range, wide enough for any press and narrow enough that no
+# arithmetic on a case can overflow or underflow (the reader's guarantee; see the README).
+Length = Annotated[float, Field(ge=0.1, le=20_000)]  # [mm] press dimensions and heights
+Height = Annotated[float, Field(ge=0, le=40_000)]  # [mm above BDC]
+Angle = Annotated[float, Field(ge=0, lt=360)]  # [deg from TDC]
+Seconds = Annotated[float, Field(ge=1e-3, le=1e5)]  # [s]
+CrankSpeed = Annotated[float, Field(ge=1e-3, le=1e4)]  # [rpm]
+SliderSpeed = Annotated[float, Field(ge=1e-3, le=1e6)]  # [mm/s]
+SliderAccel = Annotated[float, Field(ge=1e-2, le=1e9)]  # [mm/s^2]
+CrankAccel = Annotated[float, Field(ge=1e-4, le=1e6)]  # [rad/s^2]
+CrankJerk = Annotated[float, Field(ge=1e-4, le=1e9)]  # [rad/s^3]
+ShapeValue = Annotated[float, Field(gt=0, le=1e3)]  # a law's shape parameter (checked per law)
+SourceNumber = Annotated[float, Field(ge=-1e9, le=1e9)]  # a number printed by the source
+SourceTime = Annotated[float, Field(ge=0, le=1e4)]  # [s] a time printed by the source
+SourceDuration = Annotated[float, Field(gt=0, le=1e4)]  # [s]
+SourceSpeed = Annotated[float, Field(gt=0, le=1e5)]  # [rpm]
 
 
 class PressModel(_Model):
     """The machine: ``crank_radius_mm`` [mm], ``rod_length_mm`` [mm]."""
 
-    crank_radius_mm: Positive
-    rod_length_mm: Positive
+    crank_radius_mm: Length
+    rod_length_mm: Length
 
 
 class KeyPointsModel(_Model):
@@ -74,23 +87,23 @@ class KeyPointsModel(_Model):
 class ProcessModel(_Model):
     """``safety_height_mm`` [mm above BDC], ``transfer_time_s`` [s], ``draw_speed_rpm`` [rpm] or None."""
 
-    safety_height_mm: Positive
-    transfer_time_s: Positive
-    draw_speed_rpm: Positive | None = None
+    safety_height_mm: Annotated[float, Field(gt=0, le=40_000)]
+    transfer_time_s: Seconds
+    draw_speed_rpm: CrankSpeed | None = None
 
 
 class LimitsModel(_Model):
     """Process and machine limits [units in the names]; ``min_crank_speed_rpm`` keeps the crank turning
     forward; ``crank_speed_rpm``, ``crank_accel_rad_s2``, ``crank_jerk_rad_s3`` are the drive's limits."""
 
-    draw_start_speed_mm_s: Positive
-    die_height_mm: NonNegative
-    die_speed_mm_s: Positive
-    slider_accel_mm_s2: Positive
-    min_crank_speed_rpm: Positive = 1.0
-    crank_speed_rpm: Positive | None = None  # motor limits (optional), on the crank
-    crank_accel_rad_s2: Positive | None = None
-    crank_jerk_rad_s3: Positive | None = None
+    draw_start_speed_mm_s: SliderSpeed
+    die_height_mm: Height
+    die_speed_mm_s: SliderSpeed
+    slider_accel_mm_s2: SliderAccel
+    min_crank_speed_rpm: CrankSpeed = 1.0
+    crank_speed_rpm: CrankSpeed | None = None  # motor limits (optional), on the crank
+    crank_accel_rad_s2: CrankAccel | None = None
+    crank_jerk_rad_s3: CrankJerk | None = None
 
 
 class PlannerModel(_Model):
@@ -99,14 +112,14 @@ class PlannerModel(_Model):
 
     motion_law: LawName = DEFAULT_LAW
     placement: Placement = "free"
-    law_parameter: Positive | None = None
+    law_parameter: ShapeValue | None = None
 
 
 class PublishedKeyPoint(_Model):
     """A published key point: ``height_mm`` [mm], ``slider_speed_mm_s`` [mm/s] (magnitude)."""
 
-    height_mm: float | None = None
-    slider_speed_mm_s: float | None = None
+    height_mm: SourceNumber | None = None
+    slider_speed_mm_s: SourceNumber | None = None
 
 
 class PublishedKeyPoints(_Model):
@@ -117,27 +130,28 @@ class PublishedKeyPoints(_Model):
 
 
 class PublishedSolution(_Model):
-    """The paper's X = [x1..x5, wm1, wm2, T1, T5, T9, T10, T14, J]: times [s], speeds [rpm], J [rpm/s^2]."""
+    """The paper's X = [x1..x5, wm1, wm2, T1, T5, T9, T10, T14, J]: times [s], speeds [rpm], J [rpm/s^2].
+    Sub-segment lengths and speeds are positive (the rebuilt profile divides by them)."""
 
-    x1_s: float
-    x2_s: float
-    x3_s: float
-    x4_s: float
-    x5_s: float
-    wm1_rpm: float
-    wm2_rpm: float
-    T1_s: float
-    T5_s: float
-    T9_s: float
-    T10_s: float
-    T14_s: float
-    J_rpm_s2: float
+    x1_s: SourceTime
+    x2_s: SourceTime
+    x3_s: SourceTime
+    x4_s: SourceTime
+    x5_s: SourceDuration
+    wm1_rpm: SourceSpeed
+    wm2_rpm: SourceSpeed
+    T1_s: SourceDuration
+    T5_s: SourceDuration
+    T9_s: SourceDuration
+    T10_s: SourceDuration
+    T14_s: SourceDuration
+    J_rpm_s2: SourceNumber
 
 
 class PublishedModel(_Model):
     """The source's own numbers, kept for comparison only (never read by the solver)."""
 
-    spm: Positive | None = None
+    spm: Annotated[float, Field(gt=0, le=1e4)] | None = None
     key_points: PublishedKeyPoints | None = None
     solution: PublishedSolution | None = None
 
@@ -146,8 +160,8 @@ class Case(_Model):
     """A whole case file."""
 
     name: Annotated[str, Field(min_length=1, max_length=100)]
-    title: str = ""
-    source: str = ""
+    title: Annotated[str, Field(max_length=2000)] = ""
+    source: Annotated[str, Field(max_length=2000)] = ""
     press: PressModel
     key_points: KeyPointsModel
     process: ProcessModel

@@ -1,17 +1,75 @@
-"""Reading a case file (YAML) into a validated :class:`~planning.model.case.Case` (the only case I/O)."""
+"""Reading a case file (YAML) into a validated :class:`~planning.model.case.Case` (the only case I/O).
+
+A case file is untrusted input. The reader bounds what it can cost: at most :data:`MAX_BYTES`
+bytes, nesting at most :data:`MAX_DEPTH` deep, at most :data:`MAX_NODES` YAML nodes, and no aliases
+(``*name``: the alias bomb's tool; a case never needs one). A key given twice in one mapping is an
+error naming it (YAML's "last one wins" would hide a typo). Numbers follow YAML 1.2: ``3.5e3`` and
+``1e-2`` are numbers, as an engineer means them (the YAML 1.1 loader reads them as strings). Every
+value is then range-checked by the case model (``planning.model.case``), so no arithmetic on a
+case can overflow.
+"""
 
 from __future__ import annotations
 
 import difflib
+import re
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import yaml
 from pydantic import BaseModel, ValidationError
 
 from planning.model.case import Case, CaseError, cross_checks, show_value
 
-MAX_BYTES = 1_000_000
+MAX_BYTES = 256_000  # a case is about 2 kB
+MAX_DEPTH = 12  # a case nests 4 deep
+MAX_NODES = 5_000  # a case has about 60
+# YAML 1.2 floats that YAML 1.1 reads as strings: an exponent without a sign or without a decimal point
+_FLOAT_12 = re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9][0-9_]*)[eE][-+]?[0-9]+$")
+
+
+class _CaseLoader(yaml.SafeLoader):
+    """PyYAML's safe loader with the limits above; YAML 1.2 exponent floats; no aliases."""
+
+    yaml_implicit_resolvers = {k: list(v) for k, v in yaml.SafeLoader.yaml_implicit_resolvers.items()}
+
+    def __init__(self, stream: str):
+        super().__init__(stream)
+        self.depth = 0
+        self.nodes = 0
+
+    def compose_node(self, parent, index):  # noqa: ANN001 - PyYAML's signature
+        if self.check_event(yaml.AliasEvent):
+            event = self.peek_event()
+            raise _Refused(event.start_mark, f"aliases (*{event.anchor}) are not allowed in a case file")
+        self.depth += 1
+        self.nodes += 1
+        if self.depth > MAX_DEPTH:
+            raise _Refused(self.peek_event().start_mark, f"nested more than {MAX_DEPTH} levels deep")
+        if self.nodes > MAX_NODES:
+            raise _Refused(self.peek_event().start_mark, f"more than {MAX_NODES} values")
+        try:
+            return super().compose_node(parent, index)
+        finally:
+            self.depth -= 1
+
+
+_CaseLoader.add_implicit_resolver("tag:yaml.org,2002:float", _FLOAT_12, list("-+0123456789."))
+# YAML 1.1 reads 1:30 as 90 (base 60) and 010 as 8 (octal): numbers no engineer means. They stay
+# strings, so the case model rejects them as "not a number" instead of reading a different value.
+_MISREAD = re.compile(r"^[-+]?(?:[0-9][0-9_]*(?::[0-5]?[0-9])+(?:\.[0-9_]*)?|0[0-7_]+)$")
+for _first in "-+0123456789":
+    _CaseLoader.yaml_implicit_resolvers[_first].insert(0, ("tag:yaml.org,2002:str", _MISREAD))
+
+
+class _Refused(Exception):
+    """A YAML document the reader will not load: where (a PyYAML mark) and why."""
+
+    def __init__(self, mark, problem: str):  # noqa: ANN001 - a PyYAML mark
+        super().__init__(problem)
+        self.mark = mark
+        self.problem = problem
 
 
 class CaseFileError(ValueError):
@@ -22,16 +80,51 @@ def read_case(path: str | Path) -> Case:
     """Read, parse and validate a case file; raises :class:`CaseFileError` with a one-line message."""
     path = Path(path)
     raw = _read_text(path)
+    return case_from_data(load_yaml(raw, str(path)), str(path))
+
+
+def load_yaml(text: str, label: str = "<case>") -> Any:
+    """Parse YAML text within the reader's limits; :class:`CaseFileError` (one line) if it cannot be."""
+    loader = None
     try:
-        data = yaml.safe_load(raw)
+        loader = _CaseLoader(text)
+        node = loader.get_single_node()
+        if node is None:
+            return None
+        _check_duplicate_keys(node, label)
+        return loader.construct_document(node)
+    except _Refused as exc:
+        where = f"line {exc.mark.line + 1}, column {exc.mark.column + 1}: " if exc.mark else ""
+        raise CaseFileError(f"{label}: {where}{exc.problem}") from None
+    except RecursionError:  # not reached within the depth limit; kept so no input can show a traceback
+        raise CaseFileError(f"{label}: nested too deeply") from None
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         where = f"line {mark.line + 1}, column {mark.column + 1}: " if mark else ""
         problem = exc.problem or exc.context or "invalid YAML"
-        raise CaseFileError(f"{path}: YAML syntax error: {where}{problem}") from None
+        raise CaseFileError(f"{label}: YAML syntax error: {where}{problem}") from None
     except yaml.YAMLError as exc:
-        raise CaseFileError(f"{path}: YAML syntax error: {_first_line(str(exc))}") from None
-    return case_from_data(data, str(path))
+        raise CaseFileError(f"{label}: YAML syntax error: {_first_line(str(exc))}") from None
+    finally:
+        if loader is not None:
+            loader.dispose()
+
+
+def _check_duplicate_keys(node: yaml.Node, label: str, path: tuple[str, ...] = ()) -> None:
+    """Raise :class:`CaseFileError` naming the first key that a mapping holds twice."""
+    if isinstance(node, yaml.MappingNode):
+        seen: set[str] = set()
+        for key_node, value_node in node.value:
+            key = str(key_node.value)
+            field = ".".join((*path, key))
+            if key in seen:
+                line = key_node.start_mark.line + 1
+                raise CaseFileError(f"{label}: {field}: duplicate key (line {line}; each key at most once)")
+            seen.add(key)
+            _check_duplicate_keys(value_node, label, (*path, key))
+    elif isinstance(node, yaml.SequenceNode):
+        for i, item in enumerate(node.value):
+            _check_duplicate_keys(item, label, (*path, str(i)))
 
 
 def case_from_data(data: Any, label: str = "<case>") -> Case:
@@ -45,9 +138,12 @@ def case_from_data(data: Any, label: str = "<case>") -> Case:
     except ValidationError as exc:
         raise CaseFileError(_pydantic_line(exc, data, label)) from None
     try:
-        cross_checks(case)
+        with np.errstate(all="ignore"):
+            cross_checks(case)
     except CaseError as exc:
         raise CaseFileError(exc.line(label)) from None
+    except (ArithmeticError, ValueError) as exc:  # the ranges should prevent it; never a traceback
+        raise CaseFileError(f"{label}: the numbers cannot be used together ({_first_line(str(exc))})") from None
     return case
 
 

@@ -58,12 +58,11 @@ def plot_writers(folder: Path, plot_format: str = "png") -> dict[str, Callable[[
         traj = read_table(folder / "trajectory.csv")
         pub_path = folder / "published_profile.csv"
         published = read_table(pub_path) if pub_path.exists() else None
-    except (OSError, ValueError, KeyError) as exc:
-        raise OutputError(f"{folder}: not a finished pressplan output folder ({exc})") from None
-    return {
-        name: (lambda p, fig=fig: save(fig, p))
-        for name, fig in plot_files(result, traj, published, plot_format).items()
-    }
+        figures = plot_files(result, traj, published, plot_format)
+    except (OSError, ValueError, KeyError, IndexError, TypeError, AttributeError) as exc:
+        reason = " ".join(str(exc).split())[:120] or type(exc).__name__
+        raise OutputError(f"{folder}: not a finished pressplan output folder ({reason})") from None
+    return {name: (lambda p, fig=fig: save(fig, p)) for name, fig in figures.items()}
 
 
 def write_outputs(

@@ -5,6 +5,7 @@ time from TDC, one against crank angle. Key points marked, limits dashed, stages
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -24,15 +25,23 @@ FIGURES = ("motion_vs_time", "motion_vs_angle")
 
 
 def read_table(path: Path) -> dict[str, np.ndarray]:
-    """A CSV with a header row (after any ``#`` comment lines) as columns by name."""
+    """A CSV with a header row (after any ``#`` comment lines) as columns by name; ``ValueError`` when
+    it has no header, no rows or rows that do not fit the header."""
     skip = 0
+    header = None
     with open(path, encoding="utf-8") as fh:
         for line in fh:
             skip += 1
             if not line.startswith("#"):
                 header = line.strip().split(",")
                 break
-    data = np.loadtxt(path, delimiter=",", skiprows=skip, ndmin=2)
+    if header is None:
+        raise ValueError(f"{path.name} has no header row")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # an empty table is reported below, not warned about
+        data = np.loadtxt(path, delimiter=",", skiprows=skip, ndmin=2)
+    if data.shape[0] < 2 or data.shape[1] != len(header):
+        raise ValueError(f"{path.name} has {data.shape[0]} rows of {data.shape[1]} columns under {len(header)} names")
     return {name: data[:, i] for i, name in enumerate(header)}
 
 

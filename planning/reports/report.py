@@ -30,12 +30,14 @@ TRAJECTORY_COLUMNS = (
     "slider_accel_mm_s2",
 )
 BINDING_SHARE = 1e-4  # a check within this share of its limit is reported as binding
+MAX_ROWS = 200_000  # trajectory rows at most: a cycle longer than 200 s gets a step of period / MAX_ROWS
 
 
 def sample_profile(profile: Profile, machine: CrankSlider, max_step: float = MAX_STEP_S) -> np.ndarray:
-    """``profile`` over its whole duration on a uniform time grid with step <= ``max_step`` [s];
-    columns as :data:`TRAJECTORY_COLUMNS`; the first and last rows are the profile's ends."""
-    n = int(math.ceil(profile.duration / max_step))
+    """``profile`` over its whole duration on a uniform time grid with step <= ``max_step`` [s] (at most
+    :data:`MAX_ROWS` + 1 rows: a coarser uniform step for a long cycle); columns as
+    :data:`TRAJECTORY_COLUMNS`; the first and last rows are the profile's ends."""
+    n = min(int(math.ceil(profile.duration / max_step)), MAX_ROWS)
     t = np.linspace(0.0, profile.duration, n + 1)
     th, om, al, je = profile.at_time(profile.t0 + t)
     h, v, a, _ = machine.slider(th, om, al, je)

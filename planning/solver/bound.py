@@ -100,13 +100,32 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
     th1, th2, th3, th4 = case.key_angles
     w_min = lim.min_crank_speed_rpm * RPM
 
-    s = ca.MX.sym("s", n)  # s at nodes 0..n-1; node n is node 0
-    tau = ca.MX.sym("tau", n)
+    draw = np.flatnonzero((th[:-1] >= th2 - 1e-12) & (th[:-1] <= th3 + 1e-12))
+    lbx_s = np.full(n, w_min**2)
+    ubx_s = np.full(n, (lim.crank_speed_rpm * RPM) ** 2 if lim.crank_speed_rpm is not None else np.inf)
+    lbx_s[draw] = w2_lo**2
+    ubx_s[draw] = w2_hi**2
+    low = (h[:-1] <= lim.die_height_mm) & (np.abs(d1[:-1]) > 0)
+    ubx_s[low] = np.minimum(ubx_s[low], (lim.die_speed_mm_s / np.abs(d1[:-1][low])) ** 2)
+    if np.any(ubx_s < lbx_s):
+        raise Infeasible(
+            "the die-height speed limit leaves no crank speed above the minimum", limit="limits.die_speed_mm_s"
+        )
+    # scales: each node's speed^2 near the speed the slider-acceleration limit allows at constant speed,
+    # within the node's bounds; each interval's time accordingly. A draw at 0.001 rpm and a stroke at
+    # 30 rpm then both solve with variables of order one.
+    w_acc2 = lim.slider_accel_mm_s2 / (m.crank_radius + m.crank_radius**2 / m.rod_length)
+    s_unit = np.clip(np.full(n, w_acc2), lbx_s, ubx_s)
+    tau_unit = dth / np.sqrt(s_unit)
+    x_s = ca.MX.sym("s", n)  # scaled speed^2 at nodes 0..n-1; node n is node 0
+    x_tau = ca.MX.sym("tau", n)
+    s = ca.DM(s_unit) * x_s
+    tau = ca.DM(tau_unit) * x_tau
     s_next = ca.vertcat(s[1:], s[0])
     alpha = (s_next - s) / (2 * dth)
     a_start = d2[:-1] * s + d1[:-1] * alpha
     a_end = d2[1:] * s_next + d1[1:] * alpha
-    g = [tau - 2 * dth / (ca.sqrt(s) + ca.sqrt(s_next)), a_start, a_end]
+    g = [(tau - 2 * dth / (ca.sqrt(s) + ca.sqrt(s_next))) / tau_unit, a_start, a_end]
     lbg = [np.zeros(n), -lim.slider_accel_mm_s2 * np.ones(n), -lim.slider_accel_mm_s2 * np.ones(n)]
     ubg = [np.full(n, np.inf), lim.slider_accel_mm_s2 * np.ones(n), lim.slider_accel_mm_s2 * np.ones(n)]
     if lim.crank_accel_rad_s2 is not None:  # the drive's acceleration limit, linear in s
@@ -124,25 +143,13 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
     g.append(ca.sum1(tau[np.flatnonzero(window).tolist()]))
     lbg.append(np.array([case.process.transfer_time_s]))
     ubg.append(np.array([np.inf]))
-    draw = np.flatnonzero((th[:-1] >= th2 - 1e-12) & (th[:-1] <= th3 + 1e-12))
     if draw.size > 1:  # one speed through the draw
         g.append(s[draw[1:].tolist()] - s[draw[:-1].tolist()])
         lbg.append(np.zeros(draw.size - 1))
         ubg.append(np.zeros(draw.size - 1))
-    lbx_s = np.full(n, w_min**2)
-    ubx_s = np.full(n, (lim.crank_speed_rpm * RPM) ** 2 if lim.crank_speed_rpm is not None else np.inf)
-    lbx_s[draw] = w2_lo**2
-    ubx_s[draw] = w2_hi**2
-    low = (h[:-1] <= lim.die_height_mm) & (np.abs(d1[:-1]) > 0)
-    ubx_s[low] = np.minimum(ubx_s[low], (lim.die_speed_mm_s / np.abs(d1[:-1][low])) ** 2)
-    if np.any(ubx_s < lbx_s):
-        raise Infeasible(
-            "the die-height speed limit leaves no crank speed above the minimum", limit="limits.die_speed_mm_s"
-        )
-    x = ca.vertcat(s, tau)
-    nlp = {"x": x, "f": ca.sum1(tau), "g": ca.vertcat(*g)}
-    solver = NLPSolver("bound", nlp, BOUND_OPTIONS)
-    s0 = np.clip(np.full(n, (0.5 * (w2_lo + w2_hi)) ** 2), lbx_s, np.where(np.isfinite(ubx_s), ubx_s, np.inf))
+    nlp = {"x": ca.vertcat(x_s, x_tau), "f": ca.sum1(tau), "g": ca.vertcat(*g)}
+    solver = NLPSolver("bound", nlp, BOUND_OPTIONS, fixed_scale=np.concatenate([s_unit, tau_unit]))
+    s0 = s_unit  # the scales: speeds the slider-acceleration limit allows, within every bound
     x0 = np.concatenate([s0, 2 * dth / (2 * np.sqrt(s0))])
     lbx = np.concatenate([lbx_s, np.zeros(n)])
     ubx = np.concatenate([ubx_s, np.full(n, np.inf)])

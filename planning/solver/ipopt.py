@@ -15,19 +15,27 @@ back, so callers only see physical values.
 
 from __future__ import annotations
 
+import contextlib
 import enum
+import io
+import signal
+import sys
+import threading
 import time
 from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
 
+MAX_SOLVE_WALL_S = 30.0  # [s] one IPOPT call at most (a normal one takes well under a second)
 BASE_OPTIONS = {
     "ipopt.print_level": 0,
     "print_time": False,
     "ipopt.sb": "yes",
     "ipopt.tol": 1e-10,
+    "ipopt.max_wall_time": MAX_SOLVE_WALL_S,
 }
+_SIGNALS = ("SIGINT", "SIGTERM")
 WARM_START_OPTIONS = {  # a start from a nearby solution and its multipliers: a few iterations
     "ipopt.warm_start_init_point": "yes",
     "ipopt.mu_init": 1e-6,
@@ -42,7 +50,7 @@ class NLPStatus(enum.Enum):
 
     SOLVED = "solved"  # Solve_Succeeded
     ACCEPTABLE = "acceptable"  # Solved_To_Acceptable_Level
-    ITERATION_LIMIT = "iteration limit"  # Maximum_Iterations_Exceeded, Maximum_CpuTime_Exceeded, ...
+    STOPPED_AT_LIMIT = "stopped at its iteration or time limit"  # Maximum_Iterations_Exceeded, ..._WallTime_...
     LOCALLY_INFEASIBLE = "locally infeasible"  # Infeasible_Problem_Detected (a local statement only)
     FAILED = "failed"  # anything else: restoration failed, numerical trouble, ...
 
@@ -53,8 +61,8 @@ class NLPStatus(enum.Enum):
             return cls.SOLVED
         if return_status == "Solved_To_Acceptable_Level":
             return cls.ACCEPTABLE
-        if return_status.startswith("Maximum_") or return_status == "Maximum_Iterations_Exceeded":
-            return cls.ITERATION_LIMIT
+        if return_status.startswith("Maximum_"):
+            return cls.STOPPED_AT_LIMIT
         if return_status == "Infeasible_Problem_Detected":
             return cls.LOCALLY_INFEASIBLE
         return cls.FAILED
@@ -85,11 +93,14 @@ class NLPResult:
 class NLPSolver:
     """IPOPT on one CasADi problem ``{"x", "p", "f", "g"}``, compiled once and solved many times.
 
-    ``options`` are added to :data:`BASE_OPTIONS`; the warm-start variant (same problem, IPOPT set up
-    for a start from a nearby solution's multipliers) is built on first use.
+    ``options`` are added to :data:`BASE_OPTIONS`; ``fixed_scale``: the scales of a problem built in
+    scaled variables with its scales as constants (physical = fixed_scale * x); the warm-start
+    variant (same problem, IPOPT set up for a start from a nearby solution's multipliers) is built on
+    first use.
     """
 
-    def __init__(self, name: str, problem: dict, options: dict | None = None):
+    def __init__(self, name: str, problem: dict, options: dict | None = None, fixed_scale: np.ndarray | None = None):
+        self.fixed_scale = None if fixed_scale is None else np.asarray(fixed_scale, dtype=float)
         self.name = name
         self.problem = problem
         self.options = {**BASE_OPTIONS, **(options or {})}
@@ -122,7 +133,10 @@ class NLPSolver:
         """
         t0 = time.perf_counter()
         lbx, ubx = np.asarray(lbx, dtype=float), np.asarray(ubx, dtype=float)
-        unit = np.ones(lbx.shape) if scale is None else np.asarray(scale, dtype=float)
+        if scale is not None:
+            unit = np.asarray(scale, dtype=float)
+        else:
+            unit = self.fixed_scale if self.fixed_scale is not None else np.ones(lbx.shape)
         args = {
             "x0": np.clip(np.asarray(x0, dtype=float), lbx, ubx) / unit,
             "lbx": lbx / unit,
@@ -137,7 +151,7 @@ class NLPSolver:
         if warm_start is not None:
             solver = self._warm_function()
             args.update(lam_x0=warm_start[0], lam_g0=warm_start[1])
-        res = solver(**args)
+        res = _call_passing_signals_on(solver, args)
         stats = solver.stats()
         x = np.array(res["x"]).ravel() * unit
         return_status = str(stats["return_status"])
@@ -151,3 +165,39 @@ class NLPSolver:
             iterations=int(stats["iter_count"]),
             wall_time_s=time.perf_counter() - t0,
         )
+
+
+def _call_passing_signals_on(solver: ca.Function, args: dict) -> dict:
+    """Call ``solver``; a Ctrl-C or SIGTERM that arrives meanwhile is delivered again after the call.
+
+    CasADi catches an interrupt inside IPOPT and ends the solve as a failed one
+    (``NonIpopt_Exception_Thrown``): the signal would be lost and the next start would run on. Here
+    the signal is recorded, the solve is stopped, and once CasADi has returned the signal is raised
+    again with the process's own handlers (exit 130 or 143 in the CLI); CasADi's warning about it is
+    dropped, anything else it writes to stderr passes through. Only the main thread can set
+    signal handlers; elsewhere (a Dask worker thread) the call is plain.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        return solver(**args)
+    caught: list[int] = []
+
+    def record(signum: int, frame) -> None:  # noqa: ANN001 - a signal handler's signature
+        caught.append(signum)
+        raise KeyboardInterrupt  # stops IPOPT at its next check
+
+    numbers = [getattr(signal, name) for name in _SIGNALS if hasattr(signal, name)]
+    numbers = [num for num in numbers if signal.getsignal(num) is not signal.SIG_IGN]  # ignored stays ignored
+    previous = {num: signal.signal(num, record) for num in numbers}
+    said = io.StringIO()  # CasADi reports a caught interrupt as a warning on sys.stderr
+    try:
+        with contextlib.redirect_stderr(said):
+            res = solver(**args)
+    finally:
+        for num, handler in previous.items():
+            signal.signal(num, handler)
+        lines = said.getvalue().splitlines(keepends=True)
+        sys.stderr.write("".join(ln for ln in lines if not (caught and "KeyboardInterruptException" in ln)))
+    if caught:
+        signal.raise_signal(caught[0])  # the process's own handler decides (KeyboardInterrupt, exit, ...)
+        raise KeyboardInterrupt  # a handler that returned: the solve was stopped all the same
+    return res

@@ -113,6 +113,29 @@ class ConstraintBlock:
     start: int
     stop: int
 
+    @property
+    def case_field(self) -> str:
+        """The case field this block enforces (what a user can change), :data:`BLOCK_FIELDS`."""
+        return BLOCK_FIELDS[self.name]
+
+
+# the case field behind each constraint block: a failure message names what the user can change
+BLOCK_FIELDS = {
+    "peak speeds above their ends": "planner.motion_law",
+    "one jerk per S-curve (Eq. 14)": "planner.motion_law",
+    "cycle closes": "key_points",
+    "key angles": "key_points",
+    "transfer time": "process.transfer_time_s",
+    "key points in order": "key_points",
+    "key angles (published placement)": "planner.placement",
+    "die crossing angles": "limits.die_height_mm",
+    "die-height speed": "limits.die_speed_mm_s",
+    "slider acceleration": "limits.slider_accel_mm_s2",
+    "crank speed limit": "limits.crank_speed_rpm",
+    "crank acceleration limit": "limits.crank_accel_rad_s2",
+    "crank jerk limit": "limits.crank_jerk_rad_s3",
+}
+
 
 def _angle_at(t: ca.SX, starts: list, states: list, segs: list[Segment]) -> tuple[ca.SX, ca.SX]:
     """Closed-form crank angle and speed at time ``t`` [s] over the segments (clip formulation): the
@@ -168,10 +191,16 @@ class CycleNLP:
 
     def worst_violation(self, placement: Placement, g: np.ndarray) -> tuple[str, float]:
         """The constraint block with the largest violation at ``g`` (the last iterate)."""
+        worst = self.worst_block(placement, g)
         lbg, ubg = self.bounds(placement)
         viol = np.maximum(lbg - g, 0) + np.maximum(g - ubg, 0)
-        worst = max(self.blocks, key=lambda b: float(np.max(viol[b.start : b.stop], initial=0.0)))
         return worst.name, float(np.max(viol[worst.start : worst.stop], initial=0.0))
+
+    def worst_block(self, placement: Placement, g: np.ndarray) -> ConstraintBlock:
+        """The block with the largest violation at ``g``."""
+        lbg, ubg = self.bounds(placement)
+        viol = np.maximum(lbg - g, 0) + np.maximum(g - ubg, 0)
+        return max(self.blocks, key=lambda b: float(np.max(viol[b.start : b.stop], initial=0.0)))
 
 
 def values_of(result: NLPResult) -> dict[str, float]:

@@ -22,6 +22,7 @@ from planning.model.laws import get_law
 from planning.model.laws import improved_scurve as sc
 from planning.model.plan import Plan, SolverInfo, params_from_numbers, profile_from_tdc
 from planning.solver.nlp import (
+    BLOCK_FIELDS,
     PARAMETER_INDEX,
     PARAMETERS,
     VARIABLE_INDEX,
@@ -32,12 +33,13 @@ from planning.solver.nlp import (
     variable_scales,
 )
 from planning.solver.outcomes import Attempt, Infeasible, NoPlanFound, Unverified
-from planning.solver.verify import CheckId, Verification, verify
+from planning.solver.verify import CHECK_FIELDS, CheckId, Verification, verify
 
 ACCEL_BACKOFF = 5e-4  # the NLP keeps |slider acceleration| <= (1 - backoff) * limit at its samples
 MIN_HALF_S = 4e-3  # [s] lower bound on the duration of a half (1 ms per improved-S-curve sub-segment)
-MAX_TIME_S = 600.0  # [s] upper bound on any time variable
-REFINEMENTS = 3  # re-solves with a lowered sampled acceleration limit
+MAX_TIME_S = 600.0  # [s] least upper bound on a time variable (see _bounds)
+REFINEMENTS = 8  # re-solves with a lowered sampled acceleration limit
+HARDER_BACKOFF = 5e-3  # when no start verifies: once more with this back-off on the sampled limits
 NO_LIMIT = 1e9  # stands for an absent motor limit in the NLP's parameters
 AGREE_S = 1e-6  # [s] two starts whose best periods agree this closely have found the same optimum
 
@@ -166,9 +168,11 @@ def _guess(case: Case, w2: float, w1: float, peak_share: float, inside: float) -
 
 
 def _bounds(case: Case, w2_lo: float, w2_hi: float, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    lo = np.zeros(len(VARIABLES))
-    hi = np.full(len(VARIABLES), MAX_TIME_S)
     w_min = case.limits.min_crank_speed_rpm * RPM
+    # every time of a cycle lies within one period, and the crank never turns slower than w_min: the
+    # period is at most 2 pi / w_min. The bound scales with the case; 600 s keeps the usual cases' numerics.
+    lo = np.zeros(len(VARIABLES))
+    hi = np.full(len(VARIABLES), max(MAX_TIME_S, 1.01 * 2 * math.pi / w_min))
     i = VARIABLE_INDEX
     lo[i["transfer_speed"]], hi[i["transfer_speed"]] = w_min, 1e3
     lo[i["draw_speed"]], hi[i["draw_speed"]] = w2_lo, w2_hi
@@ -244,7 +248,8 @@ class _Search:
             self.iterations += res.iterations
             if not res.success:
                 block, amount = self.nlp.worst_violation(placement, res.g)
-                self.attempts.append(Attempt(solver_status=res.return_status, worst_block=block, violation=amount))
+                field = BLOCK_FIELDS[block]
+                self.attempts.append(Attempt(res.return_status, block, amount, case_field=field))
                 return None
             info = SolverInfo(self.iterations, time.perf_counter() - self.t_start, self.starts, res.return_status)
             plan = _plan(self.case, values, placement, info)
@@ -254,7 +259,7 @@ class _Search:
                     self.best = Solution(plan, check)
                 return values, plan.period
             bad = check.failures()
-            self.attempts.append(Attempt(check=bad[0]))
+            self.attempts.append(Attempt(check=bad[0], case_field=CHECK_FIELDS.get(bad[0].id, "")))
             if [c.id for c in bad] != [CheckId.SLIDER_ACCEL]:
                 return None
             q[PARAMETER_INDEX["accel_limit"]] *= (bad[0].limit / bad[0].value) * (1 - 1e-5)
@@ -287,7 +292,11 @@ class _Search:
             if found:
                 raise Unverified("no plan meets the limits: " + found[0].describe(), found[0].check)
             last = self.attempts[-1].describe() if self.attempts else "no start"
-            raise NoPlanFound("no plan meets the limits: " + last, tuple(self.attempts))
+            raise NoPlanFound(
+                f"the solver found none from {self.starts} starts, which does not prove the limits "
+                f"cannot be met; last: {last}",
+                tuple(self.attempts),
+            )
         plan = self.best.plan
         if self.placement == "free" and plan.placement == "published":
             # the published structure is one of the free structures: report it as the free answer
@@ -312,10 +321,26 @@ def solve(
     neighbour = _adopt(search, neighbour)
     if follow and _follow(search, neighbour):
         return search.answer()
+    _multi_start(search, neighbour)
+    if search.best is None:
+        _try_harder(search, neighbour)
+    return search.answer()
+
+
+def _multi_start(search: _Search, neighbour: Plan | None) -> None:
+    """The published placement's starts, then (free placement) the free starts from its best plan."""
     published = search.multi_start(_published_starts(search, neighbour), "published")
     if search.placement == "free":
         search.multi_start(_free_starts(search, neighbour, published), "free")
-    return search.answer()
+
+
+def _try_harder(search: _Search, neighbour: Plan | None) -> None:
+    """No start verified: run them all once more with a wider back-off on the sampled slider
+    acceleration (a plan of that slightly tighter problem meets this one's limits)."""
+    index = PARAMETER_INDEX["accel_limit"]
+    search.parameters = search.parameters.copy()
+    search.parameters[index] *= (1 - HARDER_BACKOFF) / (1 - ACCEL_BACKOFF)
+    _multi_start(search, neighbour)
 
 
 def _prepare(case: Case, placement: Placement) -> _Search:

@@ -50,9 +50,10 @@ class Infeasible(PlanningError):
 
 
 class NoPlanFound(PlanningError):
-    """Every start of the solver stopped without a plan (``attempts`` say how each ended)."""
+    """Every start of the solver stopped without a plan (``attempts`` say how each ended). Not a proof
+    that the limits cannot be met: the message says so and names the closest limit."""
 
-    kind = "infeasible"
+    kind = "no verified plan"
 
     def __init__(self, reason: str, attempts: tuple[Attempt, ...] = ()):
         super().__init__(reason)
@@ -83,13 +84,12 @@ class Attempt:
     worst_block: str = ""
     violation: float = 0.0
     check: Check | None = None
+    case_field: str = ""  # the case field behind the worst block or the failed check
 
     def describe(self) -> str:
-        """One line: what stopped this start."""
+        """One line: what stopped this start, with the case field a user can change."""
         if self.check is not None:
             c = self.check
-            return f"verification failed: {c.name} = {c.value:.6g} {c.unit} (limit {c.limit:.6g})"
-        return (
-            f"solver stopped ({self.solver_status}); worst constraint: {self.worst_block} "
-            f"(violated by {self.violation:.3g})"
-        )
+            where = f" ({self.case_field})" if self.case_field else ""
+            return f"verification failed: {c.name} = {c.value:.6g} {c.unit} (limit {c.limit:.6g}){where}"
+        return f"the solver stopped ({self.solver_status}) short of {self.case_field or self.worst_block}"

@@ -16,7 +16,8 @@ import numpy as np
 from planning.model.case import RPM, Case
 from planning.model.plan import Plan
 
-MAX_STEP_S = 1e-3  # [s] dense grid step (at most)
+MAX_STEP_S = 1e-3  # [s] dense grid step (at most), for cycles up to MAX_SAMPLES * MAX_STEP_S = 1000 s
+MAX_SAMPLES = 1_000_000  # grid points at most: a longer cycle gets a uniform step of period / MAX_SAMPLES
 REL_TOL = 1e-6  # relative tolerance on every limit
 ANGLE_TOL = 1e-6  # [rad] key angles and cycle closure
 TIME_TOL = 1e-6  # [s] transfer time
@@ -44,6 +45,21 @@ class CheckId(str, enum.Enum):
     CRANK_ACCEL = "crank_accel_limit"
     CRANK_JERK = "crank_jerk_limit"
     MIN_CRANK_SPEED = "min_crank_speed"
+
+
+# the case field behind each check: a failure message names what the user can change
+CHECK_FIELDS = {
+    CheckId.TRANSFER_TIME: "process.transfer_time_s",
+    CheckId.SAFETY_HEIGHT: "process.safety_height_mm",
+    CheckId.DRAW_START_SPEED: "limits.draw_start_speed_mm_s",
+    CheckId.DIE_SPEED: "limits.die_speed_mm_s",
+    CheckId.SLIDER_ACCEL: "limits.slider_accel_mm_s2",
+    CheckId.CRANK_SPEED: "limits.crank_speed_rpm",
+    CheckId.CRANK_ACCEL: "limits.crank_accel_rad_s2",
+    CheckId.CRANK_JERK: "limits.crank_jerk_rad_s3",
+    CheckId.MIN_CRANK_SPEED: "limits.min_crank_speed_rpm",
+    CheckId.KEY_ANGLES: "key_points",
+}
 
 
 @dataclass(frozen=True)
@@ -92,8 +108,9 @@ class Verification:
 
 
 def dense_times(period: float, knot_times: np.ndarray, max_step: float = MAX_STEP_S) -> np.ndarray:
-    """A uniform grid over ``[0, period]`` [s] with step <= ``max_step``, merged with the knots."""
-    n = int(math.ceil(period / max_step))
+    """A uniform grid over ``[0, period]`` [s] with step <= ``max_step`` (at most :data:`MAX_SAMPLES`
+    points: a coarser uniform step for a cycle longer than 1000 s), merged with the knots."""
+    n = min(int(math.ceil(period / max_step)), MAX_SAMPLES)
     grid = np.linspace(0.0, period, n + 1)
     return np.unique(np.concatenate([grid, knot_times]))
 

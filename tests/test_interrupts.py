@@ -1,0 +1,141 @@
+"""Kills, Ctrl-C and SIGTERM: the output folder is entirely old or entirely new, one line and the
+conventional exit status, and no worker process outlives a sweep."""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import random
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from .conftest import PUBLISHED_CASE, ROOT
+
+KILL_TRIALS = 20
+PRESSPLAN = [sys.executable, "-m", "planning.cli"]
+
+
+def run(args: list[str], **kw) -> subprocess.CompletedProcess:
+    return subprocess.run([*PRESSPLAN, *args], cwd=ROOT, capture_output=True, text=True, **kw)
+
+
+def state(folder: Path) -> tuple:
+    """What a folder holds, timing fields aside: file names and the bytes of the timing-free files."""
+    names = tuple(sorted(p.name for p in folder.iterdir()))
+    digest = {
+        name: hashlib.sha256((folder / name).read_bytes()).hexdigest()
+        for name in ("trajectory.csv", "cam_table.csv", "published_profile.csv")
+        if (folder / name).exists()
+    }
+    return names, tuple(sorted(digest.items()))
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="the kill test drives Linux processes")
+def test_killed_solve_leaves_the_folder_entirely_old_or_entirely_new(tmp_path):
+    other = tmp_path / "other.yaml"
+    other.write_text(PUBLISHED_CASE.read_text().replace("transfer_time_s: 2.0", "transfer_time_s: 1.8"))
+    old_master, new_master = tmp_path / "old", tmp_path / "new"
+    assert run(["solve", str(PUBLISHED_CASE), "--out", str(old_master)]).returncode == 0  # with figures
+    t = time.perf_counter()
+    assert run(["solve", str(other), "--out", str(new_master), "--no-plots"]).returncode == 0
+    full = time.perf_counter() - t
+    old, new = state(old_master), state(new_master)
+    assert old != new
+    rng = random.Random(2026)
+    out = tmp_path / "work" / "out"
+    ends = {"old": 0, "new": 0}
+    for _ in range(KILL_TRIALS):
+        shutil.rmtree(out, ignore_errors=True)
+        shutil.copytree(old_master, out)
+        proc = subprocess.Popen(
+            [*PRESSPLAN, "solve", str(other), "--out", str(out), "--no-plots"],
+            cwd=ROOT,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+        time.sleep(rng.uniform(0.5, 1.15) * full)  # most kills land in the late part, where the files are written
+        proc.kill()
+        proc.wait()
+        now = state(out)
+        assert now in (old, new), now
+        ends["old" if now == old else "new"] += 1
+    assert run(["solve", str(other), "--out", str(out), "--no-plots"]).returncode == 0
+    assert state(out) == new
+    assert not [p.name for p in out.parent.iterdir() if ".pressplan-" in p.name]  # leftovers cleaned
+    assert ends["old"] + ends["new"] == KILL_TRIALS
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="signals to child processes")
+def test_ctrl_c_is_one_line_and_exit_130(tmp_path):
+    proc = subprocess.Popen(
+        [*PRESSPLAN, "laws", str(PUBLISHED_CASE), "--out", str(tmp_path / "o")],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    time.sleep(2.0)  # inside the solves
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130
+    assert err.strip().splitlines() == ["pressplan: interrupted"]
+
+
+def _children(pid: int) -> set[int]:
+    out = set()
+    for task in Path("/proc").glob("[0-9]*"):
+        try:
+            fields = (task / "stat").read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            out.add(int(task.name))
+    return out
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="reads /proc")
+def test_sigterm_ends_a_sweep_and_its_workers(tmp_path):
+    proc = subprocess.Popen(
+        [
+            *PRESSPLAN,
+            "sweep",
+            str(PUBLISHED_CASE),
+            "--vary",
+            "process.transfer_time_s=1.0:3.0:40",
+            "--workers",
+            "2",
+            "--out",
+            str(tmp_path / "s"),
+        ],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    workers: set[int] = set()
+    deadline = time.monotonic() + 30
+    while len(workers) < 2 and time.monotonic() < deadline:
+        workers |= _children(proc.pid)
+        time.sleep(0.1)
+    assert workers, "the sweep started no worker processes"
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 143
+    assert err.strip().splitlines()[-1] == "pressplan: terminated" and "Traceback" not in err
+    time.sleep(0.5)
+    alive = []
+    for pid in workers:
+        try:
+            os.kill(pid, 0)
+            state_line = Path(f"/proc/{pid}/stat").read_text()
+            if ") Z " not in state_line:  # a zombie is already dead
+                alive.append(pid)
+        except (ProcessLookupError, FileNotFoundError):
+            pass
+    assert not alive, f"worker processes still running: {alive}"
