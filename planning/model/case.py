@@ -17,6 +17,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from planning.model.laws import DEFAULT_LAW, LAWS, LawName
+from press.dynamics import DriveModel
 from press.kinematics import CrankSlider
 
 RPM = 2.0 * math.pi / 60.0  # [rad/s] per rpm
@@ -66,6 +67,13 @@ SourceNumber = Annotated[float, Field(ge=-1e9, le=1e9)]  # a number printed by t
 SourceTime = Annotated[float, Field(ge=0, le=1e4)]  # [s] a time printed by the source
 SourceDuration = Annotated[float, Field(gt=0, le=1e4)]  # [s]
 SourceSpeed = Annotated[float, Field(gt=0, le=1e5)]  # [rpm]
+Mass = Annotated[float, Field(ge=0, le=1e7)]  # [kg]
+Inertia = Annotated[float, Field(ge=0, le=1e9)]  # [kg m^2]
+ForceKN = Annotated[float, Field(ge=0, le=1e6)]  # [kN]
+Torque = Annotated[float, Field(ge=1e-3, le=1e8)]  # [N m]
+MotorSpeed = Annotated[float, Field(ge=1e-2, le=1e5)]  # [rpm]
+ForcePoint = Annotated[list[float], Field(min_length=2, max_length=2)]  # [height above BDC mm, force kN]
+ForceTable = Annotated[list[ForcePoint], Field(min_length=2, max_length=500)]
 
 
 class PressModel(_Model):
@@ -90,6 +98,7 @@ class ProcessModel(_Model):
     safety_height_mm: Annotated[float, Field(gt=0, le=40_000)]
     transfer_time_s: Seconds
     draw_speed_rpm: CrankSpeed | None = None
+    forming_force_kN: ForceTable | None = None  # [[height above BDC mm, force kN], ...], linear between points
 
 
 class LimitsModel(_Model):
@@ -104,6 +113,30 @@ class LimitsModel(_Model):
     crank_speed_rpm: CrankSpeed | None = None  # motor limits (optional), on the crank
     crank_accel_rad_s2: CrankAccel | None = None
     crank_jerk_rad_s3: CrankJerk | None = None
+
+
+class MotorModel(_Model):
+    """All motors together: ``peak_torque_Nm`` up to ``base_speed_rpm``, constant power above it up to
+    ``max_speed_rpm``; ``rated_torque_Nm`` the thermal (RMS) limit."""
+
+    peak_torque_Nm: Torque
+    rated_torque_Nm: Torque
+    base_speed_rpm: MotorSpeed
+    max_speed_rpm: MotorSpeed
+
+
+class DriveSection(_Model):
+    """The drive (masses, gear, motor); see ``press.dynamics`` for the model and its signs."""
+
+    slide_mass_kg: Mass  # slide + upper die
+    rod_mass_kg: Mass
+    rod_cg_from_crank_pin_mm: Annotated[float, Field(ge=0, le=100_000)]
+    crank_inertia_kg_m2: Inertia  # crankshaft, eccentric, bull gears, about the crank axis
+    counterbalance_kN: ForceKN  # constant, upward
+    gear_ratio: Annotated[float, Field(ge=1e-3, le=1e4)]  # motor turns per crank turn
+    gear_efficiency: Annotated[float, Field(gt=0, le=1)]
+    motor_inertia_kg_m2: Inertia  # all motors and pinions, about the motor axis
+    motor: MotorModel
 
 
 class PlannerModel(_Model):
@@ -166,6 +199,7 @@ class Case(_Model):
     key_points: KeyPointsModel
     process: ProcessModel
     limits: LimitsModel
+    drive: DriveSection | None = None
     planner: PlannerModel = PlannerModel()
     published: PublishedModel | None = None
 
@@ -180,6 +214,27 @@ class Case(_Model):
         """theta1..theta4 [rad]."""
         k = self.key_points
         return np.radians([k.closing_deg, k.draw_start_deg, k.draw_end_deg, k.opening_deg])
+
+    @property
+    def drive_model(self) -> DriveModel | None:
+        """The drive in inside units (``press.dynamics``), None without a ``drive:`` section."""
+        d = self.drive
+        if d is None:
+            return None
+        return DriveModel.from_parts(
+            self.press.crank_radius_mm,
+            self.press.rod_length_mm,
+            d.slide_mass_kg,
+            d.rod_mass_kg,
+            d.rod_cg_from_crank_pin_mm,
+            d.crank_inertia_kg_m2,
+            d.counterbalance_kN,
+            d.gear_ratio,
+            d.gear_efficiency,
+            d.motor_inertia_kg_m2,
+            self.process.forming_force_kN,
+            math.radians(self.key_points.draw_start_deg),
+        )
 
     def with_law(self, law: str) -> Case:
         """The same case under motion law ``law``; a fixed ``law_parameter`` is kept for the same law only."""
@@ -215,6 +270,8 @@ def draw_speed_bounds(case: Case) -> dict[str, float]:
     out["slider_accel"] = math.sqrt(case.limits.slider_accel_mm_s2 / curv) if curv > 0 else math.inf
     if case.limits.crank_speed_rpm is not None:
         out["crank_speed"] = case.limits.crank_speed_rpm * RPM
+    if case.drive is not None:
+        out["motor_speed"] = case.drive.motor.max_speed_rpm * RPM / case.drive.gear_ratio
     return out
 
 
@@ -266,6 +323,7 @@ def cross_checks(case: Case) -> None:
                 f"{law.parameter.name} of the {law.name} law must lie in [{lo:g}, {hi:g}]",
                 fixed,
             )
+    _drive_checks(case)
     top = case.limits.crank_speed_rpm
     if top is not None and top <= case.limits.min_crank_speed_rpm:
         raise CaseError(
@@ -294,6 +352,51 @@ def cross_checks(case: Case) -> None:
                 f"is below limits.min_crank_speed_rpm = {case.limits.min_crank_speed_rpm:g}",
                 case.process.draw_speed_rpm,
             )
+
+
+def _drive_checks(case: Case) -> None:
+    """The forming-force table and the drive section against the press and each other."""
+    table = case.process.forming_force_kN
+    if table is not None:
+        stroke = case.machine.stroke
+        heights = [h for h, _ in table]
+        for k, (h, f) in enumerate(table):
+            if not 0 <= h <= stroke:
+                raise CaseError(
+                    f"process.forming_force_kN.{k}", f"height must lie within the stroke 0 ... {stroke:g} mm", h
+                )
+            if not 0 <= f <= 1e6:
+                raise CaseError(f"process.forming_force_kN.{k}", "force must lie in 0 ... 1e6 kN", f)
+        if len(set(heights)) != len(heights):
+            raise CaseError("process.forming_force_kN", "each height at most once", heights)
+    d = case.drive
+    if d is None:
+        return
+    if d.rod_cg_from_crank_pin_mm > case.press.rod_length_mm:
+        raise CaseError(
+            "drive.rod_cg_from_crank_pin_mm",
+            f"must lie on the rod (at most press.rod_length_mm = {case.press.rod_length_mm:g})",
+            d.rod_cg_from_crank_pin_mm,
+        )
+    if d.motor.rated_torque_Nm > d.motor.peak_torque_Nm:
+        raise CaseError(
+            "drive.motor.rated_torque_Nm",
+            f"must not exceed drive.motor.peak_torque_Nm = {d.motor.peak_torque_Nm:g}",
+            d.motor.rated_torque_Nm,
+        )
+    if d.motor.base_speed_rpm > d.motor.max_speed_rpm:
+        raise CaseError(
+            "drive.motor.base_speed_rpm",
+            f"must not exceed drive.motor.max_speed_rpm = {d.motor.max_speed_rpm:g}",
+            d.motor.base_speed_rpm,
+        )
+    w_min_motor = case.limits.min_crank_speed_rpm * d.gear_ratio
+    if w_min_motor >= d.motor.max_speed_rpm:
+        raise CaseError(
+            "drive.motor.max_speed_rpm",
+            f"must be above the minimum crank speed through the gear ({w_min_motor:g} rpm)",
+            d.motor.max_speed_rpm,
+        )
 
 
 _SLUG = re.compile(r"[^A-Za-z0-9._-]+")

@@ -39,6 +39,7 @@ from planning.model.cycle import CycleParameters, cycle_segments
 from planning.model.laws import DEFAULT_LAW, get_law
 from planning.model.profile import Segment, advance, advance_segment, knot_states, shape_part
 from planning.solver.ipopt import NLPResult, NLPSolver
+from press.dynamics import DriveModel, crank_torque, motor_speed, motor_torque
 from press.kinematics import height_derivatives
 
 # Decision variables and the kind of scale each is measured in (see :func:`variable_scales`)
@@ -96,6 +97,19 @@ PARAMETERS: tuple[str, ...] = (
     "crank_jerk_max",
 )
 PARAMETER_INDEX = {name: i for i, name in enumerate(PARAMETERS)}
+# Parameters of a drive (the NLP of a case with a ``drive:`` section has them after PARAMETERS), SI units
+DRIVE_PARAMETERS: tuple[str, ...] = (
+    "drive_M",  # slide-side mass [kg]
+    "drive_J0",  # crank-side inertia [kg m^2]
+    "drive_F_cb",  # counterbalance [N]
+    "drive_i",  # gear ratio
+    "drive_eta",  # gear efficiency
+    "drive_J_m",  # motor-side inertia [kg m^2]
+    "motor_peak",  # peak torque [N m] (the orchestrator lowers it if the dense check finds an overshoot)
+    "motor_base_speed",  # [rad/s] at the motor
+    "motor_rms",  # rated (RMS) torque [N m] (likewise)
+)
+DRIVE_INDEX = {name: len(PARAMETERS) + i for i, name in enumerate(DRIVE_PARAMETERS)}
 
 CYCLE_OPTIONS = {  # added to the wrapper's base options
     "ipopt.constr_viol_tol": 1e-10,
@@ -103,6 +117,8 @@ CYCLE_OPTIONS = {  # added to the wrapper's base options
 }
 SAMPLES_PER_SUBSEGMENT = 5
 SAMPLES_CONSTANT = 20
+DRAW_SAMPLES_DRIVE = 80  # with a drive the draw is sampled finer: the forming force changes fast there
+FORMING_SAMPLES = DRAW_SAMPLES_DRIVE + 1  # forming force [N] at the draw's samples, theta2 ... theta3
 
 
 @dataclass(frozen=True)
@@ -134,6 +150,9 @@ BLOCK_FIELDS = {
     "crank speed limit": "limits.crank_speed_rpm",
     "crank acceleration limit": "limits.crank_accel_rad_s2",
     "crank jerk limit": "limits.crank_jerk_rad_s3",
+    "motor peak torque": "drive.motor.peak_torque_Nm",
+    "motor constant-power corner": "drive.motor.base_speed_rpm",
+    "motor RMS torque": "drive.motor.rated_torque_Nm",
 }
 
 
@@ -208,10 +227,31 @@ def values_of(result: NLPResult) -> dict[str, float]:
     return {k: float(result.x[j]) for j, (k, _) in enumerate(VARIABLES)}
 
 
-def _build(law_name: str) -> CycleNLP:
+def _drive_constraints(add, p_case, th, om, al, d1, d2, times, period) -> None:  # noqa: ANN001 - SX
+    """The motor's limits at the samples (``press.dynamics``): the peak-torque envelope (peak torque, and
+    the constant-power corner above the base speed) and the RMS torque over the cycle by the trapezoidal
+    rule over the samples. The forming force enters at the draw's samples, the last FORMING_SAMPLES."""
+    q = {name: p_case[k] for name, k in DRIVE_INDEX.items()}
+    start = len(PARAMETERS) + len(DRIVE_PARAMETERS)
+    forming = ca.vertcat(ca.DM.zeros(th.shape[0] - FORMING_SAMPLES), p_case[start : start + FORMING_SAMPLES])
+    model = DriveModel(
+        q["drive_M"], q["drive_J0"], q["drive_F_cb"], q["drive_i"], q["drive_eta"], q["drive_J_m"], (), (), 0.0
+    )
+    tc = crank_torque(om, al, d1, d2, forming, model)
+    tm = motor_torque(tc, al, model)
+    add("motor peak torque", tm / q["motor_peak"], -1.0, 1.0)
+    corner = tm * motor_speed(om, model) / (q["motor_peak"] * q["motor_base_speed"])
+    add("motor constant-power corner", corner, -1.0, 1.0)
+    sq = tm**2
+    n = th.shape[0]
+    integral = ca.sum1((times[1:n] - times[0 : n - 1]) * (sq[1:n] + sq[0 : n - 1]) / 2)
+    add("motor RMS torque", integral / (period * q["motor_rms"] ** 2), -np.inf, 1.0)
+
+
+def _build(law_name: str, drive: bool = False) -> CycleNLP:
     law = get_law(law_name)
     x = ca.SX.sym("x", len(VARIABLES))
-    p_case = ca.SX.sym("p", len(PARAMETERS))
+    p_case = ca.SX.sym("p", len(PARAMETERS) + (len(DRIVE_PARAMETERS) + FORMING_SAMPLES if drive else 0))
     p_scale = ca.SX.sym("scale", len(VARIABLES))  # physical value = scale * x, chosen per case
     p = ca.vertcat(p_case, p_scale)
     v = {name: x[i] * p_scale[i] for i, (name, _) in enumerate(VARIABLES)}
@@ -313,13 +353,17 @@ def _build(law_name: str) -> CycleNLP:
     )
 
     # slider acceleration at sample points of every segment, one vector per segment
-    th_s, om_s, al_s = [], [], []
-    for seg, st in zip(segs, states[:-1], strict=True):
+    th_s, om_s, al_s, t_s = [], [], [], []
+    for seg, st, t0 in zip(segs, states[:-1], starts, strict=True):
         constant = seg.name in ("transfer:dwell", "draw:constant")
-        fractions = np.linspace(0.0, 1.0, (SAMPLES_CONSTANT if constant else law.samples) + 1)
+        count = SAMPLES_CONSTANT if constant else law.samples
+        if drive and seg.name == "draw:constant":
+            count = DRAW_SAMPLES_DRIVE
+        fractions = np.linspace(0.0, 1.0, count + 1)
         if seg.name != "draw:constant":
             fractions = fractions[:-1]  # the end is the next segment's start
         th, om, al, _ = advance_segment(seg, *st, ca.DM(fractions) * seg.duration)
+        t_s.append(t0 + ca.DM(fractions) * seg.duration)
         th_s.append(th)
         om_s.append(om)
         al_s.append(al)
@@ -331,14 +375,16 @@ def _build(law_name: str) -> CycleNLP:
     add("crank speed limit", ca.vertcat(wm1, wm2, w1, w2) / q["crank_speed_max"], -np.inf, 1.0)
     add("crank acceleration limit", ca.vertcat(*params.peak_accelerations()) / q["crank_accel_max"], -np.inf, 1.0)
     add("crank jerk limit", ca.vertcat(*params.peak_jerks()) / q["crank_jerk_max"], -np.inf, 1.0)
+    if drive:
+        _drive_constraints(add, p_case, th, om, al, d1, d2, ca.vertcat(*t_s), params.period)
 
     nlp = {"x": x, "p": p, "f": params.period, "g": ca.vertcat(*g)}
-    program = NLPSolver("press_cycle_" + law_name.replace("-", "_"), nlp, CYCLE_OPTIONS)
+    program = NLPSolver("press_cycle_" + law_name.replace("-", "_") + ("_drive" if drive else ""), nlp, CYCLE_OPTIONS)
     return CycleNLP(program, np.array(lb), np.array(ub), tuple(blocks), published_rows)
 
 
 @cache
-def cycle_nlp(law: str = DEFAULT_LAW) -> CycleNLP:
-    """The compiled NLP of motion law ``law`` (built on first use in a process, then reused for every
-    case and start)."""
-    return _build(law)
+def cycle_nlp(law: str = DEFAULT_LAW, drive: bool = False) -> CycleNLP:
+    """The compiled NLP of motion law ``law``, with the motor's limits when ``drive`` (built on first use
+    in a process, then reused for every case and start)."""
+    return _build(law, drive)

@@ -23,6 +23,9 @@ from planning.model.laws import improved_scurve as sc
 from planning.model.plan import Plan, SolverInfo, params_from_numbers, profile_from_tdc
 from planning.solver.nlp import (
     BLOCK_FIELDS,
+    DRIVE_INDEX,
+    DRIVE_PARAMETERS,
+    FORMING_SAMPLES,
     PARAMETER_INDEX,
     PARAMETERS,
     VARIABLE_INDEX,
@@ -34,14 +37,24 @@ from planning.solver.nlp import (
 )
 from planning.solver.outcomes import Attempt, Infeasible, NoPlanFound, Unverified
 from planning.solver.verify import CHECK_FIELDS, CheckId, Verification, verify
+from press.dynamics import forming_force
 
 ACCEL_BACKOFF = 5e-4  # the NLP keeps |slider acceleration| <= (1 - backoff) * limit at its samples
+DRIVE_BACKOFF = 5e-5  # likewise for the motor's peak and RMS torque (refined like the acceleration if it overshoots)
 MIN_HALF_S = 4e-3  # [s] lower bound on the duration of a half (1 ms per improved-S-curve sub-segment)
 MAX_TIME_S = 600.0  # [s] least upper bound on a time variable (see _bounds)
 REFINEMENTS = 8  # re-solves with a lowered sampled acceleration limit
 HARDER_BACKOFF = 5e-3  # when no start verifies: once more with this back-off on the sampled limits
 NO_LIMIT = 1e9  # stands for an absent motor limit in the NLP's parameters
 AGREE_S = 1e-6  # [s] two starts whose best periods agree this closely have found the same optimum
+
+
+# the checks whose overshoot between the NLP's samples a re-solve with a lowered sampled limit removes
+REFINED = {
+    CheckId.SLIDER_ACCEL: PARAMETER_INDEX["accel_limit"],
+    CheckId.MOTOR_PEAK: DRIVE_INDEX["motor_peak"],
+    CheckId.MOTOR_RMS: DRIVE_INDEX["motor_rms"],
+}
 
 
 @dataclass(frozen=True)
@@ -119,11 +132,44 @@ def nlp_parameters(case: Case) -> np.ndarray:
         "die_up_angle": up,
         "die_up_slope": abs(float(m.derivatives(up)[0])) if up > th3 else 0.0,
         "die_up_active": 1.0 if up > th3 else 0.0,
-        "crank_speed_max": (lim.crank_speed_rpm or NO_LIMIT) * RPM,
+        "crank_speed_max": crank_speed_limit(case) or NO_LIMIT,
         "crank_accel_max": lim.crank_accel_rad_s2 or NO_LIMIT,
         "crank_jerk_max": lim.crank_jerk_rad_s3 or NO_LIMIT,
     }
-    return np.array([values[k] for k in PARAMETERS], dtype=float)
+    out = np.array([values[k] for k in PARAMETERS], dtype=float)
+    if case.drive is None:
+        return out
+    return np.concatenate([out, drive_parameters(case)])
+
+
+def crank_speed_limit(case: Case) -> float | None:
+    """The crank's top speed [rad/s]: the drive's crank-speed limit and the motor's top speed through
+    the gear, whichever is lower; None without either."""
+    tops = [case.limits.crank_speed_rpm * RPM] if case.limits.crank_speed_rpm is not None else []
+    if case.drive is not None:
+        tops.append(case.drive.motor.max_speed_rpm * RPM / case.drive.gear_ratio)
+    return min(tops) if tops else None
+
+
+def drive_parameters(case: Case) -> np.ndarray:
+    """The drive's NLP parameters (:data:`DRIVE_PARAMETERS`, then the forming force at the draw's samples)."""
+    d = case.drive_model
+    motor = case.drive.motor
+    values = {
+        "drive_M": d.M,
+        "drive_J0": d.J0,
+        "drive_F_cb": d.F_cb,
+        "drive_i": d.i,
+        "drive_eta": d.eta,
+        "drive_J_m": d.J_m,
+        "motor_peak": motor.peak_torque_Nm * (1 - DRIVE_BACKOFF),
+        "motor_base_speed": motor.base_speed_rpm * RPM,
+        "motor_rms": motor.rated_torque_Nm * (1 - DRIVE_BACKOFF),
+    }
+    _, th2, th3, _ = case.key_angles
+    theta = th2 + np.linspace(0.0, 1.0, FORMING_SAMPLES) * (th3 - th2)
+    forming = forming_force(theta, case.machine.height(theta), d)
+    return np.concatenate([[values[k] for k in DRIVE_PARAMETERS], forming])
 
 
 def _guess(case: Case, w2: float, w1: float, peak_share: float, inside: float) -> dict[str, float]:
@@ -133,7 +179,7 @@ def _guess(case: Case, w2: float, w1: float, peak_share: float, inside: float) -
     R, L = case.press.crank_radius_mm, case.press.rod_length_mm
     th1, th2, th3, th4 = case.key_angles
     w_acc = math.sqrt(case.limits.slider_accel_mm_s2 / (R + R**2 / L))  # |d2h/dtheta2| peaks at BDC
-    top = case.limits.crank_speed_rpm * RPM if case.limits.crank_speed_rpm else math.inf
+    top = crank_speed_limit(case) or math.inf
     w1 = min(w1, 0.8 * top)
     wm = min(max(peak_share * w_acc, 1.2 * max(w1, w2)), max(0.98 * top, 1.01 * max(w1, w2)))
 
@@ -260,9 +306,10 @@ class _Search:
                 return values, plan.period
             bad = check.failures()
             self.attempts.append(Attempt(check=bad[0], case_field=CHECK_FIELDS.get(bad[0].id, "")))
-            if [c.id for c in bad] != [CheckId.SLIDER_ACCEL]:
+            if any(c.id not in REFINED for c in bad):
                 return None
-            q[PARAMETER_INDEX["accel_limit"]] *= (bad[0].limit / bad[0].value) * (1 - 1e-5)
+            for c in bad:  # lower the NLP's sampled limit by the measured overshoot
+                q[REFINED[c.id]] *= (c.limit / c.value) * (1 - 1e-5)
         return None
 
     def multi_start(self, x0s: list[dict[str, float]], placement: Placement) -> dict[str, float] | None:
@@ -351,7 +398,7 @@ def _prepare(case: Case, placement: Placement) -> _Search:
     lbx, ubx = _bounds(case, w2_lo, w2_hi, p)
     lim = case.limits
     scale = variable_scales(case.press.crank_radius_mm, case.press.rod_length_mm, lim.slider_accel_mm_s2)
-    nlp = cycle_nlp(case.planner.motion_law)
+    nlp = cycle_nlp(case.planner.motion_law, case.drive is not None)
     return _Search(case, placement, nlp, p, lbx, ubx, scale, (w2_lo, w2_hi), t_start)
 
 

@@ -22,6 +22,7 @@ REL_TOL = 1e-6  # relative tolerance on every limit
 ANGLE_TOL = 1e-6  # [rad] key angles and cycle closure
 TIME_TOL = 1e-6  # [s] transfer time
 SPEED_TOL = 1e-9  # [rad/s] continuity and constant-speed draw
+ENERGY_REL_TOL = 1e-6  # energy balance, relative to the larger of the forming work and integral |T_c omega| dt
 CONTINUITY_TOL = 1e-9  # [rad/s, rad/s^2] jump allowed at a knot (beyond the O(eps^2) remainder)
 
 
@@ -45,6 +46,10 @@ class CheckId(str, enum.Enum):
     CRANK_ACCEL = "crank_accel_limit"
     CRANK_JERK = "crank_jerk_limit"
     MIN_CRANK_SPEED = "min_crank_speed"
+    MOTOR_PEAK = "motor_peak_torque"
+    MOTOR_SPEED = "motor_speed"
+    MOTOR_RMS = "motor_rms_torque"
+    ENERGY_BALANCE = "energy_balance"
 
 
 # the case field behind each check: a failure message names what the user can change
@@ -59,6 +64,9 @@ CHECK_FIELDS = {
     CheckId.CRANK_JERK: "limits.crank_jerk_rad_s3",
     CheckId.MIN_CRANK_SPEED: "limits.min_crank_speed_rpm",
     CheckId.KEY_ANGLES: "key_points",
+    CheckId.MOTOR_PEAK: "drive.motor.peak_torque_Nm",
+    CheckId.MOTOR_SPEED: "drive.motor.max_speed_rpm",
+    CheckId.MOTOR_RMS: "drive.motor.rated_torque_Nm",
 }
 
 
@@ -275,7 +283,37 @@ def verify(plan: Plan, case: Case) -> Verification:
         "min",
         REL_TOL * lim.min_crank_speed_rpm,
     )
+    if case.drive is not None:
+        _drive_checks(add, plan, case, th, om, al)
     return Verification(tuple(checks), float(np.max(np.diff(t))), int(t.size))
+
+
+def _drive_checks(add, plan: Plan, case: Case, th, om, al) -> None:  # noqa: ANN001 - the add() of verify
+    """The motor's limits on the dense grid, its RMS torque and the energy balance by quadrature
+    (``planning.model.drive``)."""
+    from planning.model.drive import drive_figures
+    from press.dynamics import drive_state, envelope_torque
+
+    motor = case.drive.motor
+    s = drive_state(th, om, al, case.press.crank_radius_mm, case.press.rod_length_mm, case.drive_model)
+    envelope = envelope_torque(s["motor_speed_rad_s"], motor.peak_torque_Nm, motor.base_speed_rpm * RPM)
+    use = float(np.max(np.abs(s["motor_torque_Nm"]) / envelope))
+    add(CheckId.MOTOR_PEAK, "motor peak torque", use, 1.0, "of the envelope", "max", REL_TOL)
+    top = float(np.max(s["motor_speed_rad_s"])) / RPM
+    add(CheckId.MOTOR_SPEED, "motor speed", top, motor.max_speed_rpm, "rpm", "max", REL_TOL * motor.max_speed_rpm)
+    fig = drive_figures(plan.profile, case)
+    rated = motor.rated_torque_Nm
+    add(CheckId.MOTOR_RMS, "motor RMS torque", fig.rms_motor_torque_Nm, rated, "N m", "max", REL_TOL * rated)
+    scale = max(abs(fig.forming_work_kJ), fig.crank_work_abs_kJ)
+    add(
+        CheckId.ENERGY_BALANCE,
+        "energy balance: crank work = forming work",
+        fig.crank_work_kJ,
+        fig.forming_work_kJ,
+        "kJ",
+        "equal",
+        ENERGY_REL_TOL * scale,
+    )
 
 
 def max_abs_jerk(prof) -> float:

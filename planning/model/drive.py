@@ -1,0 +1,144 @@
+"""What the drive does over one planned cycle: torques, RMS, power and energy, from the closed-form profile.
+
+The integrals over the cycle use Gauss-Legendre quadrature (:data:`GAUSS_NODES` nodes) on pieces of at
+most :data:`MAX_PIECE_S` between breakpoints: every knot of the profile, theta2 and BDC (where the
+forming force starts and ends) and every height of the forming-force table on the way down (its
+kinks). The integrands are smooth on each piece, so the crank work ``integral T_c omega dt`` is exact to
+about 1e-12 relative and can be checked against the forming work, which is integrated exactly from the
+table (``press.dynamics.forming_work``): over a cycle the kinetic energy returns to its start, and
+gravity and the counterbalance are conservative, so the two are equal (the energy balance). The drawn
+and returned energies ``E+ = integral max(P, 0) dt`` and ``E- = integral min(P, 0) dt`` have kinks where
+the power changes sign; there the quadrature is accurate to the piece length squared.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from planning.model.case import RPM, Case
+from planning.model.profile import Profile
+from press.dynamics import drive_state, forming_work
+
+GAUSS_NODES = 4
+MAX_PIECE_S = 1e-3  # [s]
+MAX_PIECES = 400_000  # a longer cycle gets longer pieces
+
+
+@dataclass(frozen=True)
+class DriveFigures:
+    """One cycle of the drive: peaks, RMS and energies in engineering units."""
+
+    peak_motor_torque_Nm: float  # largest |T_m|
+    peak_motor_torque_angle_deg: float
+    rms_motor_torque_Nm: float
+    peak_crank_torque_Nm: float
+    peak_motor_power_kW: float  # largest |P|
+    peak_motor_speed_rpm: float
+    energy_drawn_kJ: float  # E+
+    energy_returned_kJ: float  # E- (negative or zero)
+    energy_net_kJ: float
+    forming_work_kJ: float
+    crank_work_kJ: float  # integral of T_c omega over the cycle: equals the forming work
+    crank_work_abs_kJ: float  # integral of |T_c omega|: the scale of the energy balance
+    peak_torque_use_pct: float  # largest |T_m| / envelope at that speed
+    rms_torque_use_pct: float  # RMS / rated
+
+    def as_dict(self) -> dict[str, float]:
+        return dict(self.__dict__)
+
+
+def _breakpoints(profile: Profile, case: Case) -> np.ndarray:
+    """Times [s] where the drive's integrands may kink: knots, theta2, BDC, table heights going down."""
+    times = list(profile.knot_times)
+    th0 = profile.theta0
+    angles = [case.key_angles[1], math.pi]
+    table = case.process.forming_force_kN or []
+    for h, _ in table:
+        if 0 < h < case.machine.stroke:
+            down = float(case.machine.angles_at_height(h)[0])
+            if case.key_angles[1] < down < math.pi:
+                angles.append(down)
+    for a in angles:
+        a = th0 + ((a - th0) % (2 * math.pi))
+        if a <= th0 + 2 * math.pi:
+            times.append(profile.time_at_angle(a))
+    return np.unique(np.clip(np.asarray(times, dtype=float), profile.t0, profile.t0 + profile.duration))
+
+
+def quadrature(profile: Profile, case: Case) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes [s] and weights [s] of the cycle's quadrature (see the module docstring)."""
+    edges = _breakpoints(profile, case)
+    span = np.diff(edges)
+    step = max(MAX_PIECE_S, profile.duration / MAX_PIECES)
+    counts = np.maximum(1, np.ceil(span / step).astype(int))
+    starts = np.repeat(edges[:-1], counts) + np.concatenate(
+        [np.arange(c) * (s / c) for c, s in zip(counts, span, strict=True)]
+    )
+    lengths = np.repeat(span / counts, counts)
+    x, w = np.polynomial.legendre.leggauss(GAUSS_NODES)
+    nodes = (starts[:, None] + lengths[:, None] * (x[None, :] + 1) / 2).ravel()
+    weights = (lengths[:, None] * w[None, :] / 2).ravel()
+    return nodes, weights
+
+
+def drive_figures(profile: Profile, case: Case) -> DriveFigures:
+    """The drive's figures over the cycle of ``profile`` (a plan's, from TDC); needs ``case.drive``."""
+    drive = case.drive_model
+    motor = case.drive.motor
+    R, L = case.press.crank_radius_mm, case.press.rod_length_mm
+    t, w = quadrature(profile, case)
+    th, om, al, _ = profile.at_time(t)
+    s = drive_state(th, om, al, R, L, drive)
+    tm, p = s["motor_torque_Nm"], s["motor_power_W"]
+    period = profile.duration
+    envelope = _envelope(s["motor_speed_rad_s"], case)
+    dense = _dense_peaks(profile, case)
+    h2 = float(case.machine.height(case.key_angles[1]))
+    forming = forming_work(h2, 0.0, drive)
+    k = int(np.argmax(dense["abs_torque"]))
+    e_plus = float(np.sum(w * np.maximum(p, 0.0)))
+    e_minus = float(np.sum(w * np.minimum(p, 0.0)))
+    rms = math.sqrt(float(np.sum(w * tm**2)) / period)
+    return DriveFigures(
+        peak_motor_torque_Nm=float(dense["abs_torque"][k]),
+        peak_motor_torque_angle_deg=float(math.degrees(dense["theta"][k]) % 360.0),
+        rms_motor_torque_Nm=rms,
+        peak_crank_torque_Nm=float(max(np.max(np.abs(s["crank_torque_Nm"])), dense["abs_crank"])),
+        peak_motor_power_kW=float(max(np.max(np.abs(p)), dense["abs_power"])) / 1e3,
+        peak_motor_speed_rpm=float(np.max(s["motor_speed_rad_s"])) / RPM,
+        energy_drawn_kJ=e_plus / 1e3,
+        energy_returned_kJ=e_minus / 1e3,
+        energy_net_kJ=(e_plus + e_minus) / 1e3,
+        forming_work_kJ=forming / 1e3,
+        crank_work_kJ=float(np.sum(w * s["crank_torque_Nm"] * om)) / 1e3,
+        crank_work_abs_kJ=float(np.sum(w * np.abs(s["crank_torque_Nm"] * om))) / 1e3,
+        peak_torque_use_pct=100.0 * max(float(np.max(np.abs(tm) / envelope)), dense["envelope_use"]),
+        rms_torque_use_pct=100.0 * rms / motor.rated_torque_Nm,
+    )
+
+
+def _envelope(motor_speed_rad_s: np.ndarray, case: Case) -> np.ndarray:
+    from press.dynamics import envelope_torque
+
+    m = case.drive.motor
+    return envelope_torque(motor_speed_rad_s, m.peak_torque_Nm, m.base_speed_rpm * RPM)
+
+
+def _dense_peaks(profile: Profile, case: Case) -> dict:
+    """Peaks on the verification's dense grid (uniform, knots included, both sides of theta2)."""
+    from planning.solver.verify import dense_times
+
+    t = dense_times(profile.duration, profile.knot_times)
+    th, om, al, _ = profile.at_time(profile.t0 + t)
+    s = drive_state(th, om, al, case.press.crank_radius_mm, case.press.rod_length_mm, case.drive_model)
+    env = _envelope(s["motor_speed_rad_s"], case)
+    return {
+        "abs_torque": np.abs(s["motor_torque_Nm"]),
+        "theta": th,
+        "abs_crank": float(np.max(np.abs(s["crank_torque_Nm"]))),
+        "abs_power": float(np.max(np.abs(s["motor_power_W"]))),
+        "envelope_use": float(np.max(np.abs(s["motor_torque_Nm"]) / env)),
+    }
