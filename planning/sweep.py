@@ -31,6 +31,14 @@ from planning.model.case import Case
 
 BLOCK_POINTS = 6
 ROW_FIELDS = ("spm", "cycle_time_s", "status", "binding", "solve_time_s", "message")
+# with a drive: what the motor must give at each point
+DRIVE_ROW_FIELDS = (
+    "peak_motor_torque_Nm",
+    "rms_motor_torque_Nm",
+    "peak_motor_power_kW",
+    "energy_drawn_kJ",
+    "energy_net_kJ",
+)
 
 
 class SweepError(ValueError):
@@ -62,7 +70,7 @@ def numeric_fields(model: type[BaseModel] = Case, prefix: str = "") -> list[str]
         nested = [a for a in args if isinstance(a, type) and issubclass(a, BaseModel)]
         if nested:
             out += numeric_fields(nested[0], f"{prefix}{name}.")
-        elif float in args or info.annotation is float or "float" in str(info.annotation):
+        elif (float in args or "float" in str(info.annotation)) and "list" not in str(info.annotation).lower():
             out.append(f"{prefix}{name}")
     return out
 
@@ -133,7 +141,7 @@ def solve_block(
             case = case_from_data(point_data(base, fields, values), f"{label}[{index}]")
             sol = solve(case, placement, neighbour=previous, follow=previous is not None)
             previous = sol.plan
-            row.update(_solved_row(sol), plan=sol.plan)
+            row.update(_solved_row(sol, case), plan=sol.plan)
         except CaseFileError as exc:
             row.update(status="bad input", message=str(exc))
         except PlanningError as exc:
@@ -145,16 +153,22 @@ def solve_block(
     return rows
 
 
-def _solved_row(sol) -> dict[str, Any]:
+def _solved_row(sol, case) -> dict[str, Any]:  # noqa: ANN001 - a Solution and its Case
     from planning.reports.report import binding
 
-    return {
+    row = {
         "spm": sol.plan.spm,
         "cycle_time_s": sol.plan.period,
         "status": "verified",
         "binding": ";".join(binding(sol)),
         "message": "",
     }
+    if case.drive is not None:
+        from planning.model.drive import drive_figures
+
+        figures = drive_figures(sol.plan.profile, case).as_dict()
+        row.update({k: figures[k] for k in DRIVE_ROW_FIELDS})
+    return row
 
 
 def neighbours(index: int, shape: tuple[int, ...]) -> list[int]:
@@ -213,7 +227,7 @@ def repair(
                 except PlanningError:
                     continue
                 if current is None or sol.plan.spm > current + 1e-9:
-                    rows[i].update(_solved_row(sol), plan=sol.plan)
+                    rows[i].update(_solved_row(sol, case), plan=sol.plan)
                     current = sol.plan.spm
                     improved += 1
                     changed = True
@@ -308,7 +322,7 @@ def run_sweep(
     earlier = _earlier_rows(csv_path, out, len(points))
     done = set(earlier)
     pending = [i for i in range(len(points)) if i not in done]
-    columns = ["index", *fields, *ROW_FIELDS]
+    columns = ["index", *fields, *ROW_FIELDS, *(DRIVE_ROW_FIELDS if base.get("drive") else ())]
     new_file = not csv_path.exists() or csv_path.stat().st_size == 0
     failed = sum(1 for r in earlier.values() if r["status"] != "verified")
     finished = len(done)

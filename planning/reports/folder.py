@@ -40,8 +40,9 @@ SOLVE_FILES = (
     "published_profile.csv",
     "motion_vs_time.*",
     "motion_vs_angle.*",
+    "drive.*",
 )
-FIGURE_FILES = ("motion_vs_time.*", "motion_vs_angle.*")
+FIGURE_FILES = ("motion_vs_time.*", "motion_vs_angle.*", "drive.*")
 COMPARE_FILES = ("comparison.json", "comparison.md")
 LAWS_FILES = ("laws.json", "laws.md", "laws_overlay.*")
 MAX_FOREIGN_FILES = 200

@@ -10,7 +10,14 @@ from pathlib import Path
 from planning.model.case import Case
 from planning.reports.cam_table import CAM_COLUMNS, DEFAULT_POINTS, cam_header, cam_table
 from planning.reports.folder import OutputError, write_json, write_table
-from planning.reports.report import TRAJECTORY_COLUMNS, result_dict, sample_profile, summary_text, trajectory
+from planning.reports.report import (
+    TRAJECTORY_COLUMNS,
+    result_dict,
+    sample_profile,
+    summary_text,
+    trajectory,
+    trajectory_columns,
+)
 from planning.reports.source_solution import rebuild_profile
 from planning.solver.optimize import Solution
 
@@ -31,7 +38,7 @@ def solution_writers(
     cam_head = cam_header(solution.plan, case.name, cam_points)
     writers: dict[str, Callable[[Path], None]] = {
         "result.json": lambda p: write_json(p, result),
-        "trajectory.csv": lambda p: write_table(p, traj, TRAJECTORY_COLUMNS),
+        "trajectory.csv": lambda p: write_table(p, traj, trajectory_columns(case)),
         "cam_table.csv": lambda p: write_table(p, cam, CAM_COLUMNS, cam_head),
         "summary.txt": lambda p: p.write_text(summary_text(result) + "\n", encoding="utf-8"),
     }
@@ -42,7 +49,7 @@ def solution_writers(
     if plot_format:
         from planning.reports.plots import plot_files, save
 
-        columns = dict(zip(TRAJECTORY_COLUMNS, traj.T, strict=True))
+        columns = dict(zip(trajectory_columns(case), traj.T, strict=True))
         pub_cols = dict(zip(TRAJECTORY_COLUMNS, published.T, strict=True)) if published is not None else None
         for name, fig in plot_files(result, columns, pub_cols, plot_format).items():
             writers[name] = lambda p, fig=fig: save(fig, p)

@@ -194,8 +194,82 @@ def _figure(result, traj, published, axis: str) -> Figure:
 def plot_files(
     result: dict[str, Any], traj: dict[str, np.ndarray], published: dict[str, np.ndarray] | None, fmt: str = "png"
 ) -> dict[str, Figure]:
-    """The figures by file name (``motion_vs_time.<fmt>``, ``motion_vs_angle.<fmt>``)."""
-    return {f"{name}.{fmt}": _figure(result, traj, published, name.split("_")[-1]) for name in FIGURES}
+    """The figures by file name (``motion_vs_time.<fmt>``, ``motion_vs_angle.<fmt>``, and ``drive.<fmt>``
+    when the result has a drive)."""
+    out = {f"{name}.{fmt}": _figure(result, traj, published, name.split("_")[-1]) for name in FIGURES}
+    if "drive" in result:
+        out[f"drive.{fmt}"] = drive_figure(result, traj)
+    return out
+
+
+def drive_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
+    """The servo-sizing picture: the cycle's operating points in the torque-speed plane over the motor's
+    peak envelope and rated line; motor torque and power against crank angle with the stages shaded."""
+    d = result["drive"]
+    motor = d["motor"]
+    t = _thin(traj)
+    fig = Figure(figsize=(12, 8.5), layout="constrained")
+    grid = fig.add_gridspec(2, 2, width_ratios=(1, 1.35))
+    plane = fig.add_subplot(grid[:, 0])
+    n_top = max(motor["max_speed_rpm"], float(np.max(np.abs(t["motor_speed_rpm"])))) * 1.05
+    n = np.linspace(0.0, motor["max_speed_rpm"], 400)
+    envelope = motor["peak_torque_Nm"] * np.minimum(1.0, motor["base_speed_rpm"] / np.maximum(n, 1e-9)) / 1e3
+    for sign in (1, -1):
+        plane.plot(n, sign * envelope, color="#b22222", lw=1.6, label="peak envelope" if sign > 0 else None)
+        plane.axhline(
+            sign * motor["rated_torque_Nm"] / 1e3,
+            color="#e08000",
+            lw=1.2,
+            ls="--",
+            label="rated (RMS limit)" if sign > 0 else None,
+        )
+    plane.axvline(motor["max_speed_rpm"], color="#b22222", lw=1.0, ls=":", label="max speed")
+    points = plane.scatter(
+        t["motor_speed_rpm"],
+        t["motor_torque_Nm"] / 1e3,
+        c=t["crank_angle_deg"],
+        s=5,
+        cmap="viridis",
+        zorder=3,
+        label="cycle (colour: crank angle)",
+    )
+    plane.axhline(d["rms_motor_torque_Nm"] / 1e3, color="#1f77b4", lw=1.0, ls="-.", label="RMS of the cycle")
+    fig.colorbar(points, ax=plane, label="crank angle [deg]", shrink=0.6)
+    plane.set_xlim(0, n_top)
+    plane.set_xlabel("motor speed [rpm]")
+    plane.set_ylabel("motor torque [kN m]")
+    plane.set_title("torque-speed plane (all motors)")
+    plane.grid(True, lw=0.3, alpha=0.6)
+    plane.legend(fontsize=8, loc="lower right")
+    torque = fig.add_subplot(grid[0, 1])
+    power = fig.add_subplot(grid[1, 1], sharex=torque)
+    x = t["crank_angle_deg"]
+    for ax, label_stages in ((torque, True), (power, False)):
+        _decorate(ax, result, "angle", label_stages)
+    torque.plot(x, t["motor_torque_Nm"] / 1e3, color="#1f77b4", lw=1.4, label="motor torque")
+    for sign in (1, -1):
+        torque.axhline(
+            sign * motor["peak_torque_Nm"] / 1e3,
+            color="#b22222",
+            lw=1.0,
+            ls="--",
+            label="peak torque" if sign > 0 else None,
+        )
+    torque.set_ylabel("motor torque [kN m]")
+    torque.legend(fontsize=8, loc="lower left")
+    power.plot(x, t["motor_power_kW"], color="#2ca02c", lw=1.4, label="motor power (drawn > 0)")
+    power.axhline(0.0, color="#444444", lw=0.6)
+    power.set_ylabel("motor power [kW]")
+    power.set_xlabel("crank angle from TDC [deg]")
+    power.legend(fontsize=8, loc="lower left")
+    _key_labels(power, result, "angle")
+    fig.suptitle(
+        f"{result['case']}: the drive at {result['spm']:.3f} strokes/min\n"
+        f"peak {d['peak_motor_torque_Nm'] / 1e3:.1f} kN m "
+        f"({d['peak_torque_use_pct']:.0f} % of envelope), RMS {d['rms_motor_torque_Nm'] / 1e3:.1f} kN m "
+        f"({d['rms_torque_use_pct']:.0f} % of rated), net {d['energy_net_kJ']:.0f} kJ per stroke"
+    )
+    return fig
 
 
 def save(fig: Figure, path: Path) -> None:

@@ -13,10 +13,12 @@ import numpy as np
 
 from planning.model.case import KEY_POINT_NAMES, RPM, Case
 from planning.model.cycle import HALVES
+from planning.model.drive import drive_figures
 from planning.model.laws.improved_scurve import ImprovedSCurve
 from planning.model.profile import Profile
 from planning.solver.optimize import Solution
 from planning.solver.verify import MAX_STEP_S
+from press.dynamics import drive_state
 from press.kinematics import CrankSlider
 
 TRAJECTORY_COLUMNS = (
@@ -29,25 +31,38 @@ TRAJECTORY_COLUMNS = (
     "slider_speed_mm_s",
     "slider_accel_mm_s2",
 )
+DRIVE_COLUMNS = ("crank_torque_Nm", "motor_speed_rpm", "motor_torque_Nm", "motor_power_kW")  # with a drive
 BINDING_SHARE = 1e-4  # a check within this share of its limit is reported as binding
 MAX_ROWS = 200_000  # trajectory rows at most: a cycle longer than 200 s gets a step of period / MAX_ROWS
 
 
-def sample_profile(profile: Profile, machine: CrankSlider, max_step: float = MAX_STEP_S) -> np.ndarray:
+def sample_profile(
+    profile: Profile, machine: CrankSlider, max_step: float = MAX_STEP_S, case: Case | None = None
+) -> np.ndarray:
     """``profile`` over its whole duration on a uniform time grid with step <= ``max_step`` [s] (at most
     :data:`MAX_ROWS` + 1 rows: a coarser uniform step for a long cycle); columns as
-    :data:`TRAJECTORY_COLUMNS`; the first and last rows are the profile's ends."""
+    :data:`TRAJECTORY_COLUMNS`, then :data:`DRIVE_COLUMNS` when ``case`` has a drive; the first and last
+    rows are the profile's ends."""
     n = min(int(math.ceil(profile.duration / max_step)), MAX_ROWS)
     t = np.linspace(0.0, profile.duration, n + 1)
     th, om, al, je = profile.at_time(profile.t0 + t)
     h, v, a, _ = machine.slider(th, om, al, je)
-    return np.column_stack([t, np.degrees(th), om / RPM, al, je, h, v, a])
+    columns = [t, np.degrees(th), om / RPM, al, je, h, v, a]
+    if case is not None and case.drive is not None:
+        s = drive_state(th, om, al, case.press.crank_radius_mm, case.press.rod_length_mm, case.drive_model)
+        columns += [s["crank_torque_Nm"], s["motor_speed_rad_s"] / RPM, s["motor_torque_Nm"], s["motor_power_W"] / 1e3]
+    return np.column_stack(columns)
+
+
+def trajectory_columns(case: Case) -> tuple[str, ...]:
+    """The columns of ``trajectory.csv`` for ``case``."""
+    return TRAJECTORY_COLUMNS + (DRIVE_COLUMNS if case.drive is not None else ())
 
 
 def trajectory(solution: Solution, case: Case, max_step: float = MAX_STEP_S) -> np.ndarray:
     """One full cycle of the plan from TDC (see :func:`sample_profile`); first and last rows are one
     period apart."""
-    return sample_profile(solution.plan.profile, case.machine, max_step)
+    return sample_profile(solution.plan.profile, case.machine, max_step, case)
 
 
 def key_points(solution: Solution, case: Case) -> list[dict[str, Any]]:
@@ -137,6 +152,7 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
         "key_points": key_points(solution, case),
         "segments": segments(solution),
         "paper_solution": plan.paper_solution() if plan.motion_law == ImprovedSCurve.name else None,
+        **({"drive": drive_block(solution, case)} if case.drive is not None else {}),
         "verification": {
             "passed": ver.passed,
             "step_s": ver.step_s,
@@ -150,6 +166,12 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
             "status": plan.solver.status,
         },
     }
+
+
+def drive_block(solution: Solution, case: Case) -> dict[str, Any]:
+    """The ``drive`` block of ``result.json``: what the motor must give over the cycle, and its limits."""
+    fig = drive_figures(solution.plan.profile, case)
+    return {**fig.as_dict(), "motor": case.drive.motor.model_dump(), "gear_ratio": case.drive.gear_ratio}
 
 
 def summary_text(result: dict[str, Any]) -> str:
@@ -176,6 +198,19 @@ def summary_text(result: dict[str, Any]) -> str:
             f"  {k['name']:<11} {k['angle_deg']:9.2f} {k['time_s']:8.4f} {k['height_mm']:9.1f} "
             f"{k['slider_speed_mm_s']:8.1f} {k['direction']:<2} {k['crank_speed_rpm']:9.3f}"
         )
+    if "drive" in r:
+        d = r["drive"]
+        lines += [
+            "",
+            f"  drive: peak motor torque {d['peak_motor_torque_Nm'] / 1e3:.2f} kN m "
+            f"at {d['peak_motor_torque_angle_deg']:.1f} deg "
+            f"({d['peak_torque_use_pct']:.1f} % of the envelope), RMS {d['rms_motor_torque_Nm'] / 1e3:.2f} kN m "
+            f"({d['rms_torque_use_pct']:.1f} % of rated), peak power {d['peak_motor_power_kW']:.0f} kW, "
+            f"top motor speed {d['peak_motor_speed_rpm']:.0f} rpm",
+            f"  energy per stroke: drawn {d['energy_drawn_kJ']:.1f} kJ, returned {d['energy_returned_kJ']:.1f} kJ, "
+            f"net {d['energy_net_kJ']:.1f} kJ; forming work {d['forming_work_kJ']:.1f} kJ "
+            f"(crank work {d['crank_work_kJ']:.1f} kJ)",
+        ]
     lines.append("")
     lines.append("  binding: " + (", ".join(r["binding_constraints"]) or "none"))
     v = r["verification"]

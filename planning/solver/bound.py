@@ -37,8 +37,9 @@ import numpy as np
 
 from planning.model.case import RPM, Case
 from planning.solver.ipopt import NLPSolver
-from planning.solver.optimize import precheck
+from planning.solver.optimize import crank_speed_limit, precheck
 from planning.solver.outcomes import Infeasible, NoPlanFound
+from press.dynamics import GRAVITY, forming_force
 
 DEFAULT_POINTS = 1440
 BOUND_OPTIONS = {"ipopt.max_iter": 3000}  # added to the wrapper's base options
@@ -74,6 +75,23 @@ class Bound:
         }
 
 
+def _motor_torque_bounds(case: Case, th, dth, s, s_next, alpha) -> list:  # noqa: ANN001 - CasADi MX
+    """Motor torque at both ends of every interval, as the two linear forms whose larger is the motor
+    torque: ``T_c / (i eta) + J_m i alpha`` and ``T_c eta / i + J_m i alpha``, with ``T_c`` linear in s and
+    alpha (``press.dynamics``). Both <= peak is exactly ``T_m <= peak``. The forming force is taken on
+    each interval's side of theta2 and BDC."""
+    d = case.drive_model
+    m = case.machine
+    out = []
+    for theta, speed2 in ((th[:-1] + 1e-12, s), (th[1:] - 1e-12, s_next)):
+        d1, d2, _ = m.derivatives(theta)
+        d1, d2 = d1 * 1e-3, d2 * 1e-3
+        f_env = forming_force(theta, m.height(theta), d) + d.F_cb - d.M * GRAVITY
+        tc = (d.J0 + d.M * d1**2) * alpha + d.M * d1 * d2 * speed2 - f_env * d1
+        out += [tc / (d.i * d.eta) + d.J_m * d.i * alpha, tc * d.eta / d.i + d.J_m * d.i * alpha]
+    return out
+
+
 def angle_grid(case: Case, points: int) -> np.ndarray:
     """Nodes [rad] from theta1 over one revolution, the key angles among them, about ``points`` in all."""
     th1, th2, th3, th4 = case.key_angles
@@ -102,7 +120,8 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
 
     draw = np.flatnonzero((th[:-1] >= th2 - 1e-12) & (th[:-1] <= th3 + 1e-12))
     lbx_s = np.full(n, w_min**2)
-    ubx_s = np.full(n, (lim.crank_speed_rpm * RPM) ** 2 if lim.crank_speed_rpm is not None else np.inf)
+    top = crank_speed_limit(case)  # the drive's crank-speed limit and the motor's top speed through the gear
+    ubx_s = np.full(n, top**2 if top is not None else np.inf)
     lbx_s[draw] = w2_lo**2
     ubx_s[draw] = w2_hi**2
     low = (h[:-1] <= lim.die_height_mm) & (np.abs(d1[:-1]) > 0)
@@ -139,6 +158,11 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
         g += [alpha_next - alpha - jerk_room, alpha_next - alpha + jerk_room]
         lbg += [np.full(n, -np.inf), np.zeros(n)]
         ubg += [np.zeros(n), np.full(n, np.inf)]
+    if case.drive is not None:  # the motor's peak torque, driving side (see the module docstring)
+        for expr in _motor_torque_bounds(case, th, dth, s, s_next, alpha):
+            g.append(expr)
+            lbg.append(np.full(n, -np.inf))
+            ubg.append(np.full(n, case.drive.motor.peak_torque_Nm))
     window = th[:-1] >= th4 - 1e-12  # the grid starts at theta1: the robot window is [theta4, theta1 + 2 pi)
     g.append(ca.sum1(tau[np.flatnonzero(window).tolist()]))
     lbg.append(np.array([case.process.transfer_time_s]))

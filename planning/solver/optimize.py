@@ -37,7 +37,7 @@ from planning.solver.nlp import (
 )
 from planning.solver.outcomes import Attempt, Infeasible, NoPlanFound, Unverified
 from planning.solver.verify import CHECK_FIELDS, CheckId, Verification, verify
-from press.dynamics import forming_force
+from press.dynamics import drive_state, envelope_torque, forming_force
 
 ACCEL_BACKOFF = 5e-4  # the NLP keeps |slider acceleration| <= (1 - backoff) * limit at its samples
 DRIVE_BACKOFF = 5e-5  # likewise for the motor's peak and RMS torque (refined like the acceleration if it overshoots)
@@ -83,6 +83,8 @@ def precheck(case: Case) -> tuple[float, float]:
             value=case.process.transfer_time_s,
             needed=window / w_min,
         )
+    if case.drive is not None:
+        _drive_precheck(case, w_min)
     w_given = case.process.draw_speed_rpm
     if w_given is not None:
         w2 = w_given * RPM
@@ -107,6 +109,37 @@ def precheck(case: Case) -> tuple[float, float]:
             needed=hi / RPM,
         )
     return w_min, hi
+
+
+def _drive_precheck(case: Case, w_lowest: float) -> None:
+    """Infeasible when the motor cannot make the draw even at the lowest draw speed the case allows (at
+    constant speed the draw needs the most torque where the forming force acts on the longest lever)."""
+    w2 = case.process.draw_speed_rpm * RPM if case.process.draw_speed_rpm is not None else w_lowest
+    _, th2, th3, _ = case.key_angles
+    theta = np.linspace(th2, th3, 2001)
+    state = drive_state(
+        theta,
+        np.full_like(theta, w2),
+        np.zeros_like(theta),
+        case.press.crank_radius_mm,
+        case.press.rod_length_mm,
+        case.drive_model,
+    )
+    motor = case.drive.motor
+    envelope = envelope_torque(state["motor_speed_rad_s"], motor.peak_torque_Nm, motor.base_speed_rpm * RPM)
+    use = np.abs(state["motor_torque_Nm"]) / envelope
+    k = int(np.argmax(use))
+    if use[k] > 1.0:
+        needed = float(abs(state["motor_torque_Nm"][k]))
+        raise Infeasible(
+            f"drive.motor.peak_torque_Nm = {motor.peak_torque_Nm:g} cannot make the draw: at "
+            f"{math.degrees(theta[k]):.1f} deg and {w2 / RPM:.3g} rpm the motors must give {needed:.0f} N m"
+            + (f" ({100 * use[k]:.0f} % of the envelope at that speed)" if envelope[k] < motor.peak_torque_Nm else ""),
+            limit="drive.motor.peak_torque_Nm",
+            value=motor.peak_torque_Nm,
+            needed=needed,
+            angle_deg=math.degrees(theta[k]),
+        )
 
 
 def nlp_parameters(case: Case) -> np.ndarray:
