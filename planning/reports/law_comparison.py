@@ -32,6 +32,11 @@ COLUMNS = (
     ("rms_crank_accel_rad_s2", "RMS crank accel [rad/s²]", ".3f"),
     ("continuity", "continuous up to", ""),
 )
+DRIVE_COLUMNS = (  # with a drive, after the others
+    ("peak_motor_torque_Nm", "peak motor torque [N m]", ".0f"),
+    ("rms_motor_torque_Nm", "RMS motor torque [N m]", ".0f"),
+    ("energy_net_kJ", "net energy [kJ/stroke]", ".1f"),
+)
 
 
 def law_row(law: str, solution: Solution, case: Case, bound: Bound, table: np.ndarray) -> dict[str, Any]:
@@ -54,12 +59,26 @@ def law_row(law: str, solution: Solution, case: Case, bound: Bound, table: np.nd
         "peak_slider_jerk_mm_s3": float(np.max(np.abs(slider_jerk))),
         "rms_crank_accel_rad_s2": float(math.sqrt(mean_sq)),
         "continuity": LAWS[law].continuity,
+        **_drive_columns(solution, case),
         "law_parameter": float(plan.parameters.law_parameter) if LAWS[law].parameter else None,
         "law_parameter_name": LAWS[law].parameter.name if LAWS[law].parameter else None,
         "placement": plan.placement,
         "structure": plan.structure,
         "binding_constraints": binding(solution),
     }
+
+
+def _drive_columns(solution: Solution, case: Case) -> dict[str, Any]:
+    if case.drive is None:
+        return {}
+    from planning.model.drive import drive_figures
+
+    fig = drive_figures(solution.plan.profile, case).as_dict()
+    return {key: fig[key] for key, _, _ in DRIVE_COLUMNS}
+
+
+def _columns(data: dict[str, Any]) -> tuple:
+    return COLUMNS + (DRIVE_COLUMNS if data.get("drive") else ())
 
 
 def compare_laws(case: Case, laws: tuple[str, ...] = tuple(LAWS)) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
@@ -84,24 +103,27 @@ def compare_laws(case: Case, laws: tuple[str, ...] = tuple(LAWS)) -> tuple[dict[
         "placement": case.planner.placement,
         "bound": bound.as_dict(),
         "jerk_limited_bound": case.limits.crank_jerk_rad_s3 is not None,
+        **({"drive": True} if case.drive is not None else {}),
         "laws": rows,
     }, tables
 
 
 def laws_markdown(data: dict[str, Any]) -> str:
     """The comparison as a Markdown table, with the bound in the last row."""
-    head = "| " + " | ".join(title for _, title, _ in COLUMNS) + " |"
-    rule = "|" + "|".join("---" if fmt == "" else "---:" for _, _, fmt in COLUMNS) + "|"
+    columns = _columns(data)
+    head = "| " + " | ".join(title for _, title, _ in columns) + " |"
+    rule = "|" + "|".join("---" if fmt == "" else "---:" for _, _, fmt in columns) + "|"
     lines = [head, rule]
     for row in data["laws"]:
         if row["status"] != "verified":
-            lines.append(f"| {row['law']} | {row['status']} |" + " |" * (len(COLUMNS) - 2))
+            lines.append(f"| {row['law']} | {row['status']} |" + " |" * (len(columns) - 2))
             continue
-        cells = [format(row[key], fmt) if fmt else str(row[key]) for key, _, fmt in COLUMNS]
+        cells = [format(row[key], fmt) if fmt else str(row[key]) for key, _, fmt in columns]
         lines.append("| " + " | ".join(cells) + " |")
     b = data["bound"]
     kind = "jerk-limited bound" if data["jerk_limited_bound"] else "time-optimal bound"
-    lines.append(f"| *{kind}* | {b['spm']:.3f} | 100.0 | {b['peak_crank_speed_rpm']:.2f} | | | | | shape free |")
+    tail = " |" * (len(columns) - len(COLUMNS))
+    lines.append(f"| *{kind}* | {b['spm']:.3f} | 100.0 | {b['peak_crank_speed_rpm']:.2f} | | | | | shape free |{tail}")
     return "\n".join(lines) + "\n"
 
 
@@ -123,5 +145,10 @@ def laws_text(data: dict[str, Any]) -> str:
             f"{r['peak_crank_accel_rad_s2']:8.3f} {r['peak_crank_jerk_rad_s3']:9.1f} "
             f"{r['peak_slider_jerk_mm_s3']:11.0f} {r['rms_crank_accel_rad_s2']:8.3f}  {r['continuity']}"
         )
+        if data.get("drive"):
+            lines.append(
+                f"  {'':<17} motor: peak {r['peak_motor_torque_Nm']:.0f} N m, RMS {r['rms_motor_torque_Nm']:.0f} N m, "
+                f"net {r['energy_net_kJ']:.1f} kJ/stroke"
+            )
     lines.append("  units: rpm, rad/s^2, rad/s^3, mm/s^3; RMS over one cycle")
     return "\n".join(lines)
