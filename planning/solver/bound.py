@@ -144,7 +144,7 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
     alpha = (s_next - s) / (2 * dth)
     a_start = d2[:-1] * s + d1[:-1] * alpha
     a_end = d2[1:] * s_next + d1[1:] * alpha
-    g = [(tau - 2 * dth / (ca.sqrt(s) + ca.sqrt(s_next))) / tau_unit, a_start, a_end]
+    g = [tau - 2 * dth / (ca.sqrt(s) + ca.sqrt(s_next)), a_start, a_end]
     lbg = [np.zeros(n), -lim.slider_accel_mm_s2 * np.ones(n), -lim.slider_accel_mm_s2 * np.ones(n)]
     ubg = [np.full(n, np.inf), lim.slider_accel_mm_s2 * np.ones(n), lim.slider_accel_mm_s2 * np.ones(n)]
     if lim.crank_accel_rad_s2 is not None:  # the drive's acceleration limit, linear in s
