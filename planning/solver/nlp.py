@@ -151,7 +151,6 @@ BLOCK_FIELDS = {
     "crank acceleration limit": "limits.crank_accel_rad_s2",
     "crank jerk limit": "limits.crank_jerk_rad_s3",
     "motor peak torque": "drive.motor.peak_torque_Nm",
-    "motor constant-power corner": "drive.motor.base_speed_rpm",
     "motor RMS torque": "drive.motor.rated_torque_Nm",
 }
 
@@ -228,9 +227,9 @@ def values_of(result: NLPResult) -> dict[str, float]:
 
 
 def _drive_constraints(add, p_case, th, om, al, d1, d2, times, period) -> None:  # noqa: ANN001 - SX
-    """The motor's limits at the samples (``press.dynamics``): the peak-torque envelope (peak torque, and
-    the constant-power corner above the base speed) and the RMS torque over the cycle by the trapezoidal
-    rule over the samples. The forming force enters at the draw's samples, the last FORMING_SAMPLES."""
+    """The motor's limits at the samples (``press.dynamics``): the peak-torque envelope (peak torque up to
+    the base speed, constant power above it, as one row) and the RMS torque over the cycle by the
+    trapezoidal rule over the samples. The forming force enters at the draw's samples, the last FORMING_SAMPLES."""
     q = {name: p_case[k] for name, k in DRIVE_INDEX.items()}
     start = len(PARAMETERS) + len(DRIVE_PARAMETERS)
     forming = ca.vertcat(ca.DM.zeros(th.shape[0] - FORMING_SAMPLES), p_case[start : start + FORMING_SAMPLES])
@@ -239,9 +238,9 @@ def _drive_constraints(add, p_case, th, om, al, d1, d2, times, period) -> None: 
     )
     tc = crank_torque(om, al, d1, d2, forming, model)
     tm = motor_torque(tc, al, model)
-    add("motor peak torque", tm / q["motor_peak"], -1.0, 1.0)
-    corner = tm * motor_speed(om, model) / (q["motor_peak"] * q["motor_base_speed"])
-    add("motor constant-power corner", corner, -1.0, 1.0)
+    # |T_m| max(1, n / n_base) <= peak is the envelope in one row per sample (kink at the base speed)
+    above_base = ca.fmax(1.0, motor_speed(om, model) / q["motor_base_speed"])
+    add("motor peak torque", tm * above_base / q["motor_peak"], -1.0, 1.0)
     sq = tm**2
     n = th.shape[0]
     integral = ca.sum1((times[1:n] - times[0 : n - 1]) * (sq[1:n] + sq[0 : n - 1]) / 2)
