@@ -339,10 +339,11 @@ class _Search:
                 return values, plan.period
             bad = check.failures()
             self.attempts.append(Attempt(check=bad[0], case_field=CHECK_FIELDS.get(bad[0].id, "")))
-            if any(c.id not in REFINED for c in bad):
+            refinable = {cid: k for cid, k in REFINED.items() if k < q.size}  # the NLP's own limits
+            if any(c.id not in refinable for c in bad):
                 return None
             for c in bad:  # lower the NLP's sampled limit by the measured overshoot
-                q[REFINED[c.id]] *= (c.limit / c.value) * (1 - 1e-5)
+                q[refinable[c.id]] *= (c.limit / c.value) * (1 - 1e-5)
         return None
 
     def multi_start(self, x0s: list[dict[str, float]], placement: Placement) -> dict[str, float] | None:
@@ -401,10 +402,27 @@ def solve(
     neighbour = _adopt(search, neighbour)
     if follow and _follow(search, neighbour):
         return search.answer()
+    if case.drive is not None and search.best is None and _kinematic_first(search, neighbour):
+        return search.answer()
     _multi_start(search, neighbour)
     if search.best is None:
         _try_harder(search, neighbour)
     return search.answer()
+
+
+def _kinematic_first(search: _Search, neighbour: Plan | None) -> bool:
+    """A case with a drive: solve it first without the motor's rows (the kinematic NLP, smaller and
+    faster). Its optimum is the drive problem's too when the motor can drive it, because the motor's
+    limits only take plans away; the dense verification (motor checks included) decides. Whether that
+    answered the case."""
+    law = search.case.planner.motion_law
+    kinematic = replace(
+        search, nlp=cycle_nlp(law, False), parameters=search.parameters[: len(PARAMETERS)], attempts=[]
+    )
+    _multi_start(kinematic, neighbour)
+    search.iterations, search.starts = kinematic.iterations, kinematic.starts
+    search.best = kinematic.best
+    return search.best is not None
 
 
 def _multi_start(search: _Search, neighbour: Plan | None) -> None:
