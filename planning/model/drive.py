@@ -23,7 +23,7 @@ from planning.model.profile import Profile
 from press.dynamics import drive_state, forming_work
 
 GAUSS_NODES = 4
-MAX_PIECE_S = 1e-3  # [s]
+MAX_PIECE_S = 5e-3  # [s] (4-point Gauss-Legendre is exact for polynomials of degree 7 on each piece)
 MAX_PIECES = 400_000  # a longer cycle gets longer pieces
 
 
@@ -84,24 +84,38 @@ def quadrature(profile: Profile, case: Case) -> tuple[np.ndarray, np.ndarray]:
     return nodes, weights
 
 
-def drive_figures(profile: Profile, case: Case) -> DriveFigures:
-    """The drive's figures over the cycle of ``profile`` (a plan's, from TDC); needs ``case.drive``."""
-    drive = case.drive_model
-    motor = case.drive.motor
-    R, L = case.press.crank_radius_mm, case.press.rod_length_mm
+def cycle_integrals(profile: Profile, case: Case) -> dict[str, float]:
+    """The quadrature's integrals over the cycle: ``rms_motor_torque_Nm``, ``energy_drawn_kJ``,
+    ``energy_returned_kJ``, ``crank_work_kJ``, ``crank_work_abs_kJ``, ``forming_work_kJ``, and the
+    quadrature's drive state (``state``, ``omega``) for the peaks."""
     t, w = quadrature(profile, case)
     th, om, al, _ = profile.at_time(t)
-    s = drive_state(th, om, al, R, L, drive)
+    s = drive_state(th, om, al, case.press.crank_radius_mm, case.press.rod_length_mm, case.drive_model)
     tm, p = s["motor_torque_Nm"], s["motor_power_W"]
-    period = profile.duration
-    envelope = _envelope(s["motor_speed_rad_s"], case)
-    dense = _dense_peaks(profile, case)
     h2 = float(case.machine.height(case.key_angles[1]))
-    forming = forming_work(h2, 0.0, drive)
+    work = s["crank_torque_Nm"] * om
+    return {
+        "rms_motor_torque_Nm": math.sqrt(float(np.sum(w * tm**2)) / profile.duration),
+        "energy_drawn_kJ": float(np.sum(w * np.maximum(p, 0.0))) / 1e3,
+        "energy_returned_kJ": float(np.sum(w * np.minimum(p, 0.0))) / 1e3,
+        "crank_work_kJ": float(np.sum(w * work)) / 1e3,
+        "crank_work_abs_kJ": float(np.sum(w * np.abs(work))) / 1e3,
+        "forming_work_kJ": forming_work(h2, 0.0, case.drive_model) / 1e3,
+        "state": s,
+    }
+
+
+def drive_figures(profile: Profile, case: Case) -> DriveFigures:
+    """The drive's figures over the cycle of ``profile`` (a plan's, from TDC); needs ``case.drive``.
+    Integrals by the quadrature (:func:`cycle_integrals`); peaks on the dense grid and the quadrature's
+    nodes together."""
+    motor = case.drive.motor
+    c = cycle_integrals(profile, case)
+    s = c["state"]
+    tm, p = s["motor_torque_Nm"], s["motor_power_W"]
+    dense = _dense_peaks(profile, case)
     k = int(np.argmax(dense["abs_torque"]))
-    e_plus = float(np.sum(w * np.maximum(p, 0.0)))
-    e_minus = float(np.sum(w * np.minimum(p, 0.0)))
-    rms = math.sqrt(float(np.sum(w * tm**2)) / period)
+    rms = c["rms_motor_torque_Nm"]
     return DriveFigures(
         peak_motor_torque_Nm=float(dense["abs_torque"][k]),
         peak_motor_torque_angle_deg=float(math.degrees(dense["theta"][k]) % 360.0),
@@ -109,13 +123,14 @@ def drive_figures(profile: Profile, case: Case) -> DriveFigures:
         peak_crank_torque_Nm=float(max(np.max(np.abs(s["crank_torque_Nm"])), dense["abs_crank"])),
         peak_motor_power_kW=float(max(np.max(np.abs(p)), dense["abs_power"])) / 1e3,
         peak_motor_speed_rpm=float(np.max(s["motor_speed_rad_s"])) / RPM,
-        energy_drawn_kJ=e_plus / 1e3,
-        energy_returned_kJ=e_minus / 1e3,
-        energy_net_kJ=(e_plus + e_minus) / 1e3,
-        forming_work_kJ=forming / 1e3,
-        crank_work_kJ=float(np.sum(w * s["crank_torque_Nm"] * om)) / 1e3,
-        crank_work_abs_kJ=float(np.sum(w * np.abs(s["crank_torque_Nm"] * om))) / 1e3,
-        peak_torque_use_pct=100.0 * max(float(np.max(np.abs(tm) / envelope)), dense["envelope_use"]),
+        energy_drawn_kJ=c["energy_drawn_kJ"],
+        energy_returned_kJ=c["energy_returned_kJ"],
+        energy_net_kJ=c["energy_drawn_kJ"] + c["energy_returned_kJ"],
+        forming_work_kJ=c["forming_work_kJ"],
+        crank_work_kJ=c["crank_work_kJ"],
+        crank_work_abs_kJ=c["crank_work_abs_kJ"],
+        peak_torque_use_pct=100.0
+        * max(float(np.max(np.abs(tm) / _envelope(s["motor_speed_rad_s"], case))), dense["envelope_use"]),
         rms_torque_use_pct=100.0 * rms / motor.rated_torque_Nm,
     )
 

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -136,7 +137,12 @@ class Profile:
         return float(self.durations.sum())
 
     def knots(self) -> np.ndarray:
-        """Knot states as an array of shape ``(n + 1, 3)``: theta [rad], omega [rad/s], alpha [rad/s^2]."""
+        """Knot states as an array of shape ``(n + 1, 3)``: theta [rad], omega [rad/s], alpha [rad/s^2]
+        (computed once per profile; a copy is returned)."""
+        return self._knots.copy()
+
+    @cached_property
+    def _knots(self) -> np.ndarray:
         return np.array(knot_states(self.theta0, self.omega0, self.alpha0, self.segments), dtype=float)
 
     def at_time(self, t: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

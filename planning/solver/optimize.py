@@ -416,9 +416,7 @@ def _kinematic_first(search: _Search, neighbour: Plan | None) -> bool:
     limits only take plans away; the dense verification (motor checks included) decides. Whether that
     answered the case."""
     law = search.case.planner.motion_law
-    kinematic = replace(
-        search, nlp=cycle_nlp(law, False), parameters=search.parameters[: len(PARAMETERS)], attempts=[]
-    )
+    kinematic = replace(search, nlp=cycle_nlp(law, False), parameters=search.parameters[: len(PARAMETERS)], attempts=[])
     _multi_start(kinematic, neighbour)
     search.iterations, search.starts = kinematic.iterations, kinematic.starts
     search.best = kinematic.best

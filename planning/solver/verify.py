@@ -291,7 +291,7 @@ def verify(plan: Plan, case: Case) -> Verification:
 def _drive_checks(add, plan: Plan, case: Case, th, om, al) -> None:  # noqa: ANN001 - the add() of verify
     """The motor's limits on the dense grid, its RMS torque and the energy balance by quadrature
     (``planning.model.drive``)."""
-    from planning.model.drive import drive_figures
+    from planning.model.drive import cycle_integrals
     from press.dynamics import drive_state, envelope_torque
 
     motor = case.drive.motor
@@ -301,15 +301,15 @@ def _drive_checks(add, plan: Plan, case: Case, th, om, al) -> None:  # noqa: ANN
     add(CheckId.MOTOR_PEAK, "motor peak torque", use, 1.0, "of the envelope", "max", REL_TOL)
     top = float(np.max(s["motor_speed_rad_s"])) / RPM
     add(CheckId.MOTOR_SPEED, "motor speed", top, motor.max_speed_rpm, "rpm", "max", REL_TOL * motor.max_speed_rpm)
-    fig = drive_figures(plan.profile, case)
+    fig = cycle_integrals(plan.profile, case)
     rated = motor.rated_torque_Nm
-    add(CheckId.MOTOR_RMS, "motor RMS torque", fig.rms_motor_torque_Nm, rated, "N m", "max", REL_TOL * rated)
-    scale = max(abs(fig.forming_work_kJ), fig.crank_work_abs_kJ)
+    add(CheckId.MOTOR_RMS, "motor RMS torque", fig["rms_motor_torque_Nm"], rated, "N m", "max", REL_TOL * rated)
+    scale = max(abs(fig["forming_work_kJ"]), fig["crank_work_abs_kJ"])
     add(
         CheckId.ENERGY_BALANCE,
         "energy balance: crank work = forming work",
-        fig.crank_work_kJ,
-        fig.forming_work_kJ,
+        fig["crank_work_kJ"],
+        fig["forming_work_kJ"],
         "kJ",
         "equal",
         ENERGY_REL_TOL * scale,
