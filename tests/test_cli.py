@@ -171,3 +171,20 @@ def test_last_iterate_names_the_violated_constraint():
     block = next(b for b in nlp.blocks if b.name == "transfer time")
     g[block.start] = -0.7  # 0.7 s short of the transfer time
     assert nlp.worst_violation("free", g) == ("transfer time", 0.7)
+
+
+def test_check_warns_when_the_slide_is_below_the_die_height_at_theta3(capsys, tmp_path):
+    """The published case ends its draw at 9.38 mm, under the 10 mm die height: check says where the
+    slide leaves the die zone (the ascending crossing, from the exact geometry)."""
+    import math
+
+    from press.kinematics import CrankSlider
+
+    assert main(["check", str(PUBLISHED_CASE)]) == 0
+    out = capsys.readouterr().out
+    leave = math.degrees(float(CrankSlider(450, 1200).angles_at_height(10.0)[1]))
+    assert "WARNING" in out and f"{leave:.2f} deg" in out
+    early = tmp_path / "early.yaml"
+    early.write_text(PUBLISHED_CASE.read_text().replace("draw_end_deg: 190 ", "draw_end_deg: 195 "))
+    assert main(["check", str(early), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["warnings"] == []

@@ -62,7 +62,26 @@ def check_case(case: Case) -> dict[str, Any]:
         "checks": checks,
         "max_draw_speed_rpm": w_max / RPM,
         "max_draw_speed_by_limit_rpm": {k: (b / RPM if math.isfinite(b) else None) for k, b in bounds.items()},
+        "warnings": warnings(case),
     }
+
+
+def warnings(case: Case) -> list[str]:
+    """What a press engineer should know before solving: a draw end (theta3) where the slide is still
+    below the die height, so the return cannot speed up until it has left the die zone."""
+    out = []
+    m = case.machine
+    die = case.limits.die_height_mm
+    th3 = case.key_angles[2]
+    h3 = float(m.height(th3))
+    if h3 < die and die < m.stroke:
+        leave = float(m.angles_at_height(die)[1])
+        out.append(
+            f"the slide is still below limits.die_height_mm = {die:g} mm at theta3 = "
+            f"{math.degrees(th3):.2f} deg ({h3:.2f} mm); it leaves the die zone at {math.degrees(leave):.2f} deg. "
+            "Until then the die-height speed limit holds the return back, whatever the motion law"
+        )
+    return out
 
 
 def _check(name: str, value: float, limit: float, unit: str, kind: str) -> dict[str, Any]:
@@ -101,4 +120,5 @@ def check_text(report: dict[str, Any]) -> str:
         f"{k.replace('_', ' ')} {v:.3f}" for k, v in report["max_draw_speed_by_limit_rpm"].items() if v is not None
     )
     lines += ["", f"  highest draw speed the limits allow: {report['max_draw_speed_rpm']:.3f} rpm ({by})"]
+    lines += [f"  WARNING: {w}" for w in report["warnings"]]
     return "\n".join(lines)
