@@ -202,6 +202,12 @@ def plot_files(
     return out
 
 
+def _plus_minus(ax, value: float, label: str, **style) -> None:  # noqa: ANN001 - a matplotlib Axes
+    """Horizontal lines at +value and -value, one legend entry."""
+    ax.axhline(value, label=label, **style)
+    ax.axhline(-value, **style)
+
+
 def drive_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
     """The servo-sizing picture: the cycle's operating points in the torque-speed plane over the motor's
     peak envelope and rated line; motor torque and power against crank angle with the stages shaded."""
@@ -216,13 +222,7 @@ def drive_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
     envelope = motor["peak_torque_Nm"] * np.minimum(1.0, motor["base_speed_rpm"] / np.maximum(n, 1e-9)) / 1e3
     for sign in (1, -1):
         plane.plot(n, sign * envelope, color="#b22222", lw=1.6, label="peak envelope" if sign > 0 else None)
-        plane.axhline(
-            sign * motor["rated_torque_Nm"] / 1e3,
-            color="#e08000",
-            lw=1.2,
-            ls="--",
-            label="rated (RMS limit)" if sign > 0 else None,
-        )
+    _plus_minus(plane, motor["rated_torque_Nm"] / 1e3, "rated (RMS limit)", color="#e08000", lw=1.2, ls="--")
     plane.axvline(motor["max_speed_rpm"], color="#b22222", lw=1.0, ls=":", label="max speed")
     points = plane.scatter(
         t["motor_speed_rpm"],
@@ -247,14 +247,7 @@ def drive_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
     for ax, label_stages in ((torque, True), (power, False)):
         _decorate(ax, result, "angle", label_stages)
     torque.plot(x, t["motor_torque_Nm"] / 1e3, color="#1f77b4", lw=1.4, label="motor torque")
-    for sign in (1, -1):
-        torque.axhline(
-            sign * motor["peak_torque_Nm"] / 1e3,
-            color="#b22222",
-            lw=1.0,
-            ls="--",
-            label="peak torque" if sign > 0 else None,
-        )
+    _plus_minus(torque, motor["peak_torque_Nm"] / 1e3, "peak torque", color="#b22222", lw=1.0, ls="--")
     torque.set_ylabel("motor torque [kN m]")
     torque.legend(fontsize=8, loc="lower left")
     power.plot(x, t["motor_power_kW"], color="#2ca02c", lw=1.4, label="motor power (drawn > 0)")
