@@ -210,3 +210,23 @@ def test_solve_and_sweep_take_a_law(tmp_path, capsys):
     spm_at_2s = float(rows[2].split(",")[2])  # transfer time 2.0 s: the case itself, under seven-segment
     assert spm_at_2s == pytest.approx(solve(read_case(PUBLISHED_CASE).with_law("seven-segment")).plan.spm, abs=1e-6)
     capsys.readouterr()
+
+
+def test_laws_go_on_when_the_bound_has_no_answer(monkeypatch, tmp_path, capsys):
+    """The bound is a yardstick: when it has no answer the laws are still compared and written."""
+    import planning.reports.law_comparison as comparison
+    from planning.cli import main
+    from planning.solver.outcomes import NoPlanFound
+
+    from .conftest import PUBLISHED_CASE
+
+    def no_bound(case, points=1440):
+        raise NoPlanFound("the time-optimal bound did not converge (Maximum_Iterations_Exceeded)")
+
+    monkeypatch.setattr(comparison, "time_optimal_bound", no_bound)
+    out = tmp_path / "laws"
+    assert main(["laws", str(PUBLISHED_CASE), "--out", str(out), "--json"]) == 0
+    data = json.loads((out / "laws.json").read_text())
+    assert data["bound"] is None and "did not converge" in data["bound_failure"]
+    assert all(r["status"] == "verified" and r["share_of_bound_pct"] is None for r in data["laws"])
+    assert "| – |" in (out / "laws.md").read_text()

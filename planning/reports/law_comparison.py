@@ -39,7 +39,7 @@ DRIVE_COLUMNS = (  # with a drive, after the others
 )
 
 
-def law_row(law: str, solution: Solution, case: Case, bound: Bound, table: np.ndarray) -> dict[str, Any]:
+def law_row(law: str, solution: Solution, case: Case, bound: Bound | None, table: np.ndarray) -> dict[str, Any]:
     """The figures of merit of one verified plan (engineering units in the keys); ``table``: its
     trajectory from :func:`planning.reports.report.sample_profile`."""
     plan = solution.plan
@@ -52,7 +52,7 @@ def law_row(law: str, solution: Solution, case: Case, bound: Bound, table: np.nd
         "status": "verified",
         "spm": plan.spm,
         "cycle_time_s": plan.period,
-        "share_of_bound_pct": 100.0 * plan.spm / bound.spm,
+        "share_of_bound_pct": 100.0 * plan.spm / bound.spm if bound is not None else None,
         "peak_crank_speed_rpm": float(np.max(om)),
         "peak_crank_accel_rad_s2": float(np.max(np.abs(al))),
         "peak_crank_jerk_rad_s3": max_abs_jerk(plan.profile),
@@ -86,8 +86,11 @@ def compare_laws(case: Case, laws: tuple[str, ...] = tuple(LAWS)) -> tuple[dict[
     plan, its trajectory (columns :data:`planning.reports.report.TRAJECTORY_COLUMNS`).
 
     A law without a verified plan gets a row with ``status`` ``failed: <reason>`` and no numbers;
-    the bound's failure raises :class:`PlanningError` (nothing to compare against)."""
-    bound = time_optimal_bound(case)
+    when the bound has no answer the laws are still compared (``bound`` None, ``bound_failure`` says why)."""
+    try:
+        bound, bound_failure = time_optimal_bound(case), None
+    except PlanningError as exc:
+        bound, bound_failure = None, str(exc)
     rows, tables = [], {}
     for law in laws:
         variant = case.with_law(law)
@@ -101,11 +104,19 @@ def compare_laws(case: Case, laws: tuple[str, ...] = tuple(LAWS)) -> tuple[dict[
     return {
         "case": case.name,
         "placement": case.planner.placement,
-        "bound": bound.as_dict(),
+        "bound": bound.as_dict() if bound is not None else None,
+        **({"bound_failure": bound_failure} if bound_failure else {}),
         "jerk_limited_bound": case.limits.crank_jerk_rad_s3 is not None,
         **({"drive": True} if case.drive is not None else {}),
         "laws": rows,
     }, tables
+
+
+def _cell(value: Any, fmt: str) -> str:
+    """A table cell: ``value`` formatted, or a dash when there is none (no bound)."""
+    if value is None:
+        return "–"
+    return format(value, fmt) if fmt else str(value)
 
 
 def laws_markdown(data: dict[str, Any]) -> str:
@@ -118,9 +129,11 @@ def laws_markdown(data: dict[str, Any]) -> str:
         if row["status"] != "verified":
             lines.append(f"| {row['law']} | {row['status']} |" + " |" * (len(columns) - 2))
             continue
-        cells = [format(row[key], fmt) if fmt else str(row[key]) for key, _, fmt in columns]
+        cells = [_cell(row[key], fmt) for key, _, fmt in columns]
         lines.append("| " + " | ".join(cells) + " |")
     b = data["bound"]
+    if b is None:
+        return "\n".join(lines) + "\n"
     kind = "jerk-limited bound" if data["jerk_limited_bound"] else "time-optimal bound"
     tail = " |" * (len(columns) - len(COLUMNS))
     lines.append(f"| *{kind}* | {b['spm']:.3f} | 100.0 | {b['peak_crank_speed_rpm']:.2f} | | | | | shape free |{tail}")
@@ -130,8 +143,9 @@ def laws_markdown(data: dict[str, Any]) -> str:
 def laws_text(data: dict[str, Any]) -> str:
     """The console table of a comparison."""
     b = data["bound"]
+    bound_text = f"bound {b['spm']:.3f} SPM" if b is not None else f"no bound ({data.get('bound_failure')})"
     lines = [
-        f"{data['case']}: motion laws ({data['placement']} placement), bound {b['spm']:.3f} SPM"
+        f"{data['case']}: motion laws ({data['placement']} placement), {bound_text}"
         + (" (with the crank-jerk limit)" if data["jerk_limited_bound"] else ""),
         f"  {'law':<17} {'SPM':>7} {'% bound':>7} {'rpm max':>8} {'acc max':>8} {'jerk max':>9} "
         f"{'slider jerk':>11} {'acc RMS':>8}  continuous up to",
@@ -141,7 +155,8 @@ def laws_text(data: dict[str, Any]) -> str:
             lines.append(f"  {r['law']:<17} {r['status']}")
             continue
         lines.append(
-            f"  {r['law']:<17} {r['spm']:7.3f} {r['share_of_bound_pct']:7.1f} {r['peak_crank_speed_rpm']:8.2f} "
+            f"  {r['law']:<17} {r['spm']:7.3f} {_cell(r['share_of_bound_pct'], '7.1f')} "
+            f"{r['peak_crank_speed_rpm']:8.2f} "
             f"{r['peak_crank_accel_rad_s2']:8.3f} {r['peak_crank_jerk_rad_s3']:9.1f} "
             f"{r['peak_slider_jerk_mm_s3']:11.0f} {r['rms_crank_accel_rad_s2']:8.3f}  {r['continuity']}"
         )
