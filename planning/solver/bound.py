@@ -93,9 +93,18 @@ def _motor_torque_bounds(case: Case, th, dth, s, s_next, alpha) -> list:  # noqa
 
 
 def angle_grid(case: Case, points: int) -> np.ndarray:
-    """Nodes [rad] from theta1 over one revolution, the key angles among them, about ``points`` in all."""
+    """Nodes [rad] from theta1 over one revolution, about ``points`` in all. Among them: the key angles,
+    TDC, and the angles where the slide passes the die height, so that the die-height speed limit holds
+    exactly where it starts and ends (between nodes it would be missed)."""
     th1, th2, th3, th4 = case.key_angles
-    arcs = [th1, th2, th3, th4, th1 + 2 * math.pi]
+    two_pi = 2 * math.pi
+    breaks = {th2, th3, th4, two_pi}
+    die = case.limits.die_height_mm
+    if 0 < die < case.machine.stroke:
+        breaks |= {float(a) for a in case.machine.angles_at_height(die)}
+    inside = sorted(a + two_pi if a <= th1 else a for a in breaks)
+    inside = [a for a in inside if th1 + 1e-9 < a < th1 + two_pi - 1e-9]
+    arcs = [th1, *sorted(set(inside)), th1 + two_pi]
     nodes = [np.array([th1])]
     for a, b in zip(arcs[:-1], arcs[1:], strict=True):
         n = max(4, int(round(points * (b - a) / (2 * math.pi))))
@@ -124,7 +133,7 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
     ubx_s = np.full(n, top**2 if top is not None else np.inf)
     lbx_s[draw] = w2_lo**2
     ubx_s[draw] = w2_hi**2
-    low = (h[:-1] <= lim.die_height_mm) & (np.abs(d1[:-1]) > 0)
+    low = (h[:-1] <= lim.die_height_mm * (1 + 1e-12) + 1e-9) & (np.abs(d1[:-1]) > 0)  # the crossings count
     ubx_s[low] = np.minimum(ubx_s[low], (lim.die_speed_mm_s / np.abs(d1[:-1][low])) ** 2)
     if np.any(ubx_s < lbx_s):
         raise Infeasible(
