@@ -74,7 +74,17 @@ def test_killed_solve_leaves_the_folder_entirely_old_or_entirely_new(tmp_path):
 @pytest.mark.skipif(sys.platform != "linux", reason="signals to child processes")
 def test_ctrl_c_is_one_line_and_exit_130(tmp_path):
     proc = subprocess.Popen(
-        [*PRESSPLAN, "laws", str(PUBLISHED_CASE), "--out", str(tmp_path / "o")],
+        [  # 41 solves in this process: several seconds on any machine
+            *PRESSPLAN,
+            "sweep",
+            str(PUBLISHED_CASE),
+            "--vary",
+            "process.transfer_time_s=1.0:3.0:41",
+            "--workers",
+            "1",
+            "--out",
+            str(tmp_path / "o"),
+        ],
         cwd=ROOT,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
