@@ -1,7 +1,8 @@
 """The ``pressplan`` command: a thin layer over the Python API.
 
 Exit status: 0 success, 2 bad input (case file, arguments, output folder), 3 no feasible or no
-verified plan. Every error is one line on stderr; no traceback.
+verified plan, 130 interrupted (Ctrl-C), 143 terminated (SIGTERM). Every error is one line on stderr;
+no traceback. Outcomes become exit statuses in one place, :func:`_exit_code`.
 """
 
 from __future__ import annotations

@@ -5,7 +5,10 @@ peak speeds near the constant-speed acceleration bound, and half durations that 
 between the key points (the same for every motion law: each half of every law sweeps
 ``D (v_start + v_end) / 2``). The NLP is the one of the case's motion law (``planner.motion_law``).
 ``free`` placement starts also from the ``published`` placement's solution, so it is never worse
-than that structure, and keeps the best plan that verifies.
+than that structure, and keeps the best plan that verifies. A case with a drive is solved first
+without the motor's rows; that optimum is the answer when the motor can drive it (the motor's limits
+only take plans away), else the drive NLP runs. Without a verified plan the answer is a typed
+outcome (``planning.solver.outcomes``).
 """
 
 from __future__ import annotations
