@@ -173,3 +173,15 @@ def test_bad_drive_field_is_exit_2_naming_it(old, new, field, tmp_path, capsys):
     assert main(["check", str(path)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and field in err[0]
+
+
+def test_a_motor_too_small_for_the_draws_heat_is_exit_3_naming_it(tmp_path, capsys):
+    """The draw alone over the longest cycle the minimum crank speed allows already overheats a motor
+    rated 4 kN m (at least 6.56 kN m RMS): proven before any solve, so `infeasible`."""
+    text = DRIVE_CASES[0].read_text().replace("rated_torque_Nm: 20000", "rated_torque_Nm: 4000")
+    path = tmp_path / "hot.yaml"
+    path.write_text(text)
+    assert main(["solve", str(path), "--out", str(tmp_path / "o")]) == 3
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "infeasible: drive.motor.rated_torque_Nm = 4000" in err[0]
+    assert "limits.min_crank_speed_rpm" in err[0]

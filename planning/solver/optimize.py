@@ -43,6 +43,7 @@ from planning.solver.verify import CHECK_FIELDS, CheckId, Verification, verify
 from press.dynamics import drive_state, envelope_torque, forming_force
 
 ACCEL_BACKOFF = 5e-4  # the NLP keeps |slider acceleration| <= (1 - backoff) * limit at its samples
+RMS_PROOF_MARGIN = 1e-3  # relative: the trapezoidal draw integral of the RMS precheck is far more accurate
 DRIVE_BACKOFF = 5e-5  # likewise for the motor's peak and RMS torque (refined like the acceleration if it overshoots)
 MIN_HALF_S = 4e-3  # [s] lower bound on the duration of a half (1 ms per improved-S-curve sub-segment)
 MAX_TIME_S = 600.0  # [s] least upper bound on a time variable (see _bounds)
@@ -142,6 +143,23 @@ def _drive_precheck(case: Case, w_lowest: float) -> None:
             value=motor.peak_torque_Nm,
             needed=needed,
             angle_deg=math.degrees(theta[k]),
+        )
+    if case.process.draw_speed_rpm is None:
+        return
+    # RMS: the draw alone gives integral T_m^2 dt = integral T_m^2 dtheta / w2, and no cycle is longer than
+    # one turn at the minimum crank speed, so RMS^2 >= that integral / (2 pi / w_min)
+    sq = state["motor_torque_Nm"] ** 2
+    draw_heat = float(np.sum(np.diff(theta) * (sq[1:] + sq[:-1]) / 2)) / w2
+    longest = 2 * math.pi / (case.limits.min_crank_speed_rpm * RPM)
+    least_rms = math.sqrt(draw_heat / longest)
+    if least_rms > motor.rated_torque_Nm * (1 + RMS_PROOF_MARGIN):
+        raise Infeasible(
+            f"drive.motor.rated_torque_Nm = {motor.rated_torque_Nm:g} cannot be met: the draw alone at "
+            f"{w2 / RPM:.3g} rpm gives an RMS torque of at least {least_rms:.0f} N m over the longest cycle "
+            f"limits.min_crank_speed_rpm = {case.limits.min_crank_speed_rpm:g} allows ({longest:.1f} s)",
+            limit="drive.motor.rated_torque_Nm",
+            value=motor.rated_torque_Nm,
+            needed=least_rms,
         )
 
 
