@@ -25,6 +25,18 @@ def run(args: list[str], **kw) -> subprocess.CompletedProcess:
     return subprocess.run([*PRESSPLAN, *args], cwd=ROOT, capture_output=True, text=True, **kw)
 
 
+def sweep_process(out: Path, workers: int) -> subprocess.Popen:
+    """A 41-point transfer-time sweep of the published case in a child process, output captured."""
+    return subprocess.Popen(
+        [*PRESSPLAN, "sweep", str(PUBLISHED_CASE), "--vary", "process.transfer_time_s=1.0:3.0:41"]
+        + ["--workers", str(workers), "--out", str(out)],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+
+
 def state(folder: Path) -> tuple:
     """What a folder holds, timing fields aside: file names and the bytes of the timing-free files."""
     names = tuple(sorted(p.name for p in folder.iterdir()))
@@ -73,23 +85,7 @@ def test_killed_solve_leaves_the_folder_entirely_old_or_entirely_new(tmp_path):
 
 @pytest.mark.skipif(sys.platform != "linux", reason="signals to child processes")
 def test_ctrl_c_is_one_line_and_exit_130(tmp_path):
-    proc = subprocess.Popen(
-        [  # 41 solves in this process: several seconds on any machine
-            *PRESSPLAN,
-            "sweep",
-            str(PUBLISHED_CASE),
-            "--vary",
-            "process.transfer_time_s=1.0:3.0:41",
-            "--workers",
-            "1",
-            "--out",
-            str(tmp_path / "o"),
-        ],
-        cwd=ROOT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    proc = sweep_process(tmp_path / "o", workers=1)  # 41 solves in this process: seconds on any machine
     time.sleep(2.0)  # inside the solves
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)
@@ -111,23 +107,7 @@ def _children(pid: int) -> set[int]:
 
 @pytest.mark.skipif(sys.platform != "linux", reason="reads /proc")
 def test_sigterm_ends_a_sweep_and_its_workers(tmp_path):
-    proc = subprocess.Popen(
-        [
-            *PRESSPLAN,
-            "sweep",
-            str(PUBLISHED_CASE),
-            "--vary",
-            "process.transfer_time_s=1.0:3.0:40",
-            "--workers",
-            "2",
-            "--out",
-            str(tmp_path / "s"),
-        ],
-        cwd=ROOT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    proc = sweep_process(tmp_path / "s", workers=2)
     workers: set[int] = set()
     deadline = time.monotonic() + 30
     while len(workers) < 2 and time.monotonic() < deadline:
