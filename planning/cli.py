@@ -9,11 +9,13 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 from typing import NoReturn
 
+from planning.model.case import OBJECTIVES
 from planning.model.laws import LAWS
 
 EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = 0, 2, 3
@@ -37,6 +39,8 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--out", help="output folder (default: out/<case name>)")
     s.add_argument("--placement", choices=("free", "published"), help="where theta1/theta4 may fall (default: case)")
     s.add_argument("--law", choices=tuple(LAWS), default=None, help="motion law (default: case, improved-s-curve)")
+    s.add_argument("--objective", choices=OBJECTIVES, default=None, help="what to optimise (default: case, max-spm)")
+    s.add_argument("--spm", type=_rate, default=None, help="the line's rate for min-rms-torque / min-energy")
     s.add_argument("--json", action="store_true", help="print result.json instead of the summary")
     s.add_argument("--format", choices=PLOT_FORMATS, default="png", help="figure format (default png)")
     s.add_argument("--no-plots", action="store_true", help="do not draw the figures")
@@ -61,6 +65,20 @@ def _parser() -> argparse.ArgumentParser:
     w.add_argument("--workers", type=_whole(1, 256), default=2, help="local worker processes (default 2)")
     w.add_argument("--scheduler", help="address of a Dask distributed scheduler (instead of local workers)")
     w.add_argument("--out", required=True, help="output folder (sweep.csv, sweep.json, sweep_spm.png)")
+    t = sub.add_parser("tradeoff", help="the least RMS torque or energy at each line rate, beside waiting")
+    t.add_argument("case", help="case file (YAML) with a drive: section")
+    t.add_argument("--spm", required=True, metavar="START:STOP:COUNT", help="rates, e.g. 6:max:7 (max: the fastest)")
+    t.add_argument(
+        "--objective",
+        choices=OBJECTIVES[1:],
+        default=None,
+        help="min-rms-torque or min-energy (default: case, else min-rms-torque)",
+    )
+    t.add_argument("--law", choices=tuple(LAWS), default=None, help="motion law (default: case)")
+    t.add_argument("--placement", choices=("free", "published"), help="where theta1/theta4 may fall")
+    t.add_argument("--workers", type=_whole(1, 256), default=2, help="local worker processes (default 2)")
+    t.add_argument("--scheduler", help="address of a Dask distributed scheduler (instead of local workers)")
+    t.add_argument("--out", required=True, help="output folder (tradeoff.csv, tradeoff.png)")
     b = sub.add_parser("bound", help="the time-optimal bound: the most strokes any motion can make")
     b.add_argument("case", help="case file (YAML)")
     b.add_argument(
@@ -76,6 +94,17 @@ def _parser() -> argparse.ArgumentParser:
     pl.add_argument("folder", help="output folder of `pressplan solve`")
     pl.add_argument("--format", choices=PLOT_FORMATS, default="png", help="figure format (default png)")
     return ap
+
+
+def _rate(text: str) -> float:
+    """An argparse type: a rate in strokes/min, 0 < rate <= 10000."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a rate in strokes/min, got {text!r}") from None
+    if not (math.isfinite(value) and 0 < value <= 1e4):
+        raise argparse.ArgumentTypeError(f"must be above 0 and at most 10000 strokes/min, got {text}")
+    return value
 
 
 def _whole(lo: int, hi: int):
@@ -127,6 +156,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "solve": _solve,
         "compare": _compare,
         "sweep": _sweep,
+        "tradeoff": _tradeoff,
         "bound": _bound,
         "laws": _laws,
         "plot": _plot,
@@ -177,6 +207,7 @@ def _solve(case, args) -> int:
 
     if args.law:
         case = case.with_law(args.law)
+    case = _with_objective(case, args)
     out = _output_folder(case, args, SOLVE_FILES)
     solution = solve(case, args.placement)
     if not solution.verification.passed:  # solve() returns only verified plans; belt and braces
@@ -185,6 +216,21 @@ def _solve(case, args) -> int:
     writers = solution_writers(solution, case, cam_points=args.cam_points, plot_format=plot_format)
     result = result_dict(solution, case)
     return _write_and_report(out, writers, result, summary_text(result), args, SOLVE_FILES)
+
+
+def _with_objective(case, args):  # noqa: ANN001, ANN202 - a Case and the parsed arguments
+    """The case with ``--objective`` and ``--spm`` applied; a rate without an objective at a rate is an error."""
+    from planning.model.case import CaseError
+
+    objective = args.objective or case.planner.objective
+    if args.spm is not None and objective == "max-spm":
+        raise CommandError(
+            "--spm: the max-spm objective has no target rate (add --objective min-rms-torque or min-energy)"
+        )
+    try:
+        return case.with_objective(args.objective, args.spm)
+    except CaseError as exc:
+        raise CommandError(f"{args.case}: {exc.line()}") from None
 
 
 def _compare(case, args) -> int:
@@ -254,6 +300,36 @@ def _sweep(case, args) -> int:
         f"{f' ({result.resumed} from an earlier run)' if result.resumed else ''}"
         f"{f', {result.repaired} improved from a neighbour' if result.repaired else ''}; wrote {out / 'sweep.csv'}"
     )
+    return EXIT_OK
+
+
+def _tradeoff(case, args) -> int:
+    import planning.solver.optimize  # noqa: F401 - loaded once here, inherited by forked workers
+    from planning.model.case import CaseError
+    from planning.reports.folder import TRADEOFF_FILES, write_atomic
+    from planning.reports.plots import save, tradeoff_figure
+    from planning.tradeoff import COLUMNS, parse_rates, run_tradeoff, table_text, write_rows
+
+    rates = parse_rates(args.spm)
+    if case.drive is None:
+        raise CommandError(f"{args.case}: drive: the trade-off weighs the motor: the case needs a drive: section")
+    if args.law:
+        case = case.with_law(args.law)
+    objective = args.objective or (case.planner.objective if case.planner.objective != "max-spm" else "min-rms-torque")
+    try:
+        case = case.with_objective(objective, rates.start)
+    except CaseError as exc:
+        raise CommandError(f"{args.case}: {exc.line()}") from None
+    out = _output_folder(case, args, TRADEOFF_FILES)
+    result = run_tradeoff(case, rates, args.workers, args.scheduler, args.placement)
+    title = f"{case.name}: {objective} at the line's rate ({case.planner.motion_law})"
+    writers = {
+        "tradeoff.csv": lambda p: write_rows(p, result.rows, COLUMNS),
+        "tradeoff.png": lambda p: save(tradeoff_figure(result.rows, case, title), p),
+    }
+    files = write_atomic(out, writers, TRADEOFF_FILES, keep=args.case)
+    print(table_text(result, case))
+    print(f"  wrote {', '.join(str(f) for f in files)}")
     return EXIT_OK
 
 

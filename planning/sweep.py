@@ -331,7 +331,8 @@ def run_sweep(
         writer = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
         if new_file:
             writer.writeheader()
-        for rows in _execute(base, fields, blocks(pending, points), placement, label, workers, scheduler):
+        work = [(base, fields, blk, placement, label) for blk in blocks(pending, points)]
+        for rows in execute(solve_block, work, workers, scheduler):
             for row in rows:
                 writer.writerow({k: _cell(row.get(k)) for k in columns})
                 fresh[row["index"]] = row
@@ -362,8 +363,12 @@ def _cell(value: Any) -> Any:
     return "" if value is None else value
 
 
-def _execute(base, fields, work, placement, label, workers, scheduler) -> Iterator[list[dict[str, Any]]]:
-    """Blocks of rows as they finish: in this process (1 worker), a process pool, or Dask."""
+def execute(
+    task: Callable[..., list[dict[str, Any]]], work: list[tuple], workers: int = 2, scheduler: str | None = None
+) -> Iterator[list[dict[str, Any]]]:
+    """``task(*args)`` for every ``args`` of ``work``, results as they finish: in this process (1
+    worker), a pool of local processes, or a Dask distributed cluster at ``scheduler``. Ctrl-C and
+    SIGTERM end every worker process with the parent's."""
     if not work:
         return
     if scheduler:
@@ -376,15 +381,15 @@ def _execute(base, fields, work, placement, label, workers, scheduler) -> Iterat
         except (OSError, TimeoutError) as exc:
             raise SweepError(f"--scheduler: cannot reach {scheduler} ({exc})") from None
         try:
-            futures = [client.submit(solve_block, base, fields, blk, placement, label, pure=False) for blk in work]
+            futures = [client.submit(task, *args, pure=False) for args in work]
             for fut in as_completed(futures):
                 yield fut.result()
         finally:
             client.close()
         return
     if workers <= 1:
-        for blk in work:
-            yield solve_block(base, fields, blk, placement, label)
+        for args in work:
+            yield task(*args)
         return
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -392,10 +397,10 @@ def _execute(base, fields, work, placement, label, workers, scheduler) -> Iterat
     ctx = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_signals)
     try:
-        futures = [pool.submit(solve_block, base, fields, blk, placement, label) for blk in work]
+        futures = [pool.submit(task, *args) for args in work]
         for fut in as_completed(futures):
             yield fut.result()
-    except BaseException:  # Ctrl-C, SIGTERM, a failed write: no worker outlives the sweep
+    except BaseException:  # Ctrl-C, SIGTERM, a failed write: no worker outlives the run
         for process in list(getattr(pool, "_processes", {}).values()):
             process.terminate()
         pool.shutdown(wait=False, cancel_futures=True)

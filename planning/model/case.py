@@ -22,6 +22,8 @@ from press.kinematics import CrankSlider
 
 RPM = 2.0 * math.pi / 60.0  # [rad/s] per rpm
 Placement = Literal["free", "published"]  # where theta1 / theta4 may fall (the paper's Fig. 6, or anywhere)
+Objective = Literal["max-spm", "min-rms-torque", "min-energy"]  # what the planner optimises
+OBJECTIVES: tuple[str, ...] = Objective.__args__
 
 
 class CaseError(ValueError):
@@ -137,15 +139,21 @@ class DriveSection(_Model):
     gear_efficiency: Annotated[float, Field(gt=0, le=1)]
     motor_inertia_kg_m2: Inertia  # all motors and pinions, about the motor axis
     motor: MotorModel
+    # the share of the braking energy the supply takes back: 0 a braking resistor, 1 a perfect store
+    regen_efficiency: Annotated[float, Field(ge=0, le=1)] = 0.0
 
 
 class PlannerModel(_Model):
     """``motion_law``, ``placement`` of the key points (free | published) and ``law_parameter``: the
-    law's shape parameter held fixed (seven-segment jerk share, logistic flexible); omitted: optimised."""
+    law's shape parameter held fixed (seven-segment jerk share, logistic flexible); omitted: optimised.
+    ``objective``: the most strokes (``max-spm``), or at ``target_spm`` [strokes/min] the least RMS motor
+    torque (``min-rms-torque``) or the least energy drawn from the supply per stroke (``min-energy``)."""
 
     motion_law: LawName = DEFAULT_LAW
     placement: Placement = "free"
     law_parameter: ShapeValue | None = None
+    objective: Objective = "max-spm"
+    target_spm: Annotated[float, Field(gt=0, le=1e4)] | None = None
 
 
 class PublishedKeyPoint(_Model):
@@ -236,6 +244,17 @@ class Case(_Model):
             math.radians(self.key_points.draw_start_deg),
         )
 
+    def with_objective(self, objective: str | None, target_spm: float | None = None) -> Case:
+        """The same case with ``planner.objective`` (None: kept) and ``planner.target_spm`` (None: kept),
+        checked as a case file's would be (:class:`CaseError`)."""
+        update = {k: v for k, v in (("objective", objective), ("target_spm", target_spm)) if v is not None}
+        if not update:
+            return self
+        planner = PlannerModel.model_validate({**self.planner.model_dump(), **update})
+        case = self.model_copy(update={"planner": planner})
+        _objective_checks(case)
+        return case
+
     def with_law(self, law: str) -> Case:
         """The same case under motion law ``law``; a fixed ``law_parameter`` is kept for the same law only."""
         if law == self.planner.motion_law:
@@ -324,6 +343,7 @@ def cross_checks(case: Case) -> None:
                 fixed,
             )
     _drive_checks(case)
+    _objective_checks(case)
     top = case.limits.crank_speed_rpm
     if top is not None and top <= case.limits.min_crank_speed_rpm:
         raise CaseError(
@@ -397,6 +417,17 @@ def _drive_checks(case: Case) -> None:
             f"must be above the minimum crank speed through the gear ({w_min_motor:g} rpm)",
             d.motor.max_speed_rpm,
         )
+
+
+def _objective_checks(case: Case) -> None:
+    """An objective at the line's rate needs the rate and the drive whose torque or energy it weighs."""
+    planner = case.planner
+    if planner.objective == "max-spm":
+        return
+    if planner.target_spm is None:
+        raise CaseError("planner.target_spm", f"the {planner.objective} objective needs the line's rate", None, False)
+    if case.drive is None:
+        raise CaseError("planner.objective", "needs a drive: section (the motor it weighs)", planner.objective)
 
 
 _SLUG = re.compile(r"[^A-Za-z0-9._-]+")

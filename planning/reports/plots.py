@@ -324,3 +324,63 @@ def laws_figure(curves: dict[str, dict[str, np.ndarray]], title: str) -> Figure:
     top.legend(fontsize=8, ncol=3)
     top.set_title(title, fontsize=10)
     return fig
+
+
+def tradeoff_figure(rows: list[dict[str, Any]], case: Any, title: str) -> Figure:
+    """The motor-sizing picture: RMS and peak motor torque against SPM with the motor's rated and peak
+    torque as lines (top), energy from the supply per stroke against SPM (bottom); optimised plans solid,
+    the baseline (the max-SPM plan with the spare time given to the transfer) dashed."""
+    fig = Figure(figsize=(9, 7.5), dpi=90)
+    FigureCanvasAgg(fig)
+    top, bottom = fig.subplots(2, 1, sharex=True)
+    ok = [r for r in rows if r.get("status") == "verified"]
+    spm = np.array([float(r["target_spm"]) for r in ok])
+
+    def column(name: str) -> np.ndarray:
+        return np.array([float(r[name]) for r in ok])
+
+    motor = case.drive.motor
+    if ok:
+        top.plot(spm, column("rms_torque_Nm") / 1e3, "o-", color="tab:blue", lw=1.5, ms=4, label="RMS, optimised")
+        top.plot(
+            spm,
+            column("baseline_rms_torque_Nm") / 1e3,
+            "o--",
+            color="tab:blue",
+            lw=1,
+            ms=3,
+            mfc="none",
+            label="RMS, baseline",
+        )
+        top.plot(
+            spm, column("peak_motor_torque_Nm") / 1e3, "s-", color="tab:orange", lw=1.5, ms=4, label="peak, optimised"
+        )
+        top.plot(
+            spm,
+            column("baseline_peak_motor_torque_Nm") / 1e3,
+            "s--",
+            color="tab:orange",
+            lw=1,
+            ms=3,
+            mfc="none",
+            label="peak, baseline",
+        )
+        bottom.plot(spm, column("energy_kJ"), "o-", color="tab:green", lw=1.5, ms=4, label="optimised")
+        bottom.plot(
+            spm, column("baseline_energy_kJ"), "o--", color="tab:green", lw=1, ms=3, mfc="none", label="baseline"
+        )
+    top.axhline(motor.rated_torque_Nm / 1e3, color="tab:blue", lw=1, ls=":", label="rated torque")
+    top.axhline(motor.peak_torque_Nm / 1e3, color="tab:orange", lw=1, ls=":", label="peak torque")
+    failed = [float(r["target_spm"]) for r in rows if r.get("status") != "verified"]
+    for x in failed:
+        top.axvline(x, color="tab:red", lw=0.8, alpha=0.5)
+    top.set_ylabel("motor torque [kN m]")
+    top.set_ylim(bottom=0)
+    bottom.set_ylabel("energy from the supply per stroke [kJ]")
+    bottom.set_xlabel("strokes per minute" + (" (red: no plan at this rate)" if failed else ""))
+    bottom.set_ylim(bottom=0)
+    for ax in (top, bottom):
+        ax.grid(True, lw=0.3)
+        ax.legend(fontsize=8, ncol=3)
+    top.set_title(title, fontsize=10)
+    return fig

@@ -153,6 +153,7 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
         "segments": segments(solution),
         "paper_solution": plan.paper_solution() if plan.motion_law == ImprovedSCurve.name else None,
         **({"drive": drive_block(solution, case)} if case.drive is not None else {}),
+        **objective_block(solution, case),
         "verification": {
             "passed": ver.passed,
             "step_s": ver.step_s,
@@ -172,6 +173,29 @@ def drive_block(solution: Solution, case: Case) -> dict[str, Any]:
     """The ``drive`` block of ``result.json``: what the motor must give over the cycle, and its limits."""
     fig = drive_figures(solution.plan.profile, case)
     return {**fig.as_dict(), "motor": case.drive.motor.model_dump(), "gear_ratio": case.drive.gear_ratio}
+
+
+def objective_block(solution: Solution, case: Case) -> dict[str, Any]:
+    """The objective keys of ``result.json``: ``objective``, ``target_spm``; with a drive the plan's
+    ``rms_torque_Nm`` and ``energy_kJ`` (drawn from the supply per stroke, ``E+ - r |E-|``); at a target
+    rate also the ``baseline``'s (the max-SPM planner with the spare time given to the transfer), the
+    ``saving_pct`` and the ``fastest_spm`` the limits allow."""
+    out: dict[str, Any] = {"objective": case.planner.objective, "target_spm": case.planner.target_spm}
+    a = solution.at_rate
+    if a is not None:
+        out.update(a.figures.as_dict())
+        out.pop("spm")
+        baseline = {k: v for k, v in a.baseline_figures.as_dict().items()}
+        out["baseline"] = baseline
+        out["saving_pct"] = {"rms_torque": a.saving_pct("rms_torque_Nm"), "energy": a.saving_pct("energy_kJ")}
+        out["improved_on_baseline"] = a.improved
+        out["fastest_spm"] = a.fastest_spm
+    elif case.drive is not None:
+        from planning.solver.objectives import rate_figures
+
+        fig = rate_figures(solution.plan, case)
+        out.update(rms_torque_Nm=fig.rms_torque_Nm, energy_kJ=fig.energy_kJ)
+    return out
 
 
 def summary_text(result: dict[str, Any]) -> str:
@@ -210,6 +234,18 @@ def summary_text(result: dict[str, Any]) -> str:
             f"  energy per stroke: drawn {d['energy_drawn_kJ']:.1f} kJ, returned {d['energy_returned_kJ']:.1f} kJ, "
             f"net {d['energy_net_kJ']:.1f} kJ; forming work {d['forming_work_kJ']:.1f} kJ "
             f"(crank work {d['crank_work_kJ']:.1f} kJ)",
+        ]
+    if r.get("baseline"):
+        b, saving = r["baseline"], r["saving_pct"]
+        lines += [
+            "",
+            f"  objective {r['objective']} at {r['target_spm']:g} strokes/min (the limits allow up to "
+            f"{r['fastest_spm']:.3f}): RMS motor torque {r['rms_torque_Nm'] / 1e3:.2f} kN m, "
+            f"energy from the supply {r['energy_kJ']:.1f} kJ per stroke",
+            f"  baseline (max-SPM plan, spare time to the transfer: window {b['transfer_time_s']:.3f} s): RMS "
+            f"{b['rms_torque_Nm'] / 1e3:.2f} kN m, energy {b['energy_kJ']:.1f} kJ; saving {saving['rms_torque']:.1f} % "
+            f"RMS torque, {saving['energy']:.1f} % energy"
+            + ("" if r["improved_on_baseline"] else " (no solve beat the baseline: it is the plan)"),
         ]
     lines.append("")
     lines.append("  binding: " + (", ".join(r["binding_constraints"]) or "none"))

@@ -40,7 +40,7 @@ from planning.model.laws import DEFAULT_LAW, get_law
 from planning.model.profile import Segment, advance, advance_segment, knot_states, shape_part
 from planning.solver.ipopt import NLPResult, NLPSolver
 from press.dynamics import DriveModel, crank_torque, motor_speed, motor_torque
-from press.kinematics import height_derivatives
+from press.kinematics import height, height_derivatives
 
 # Decision variables and the kind of scale each is measured in (see :func:`variable_scales`)
 VARIABLES: tuple[tuple[str, str], ...] = (
@@ -95,6 +95,7 @@ PARAMETERS: tuple[str, ...] = (
     "crank_speed_max",  # motor limits [rad/s, rad/s^2, rad/s^3] (very large when the case sets none)
     "crank_accel_max",
     "crank_jerk_max",
+    "die_height",  # [mm above BDC] (the drive NLP holds the die speed at every sample below it)
 )
 PARAMETER_INDEX = {name: i for i, name in enumerate(PARAMETERS)}
 # Parameters of a drive (the NLP of a case with a ``drive:`` section has them after PARAMETERS), SI units
@@ -108,6 +109,15 @@ DRIVE_PARAMETERS: tuple[str, ...] = (
     "motor_peak",  # peak torque [N m] (the orchestrator lowers it if the dense check finds an overshoot)
     "motor_base_speed",  # [rad/s] at the motor
     "motor_rms",  # rated (RMS) torque [N m] (likewise)
+    # the objective (``planning.solver.objectives``): f = weight_period * period + weight_heat * heat
+    # + weight_energy * supply energy - weight_dwell * transfer dwell; max-SPM sets weight_period = 1, the rest 0
+    "weight_period",  # [1/s]
+    "weight_heat",  # [1/(N^2 m^2 s)] heat = integral T_m^2 dt over the cycle
+    "weight_energy",  # [1/J] supply energy = integral (r P + (1 - r) smoothmax(P, 0)) dt
+    "weight_dwell",  # [1/s] the constant-speed transfer dwell
+    "regen",  # r, the share of the returned energy the supply takes back, 0 ... 1
+    "power_smoothing",  # [W] epsilon of smoothmax(P, 0) = (P + sqrt(P^2 + epsilon^2)) / 2
+    "target_period",  # [s] the cycle time of a target rate (the "cycle time" row; unbounded for max-SPM)
 )
 DRIVE_INDEX = {name: len(PARAMETERS) + i for i, name in enumerate(DRIVE_PARAMETERS)}
 
@@ -146,12 +156,14 @@ BLOCK_FIELDS = {
     "key angles (published placement)": "planner.placement",
     "die crossing angles": "limits.die_height_mm",
     "die-height speed": "limits.die_speed_mm_s",
+    "die-zone speed": "limits.die_speed_mm_s",
     "slider acceleration": "limits.slider_accel_mm_s2",
     "crank speed limit": "limits.crank_speed_rpm",
     "crank acceleration limit": "limits.crank_accel_rad_s2",
     "crank jerk limit": "limits.crank_jerk_rad_s3",
     "motor peak torque": "drive.motor.peak_torque_Nm",
     "motor RMS torque": "drive.motor.rated_torque_Nm",
+    "cycle time": "planner.target_spm",
 }
 
 
@@ -182,12 +194,19 @@ class CycleNLP:
     ubg: np.ndarray
     blocks: tuple[ConstraintBlock, ...]
     published_rows: slice
+    period_rows: slice | None = None  # the drive NLP's "cycle time" row (period - target_period)
+    die_zone_rows: slice | None = None  # the drive NLP's die-zone speed at every sample below the die height
 
-    def bounds(self, placement: Placement) -> tuple[np.ndarray, np.ndarray]:
-        """``(lbg, ubg)`` for ``placement``."""
+    def bounds(self, placement: Placement, fixed_period: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """``(lbg, ubg)`` for ``placement``; ``fixed_period``: the cycle time held at the parameter
+        ``target_period`` (a target rate; drive NLP only)."""
         lbg, ubg = self.lbg.copy(), self.ubg.copy()
         pinned = 0.0 if placement == "published" else np.inf
         lbg[self.published_rows], ubg[self.published_rows] = -pinned, pinned
+        if fixed_period:
+            if self.period_rows is None:
+                raise ValueError("only the drive NLP holds a target cycle time")
+            lbg[self.period_rows], ubg[self.period_rows] = 0.0, 0.0
         return lbg, ubg
 
     def solve(
@@ -199,24 +218,25 @@ class CycleNLP:
         placement: Placement,
         scale: np.ndarray,
         warm_start: tuple[np.ndarray, np.ndarray] | None = None,
+        fixed_period: bool = False,
     ) -> NLPResult:
         """One IPOPT solve from the variable values ``start`` (physical units) for the case parameters
         (:data:`PARAMETERS` order), physical bounds ``lbx``/``ubx`` and the variables' ``scale``;
-        ``warm_start``: the multipliers of a nearby solve."""
-        lbg, ubg = self.bounds(placement)
+        ``warm_start``: the multipliers of a nearby solve; ``fixed_period``: see :meth:`bounds`."""
+        lbg, ubg = self.bounds(placement, fixed_period)
         x0 = np.array([start[k] for k, _ in VARIABLES])
         return self.program.solve(x0, lbx, ubx, lbg, ubg, p=case_parameters, scale=scale, warm_start=warm_start)
 
-    def worst_violation(self, placement: Placement, g: np.ndarray) -> tuple[str, float]:
+    def worst_violation(self, placement: Placement, g: np.ndarray, fixed_period: bool = False) -> tuple[str, float]:
         """The constraint block with the largest violation at ``g`` (the last iterate)."""
-        worst = self.worst_block(placement, g)
-        lbg, ubg = self.bounds(placement)
+        worst = self.worst_block(placement, g, fixed_period)
+        lbg, ubg = self.bounds(placement, fixed_period)
         viol = np.maximum(lbg - g, 0) + np.maximum(g - ubg, 0)
         return worst.name, float(np.max(viol[worst.start : worst.stop], initial=0.0))
 
-    def worst_block(self, placement: Placement, g: np.ndarray) -> ConstraintBlock:
+    def worst_block(self, placement: Placement, g: np.ndarray, fixed_period: bool = False) -> ConstraintBlock:
         """The block with the largest violation at ``g``."""
-        lbg, ubg = self.bounds(placement)
+        lbg, ubg = self.bounds(placement, fixed_period)
         viol = np.maximum(lbg - g, 0) + np.maximum(g - ubg, 0)
         return max(self.blocks, key=lambda b: float(np.max(viol[b.start : b.stop], initial=0.0)))
 
@@ -226,10 +246,12 @@ def values_of(result: NLPResult) -> dict[str, float]:
     return {k: float(result.x[j]) for j, (k, _) in enumerate(VARIABLES)}
 
 
-def _drive_constraints(add, p_case, th, om, al, d1, d2, times, period) -> None:  # noqa: ANN001 - SX
+def _drive_constraints(add, p_case, th, om, al, d1, d2, times, period) -> tuple[ca.SX, ca.SX]:  # noqa: ANN001 - SX
     """The motor's limits at the samples (``press.dynamics``): the peak-torque envelope (peak torque up to
     the base speed, constant power above it, as one row) and the RMS torque over the cycle by the
-    trapezoidal rule over the samples. The forming force enters at the draw's samples, the last FORMING_SAMPLES."""
+    trapezoidal rule over the samples. The forming force enters at the draw's samples, the last
+    FORMING_SAMPLES. Returns the trapezoidal ``(heat, supply energy)`` of the objectives: integral T_m^2 dt
+    [N^2 m^2 s] and integral (r P + (1 - r) smoothmax(P, 0)) dt [J]."""
     q = {name: p_case[k] for name, k in DRIVE_INDEX.items()}
     start = len(PARAMETERS) + len(DRIVE_PARAMETERS)
     forming = ca.vertcat(ca.DM.zeros(th.shape[0] - FORMING_SAMPLES), p_case[start : start + FORMING_SAMPLES])
@@ -239,12 +261,27 @@ def _drive_constraints(add, p_case, th, om, al, d1, d2, times, period) -> None: 
     tc = crank_torque(om, al, d1, d2, forming, model)
     tm = motor_torque(tc, al, model)
     # |T_m| max(1, n / n_base) <= peak is the envelope in one row per sample (kink at the base speed)
-    above_base = ca.fmax(1.0, motor_speed(om, model) / q["motor_base_speed"])
+    speed = motor_speed(om, model)
+    above_base = ca.fmax(1.0, speed / q["motor_base_speed"])
     add("motor peak torque", tm * above_base / q["motor_peak"], -1.0, 1.0)
-    sq = tm**2
-    n = th.shape[0]
-    integral = ca.sum1((times[1:n] - times[0 : n - 1]) * (sq[1:n] + sq[0 : n - 1]) / 2)
-    add("motor RMS torque", integral / (period * q["motor_rms"] ** 2), -np.inf, 1.0)
+    add("motor RMS torque", _trapezoid(tm**2, times) / (period * q["motor_rms"] ** 2), -np.inf, 1.0)
+    # the objectives on a smooth torque: the gear's loss switches sides where T_c changes sign, and a plan
+    # that saves heat or energy coasts there (T_c = 0 over stretches), so both kinks are rounded:
+    # |x| -> sqrt(x^2 + eps^2)
+    up, down = 1 / (model.i * model.eta), model.eta / model.i
+    eps_crank = q["power_smoothing"] / (q["motor_base_speed"] * down)  # [N m] at the crank
+    through = tc * (up + down) / 2 + ca.sqrt(tc**2 + eps_crank**2) * (up - down) / 2
+    smooth_torque = through + model.J_m * model.i * al
+    power = smooth_torque * speed
+    drawn = (power + ca.sqrt(power**2 + q["power_smoothing"] ** 2)) / 2  # smooth max(P, 0)
+    energy = _trapezoid(q["regen"] * power + (1 - q["regen"]) * drawn, times)
+    return _trapezoid(smooth_torque**2, times), energy
+
+
+def _trapezoid(values: ca.SX, times: ca.SX) -> ca.SX:
+    """The trapezoidal integral of ``values`` at the sample ``times`` [s]."""
+    n = values.shape[0]
+    return ca.sum1((times[1:n] - times[0 : n - 1]) * (values[1:n] + values[0 : n - 1]) / 2)
 
 
 def _build(law_name: str, drive: bool = False) -> CycleNLP:
@@ -374,12 +411,26 @@ def _build(law_name: str, drive: bool = False) -> CycleNLP:
     add("crank speed limit", ca.vertcat(wm1, wm2, w1, w2) / q["crank_speed_max"], -np.inf, 1.0)
     add("crank acceleration limit", ca.vertcat(*params.peak_accelerations()) / q["crank_accel_max"], -np.inf, 1.0)
     add("crank jerk limit", ca.vertcat(*params.peak_jerks()) / q["crank_jerk_max"], -np.inf, 1.0)
+    objective = params.period
+    period_rows = die_zone_rows = None
     if drive:
-        _drive_constraints(add, p_case, th, om, al, d1, d2, ca.vertcat(*t_s), params.period)
+        # at a target rate a plan may peak in speed inside the die zone, between the crossings: below the die
+        # height every sample keeps the die speed (max(h - h_die, v_die - |v|) >= 0, continuous; the draw's
+        # constant speed is bounded already). The samples of the draw are the last FORMING_SAMPLES.
+        outside = slice(0, th.shape[0] - FORMING_SAMPLES)
+        h_s = height(th[outside], q["R"], q["L"])
+        v_s = d1[outside] * om[outside]
+        zone = ca.fmax((h_s - q["die_height"]) / q["R"], (q["die_speed"] - ca.fabs(v_s)) / q["die_speed"])
+        die_zone_rows = add("die-zone speed", zone, 0.0, np.inf)
+        heat, energy = _drive_constraints(add, p_case, th, om, al, d1, d2, ca.vertcat(*t_s), params.period)
+        w = {name: p_case[DRIVE_INDEX[name]] for name in ("weight_period", "weight_heat", "weight_energy")}
+        objective = w["weight_period"] * params.period + w["weight_heat"] * heat + w["weight_energy"] * energy
+        objective -= p_case[DRIVE_INDEX["weight_dwell"]] * params.transfer_dwell
+        period_rows = add("cycle time", params.period - p_case[DRIVE_INDEX["target_period"]], -np.inf, np.inf)
 
-    nlp = {"x": x, "p": p, "f": params.period, "g": ca.vertcat(*g)}
+    nlp = {"x": x, "p": p, "f": objective, "g": ca.vertcat(*g)}
     program = NLPSolver("press_cycle_" + law_name.replace("-", "_") + ("_drive" if drive else ""), nlp, CYCLE_OPTIONS)
-    return CycleNLP(program, np.array(lb), np.array(ub), tuple(blocks), published_rows)
+    return CycleNLP(program, np.array(lb), np.array(ub), tuple(blocks), published_rows, period_rows, die_zone_rows)
 
 
 @cache

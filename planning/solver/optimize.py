@@ -15,7 +15,9 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
@@ -51,11 +53,13 @@ REFINEMENTS = 8  # re-solves with a lowered sampled acceleration limit
 HARDER_BACKOFF = 5e-3  # when no start verifies: once more with this back-off on the sampled limits
 NO_LIMIT = 1e9  # stands for an absent motor limit in the NLP's parameters
 AGREE_S = 1e-6  # [s] two starts whose best periods agree this closely have found the same optimum
+POWER_SMOOTHING = 1e-3  # epsilon of the NLP's smooth max(P, 0), as a share of rated torque x base speed
 
 
 # the checks whose overshoot between the NLP's samples a re-solve with a lowered sampled limit removes
 REFINED = {
     CheckId.SLIDER_ACCEL: PARAMETER_INDEX["accel_limit"],
+    CheckId.DIE_SPEED: PARAMETER_INDEX["die_speed"],  # the drive NLP's die-zone rows (see CycleNLP.die_zone_rows)
     CheckId.MOTOR_PEAK: DRIVE_INDEX["motor_peak"],
     CheckId.MOTOR_RMS: DRIVE_INDEX["motor_rms"],
 }
@@ -63,10 +67,12 @@ REFINED = {
 
 @dataclass(frozen=True)
 class Solution:
-    """A verified plan and its verification."""
+    """A verified plan and its verification; ``at_rate``: for an objective at the line's rate, the
+    objective's figures and the baseline it beats (``planning.solver.objectives.AtRate``), else None."""
 
     plan: Plan
     verification: Verification
+    at_rate: Any = None
 
 
 def precheck(case: Case) -> tuple[float, float]:
@@ -189,6 +195,7 @@ def nlp_parameters(case: Case) -> np.ndarray:
         "crank_speed_max": crank_speed_limit(case) or NO_LIMIT,
         "crank_accel_max": lim.crank_accel_rad_s2 or NO_LIMIT,
         "crank_jerk_max": lim.crank_jerk_rad_s3 or NO_LIMIT,
+        "die_height": lim.die_height_mm,
     }
     out = np.array([values[k] for k in PARAMETERS], dtype=float)
     if case.drive is None:
@@ -219,6 +226,14 @@ def drive_parameters(case: Case) -> np.ndarray:
         "motor_peak": motor.peak_torque_Nm * (1 - DRIVE_BACKOFF),
         "motor_base_speed": motor.base_speed_rpm * RPM,
         "motor_rms": motor.rated_torque_Nm * (1 - DRIVE_BACKOFF),
+        # the objective: the period alone (max-SPM); planning.solver.objectives sets the others per solve
+        "weight_period": 1.0,
+        "weight_heat": 0.0,
+        "weight_energy": 0.0,
+        "weight_dwell": 0.0,
+        "regen": case.drive.regen_efficiency,
+        "power_smoothing": POWER_SMOOTHING * motor.rated_torque_Nm * motor.base_speed_rpm * RPM,
+        "target_period": 0.0,
     }
     _, th2, th3, _ = case.key_angles
     theta = th2 + np.linspace(0.0, 1.0, FORMING_SAMPLES) * (th3 - th2)
@@ -333,6 +348,13 @@ class _Search:
     attempts: list[Attempt] = field(default_factory=list)
     iterations: int = 0
     starts: int = 0
+    fixed_period: bool = False  # the cycle time held at the parameter target_period (a target rate)
+    score: Callable[[Plan], float] | None = None  # what "better" means, lower is better; None: the period
+    best_score: float = math.inf
+
+    def score_of(self, plan: Plan) -> float:
+        """The plan's score: :attr:`score`, or its period [s]."""
+        return plan.period if self.score is None else self.score(plan)
 
     def attempt(self, x0: dict[str, float], placement: Placement) -> tuple[dict[str, float], float] | None:
         """Solve from ``x0``; if only the dense slider-acceleration check fails, lower the NLP's
@@ -343,11 +365,11 @@ class _Search:
         multipliers = None
         self.starts += 1
         for _ in range(REFINEMENTS + 1):
-            res = self.nlp.solve(values, q, self.lbx, self.ubx, placement, self.scale, multipliers)
+            res = self.nlp.solve(values, q, self.lbx, self.ubx, placement, self.scale, multipliers, self.fixed_period)
             values, multipliers = values_of(res), res.multipliers
             self.iterations += res.iterations
             if not res.success:
-                block, amount = self.nlp.worst_violation(placement, res.g)
+                block, amount = self.nlp.worst_violation(placement, res.g, self.fixed_period)
                 field = BLOCK_FIELDS[block]
                 self.attempts.append(Attempt(res.return_status, block, amount, case_field=field))
                 return None
@@ -355,21 +377,31 @@ class _Search:
             plan = _plan(self.case, values, placement, info)
             check = verify(plan, self.case)
             if check.passed:
-                if self.best is None or plan.period < self.best.plan.period - 1e-9:
-                    self.best = Solution(plan, check)
-                return values, plan.period
+                score = self.score_of(plan)
+                self.consider(Solution(plan, check), score)
+                return values, score
             bad = check.failures()
             self.attempts.append(Attempt(check=bad[0], case_field=CHECK_FIELDS.get(bad[0].id, "")))
             refinable = {cid: k for cid, k in REFINED.items() if k < q.size}  # the NLP's own limits
+            if self.nlp.die_zone_rows is None:  # the kinematic NLP holds the die speed at the crossings only
+                refinable.pop(CheckId.DIE_SPEED)
             if any(c.id not in refinable for c in bad):
                 return None
             for c in bad:  # lower the NLP's sampled limit by the measured overshoot
                 q[refinable[c.id]] *= (c.limit / c.value) * (1 - 1e-5)
         return None
 
-    def multi_start(self, x0s: list[dict[str, float]], placement: Placement) -> dict[str, float] | None:
-        """Run the starts in order until the two best verified ones agree on the period (the optimum
-        is confirmed) or the starts run out; the values of the best verified start."""
+    def consider(self, solution: Solution, score: float) -> None:
+        """Keep ``solution`` (verified) when its ``score`` beats the best so far."""
+        if self.best is None or score < self.best_score - 1e-9:
+            self.best, self.best_score = solution, score
+
+    def multi_start(
+        self, x0s: list[dict[str, float]], placement: Placement, confirm: bool = True
+    ) -> dict[str, float] | None:
+        """Run the starts in order until the two best verified ones agree on the score (the optimum
+        is confirmed; ``confirm`` False: until one verifies) or the starts run out; the values of the
+        best verified start."""
         found: list[tuple[float, dict[str, float]]] = []
         tried: list[np.ndarray] = []
         for x0 in x0s:
@@ -382,7 +414,7 @@ class _Search:
                 continue
             found.append((out[1], out[0]))
             found.sort(key=lambda item: item[0])
-            if len(found) >= 2 and found[1][0] - found[0][0] <= AGREE_S:
+            if not confirm or (len(found) >= 2 and found[1][0] - found[0][0] <= AGREE_S):
                 break
         return found[0][1] if found else None
 
@@ -417,8 +449,13 @@ def solve(
     case's) and its NLP values start the multi-start, so the answer is never worse than ``neighbour``
     where ``neighbour`` is feasible here. ``follow``: with a fitting ``neighbour``, solve from it alone
     and return what that start finds when it verifies (a sweep following its neighbours); otherwise
-    the full multi-start runs.
+    the full multi-start runs. A case whose ``planner.objective`` is not ``max-spm`` is solved at its
+    target rate (``planning.solver.objectives.solve_at_rate``).
     """
+    if case.planner.objective != "max-spm":
+        from planning.solver.objectives import solve_at_rate
+
+        return solve_at_rate(case, placement, neighbour)
     search = _prepare(case, placement or case.planner.placement)
     neighbour = _adopt(search, neighbour)
     if follow and _follow(search, neighbour):
@@ -440,7 +477,7 @@ def _kinematic_first(search: _Search, neighbour: Plan | None) -> bool:
     kinematic = replace(search, nlp=cycle_nlp(law, False), parameters=search.parameters[: len(PARAMETERS)], attempts=[])
     _multi_start(kinematic, neighbour)
     search.iterations, search.starts = kinematic.iterations, kinematic.starts
-    search.best = kinematic.best
+    search.best, search.best_score = kinematic.best, kinematic.best_score
     return search.best is not None
 
 
@@ -480,7 +517,7 @@ def _adopt(search: _Search, neighbour: Plan | None) -> Plan | None:
     if _fits(neighbour, search.case, search.placement, *search.draw_speed_range):
         check = verify(neighbour, search.case)
         if check.passed:
-            search.best = Solution(neighbour, check)
+            search.consider(Solution(neighbour, check), search.score_of(neighbour))
     if neighbour.motion_law != search.case.planner.motion_law or not neighbour.nlp_values:
         return None  # another law's plan neither answers this case nor starts its NLP
     return neighbour

@@ -1,0 +1,229 @@
+"""At the line's rate: the gentlest verified plan at a target SPM, and the baseline it beats.
+
+In a press line the rate is set by the line, not by one press's maximum. At a target rate (cycle time
+``60 / target_spm``, the drive NLP's "cycle time" row held fixed) the planner minimises
+
+- ``min-rms-torque``: the heat ``integral T_m^2 dt`` over the cycle (the RMS torque squared times the
+  cycle time, which is fixed);
+- ``min-energy``: the energy drawn from the supply per stroke ``E+ - r |E-|`` (``r`` =
+  ``drive.regen_efficiency``). ``max(P, 0)`` has a kink where the power changes sign: the NLP uses the
+  smooth ``(P + sqrt(P^2 + eps^2)) / 2`` on its samples; the verification and every output use the
+  exact integral (``planning.model.drive``).
+
+Every limit of ``max-spm`` still holds. Steps: the fastest plan (``max-spm``; a target above its rate
+is :class:`Infeasible`, naming the limits that bind there); the **baseline**, the max-SPM plan run at
+the target rate the way a controller does, with the spare time spent at the transfer speed: at the
+target cycle time, the plan with the longest constant-speed transfer dwell (every other limit as
+before), started from the fastest plan run slower (every speed divided and every time multiplied by
+the ratio of the cycle times, so the key angles stay put); then the objective, started from a
+neighbouring rate's plan, the baseline (feasible at the rate) and the slowed fastest plan. The answer
+is the verified plan with the lowest exact objective; the baseline is one candidate, so the answer
+never does worse than waiting, and ``AtRate.improved`` says whether a solve beat it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+from planning.model.case import Case, Placement
+from planning.model.drive import cycle_integrals
+from planning.model.plan import Plan
+from planning.solver.nlp import DRIVE_INDEX, VARIABLE_INDEX, VARIABLES
+from planning.solver.optimize import Solution, _prepare, _Search, solve
+from planning.solver.outcomes import Infeasible, NoPlanFound
+from planning.solver.verify import CHECK_FIELDS
+
+RATE_TOLERANCE = 1e-9  # relative: a target this close above the fastest rate is that rate
+SAME_PERIOD_S = 1e-9  # [s] a plan whose period is this close to the target cycle time runs at the rate
+HEAT_TIE_BREAK = 1e-3  # min-energy: the heat's weight against the energy's (both normalised by the baseline's)
+BINDING_SHARE = 1e-4  # a check within this share of its limit binds (as in the reports)
+
+
+@dataclass(frozen=True)
+class RateFigures:
+    """The exact figures of one plan that the objectives weigh: RMS motor torque [N m], energy drawn
+    from the supply per stroke ``E+ - r |E-|`` [kJ], and the robot's window [s]."""
+
+    rms_torque_Nm: float
+    energy_kJ: float
+    transfer_time_s: float
+    spm: float
+
+    def as_dict(self) -> dict[str, float]:
+        return dict(self.__dict__)
+
+
+@dataclass(frozen=True)
+class AtRate:
+    """What a solve at the line's rate found: the ``objective``, ``target_spm``, the fastest rate the
+    limits allow (``fastest_spm``), the plan's and the baseline's figures, the baseline itself, and
+    whether the answer is the optimiser's plan (``improved``; False when no solve beat the baseline)."""
+
+    objective: str
+    target_spm: float
+    fastest_spm: float
+    figures: RateFigures
+    baseline_figures: RateFigures
+    baseline: Solution
+    improved: bool
+
+    def saving_pct(self, key: str) -> float:
+        """How much lower the plan's ``key`` (``rms_torque_Nm`` or ``energy_kJ``) is than the baseline's [%]."""
+        base = getattr(self.baseline_figures, key)
+        return 100.0 * (base - getattr(self.figures, key)) / base if base else 0.0
+
+
+def rate_figures(plan: Plan, case: Case) -> RateFigures:
+    """The exact RMS torque and supply energy of ``plan`` (the drive's quadrature)."""
+    c = cycle_integrals(plan.profile, case)
+    regen = case.drive.regen_efficiency
+    return RateFigures(
+        rms_torque_Nm=c["rms_motor_torque_Nm"],
+        energy_kJ=c["energy_drawn_kJ"] + regen * c["energy_returned_kJ"],
+        transfer_time_s=plan.transfer_window(),
+        spm=plan.spm,
+    )
+
+
+def objective_value(figures: RateFigures, objective: str) -> float:
+    """The exact objective: RMS torque squared [N^2 m^2] (the heat over the fixed cycle time) or the
+    supply energy [kJ]."""
+    return figures.rms_torque_Nm**2 if objective == "min-rms-torque" else figures.energy_kJ
+
+
+def solve_at_rate(
+    case: Case,
+    placement: Placement | None = None,
+    neighbour: Plan | None = None,
+    fastest: Solution | None = None,
+    neighbour_baseline: Plan | None = None,
+    confirm: bool = True,
+) -> Solution:
+    """The verified plan of ``case`` at ``planner.target_spm`` with the least ``planner.objective``, with
+    its :class:`AtRate`; raises a :class:`PlanningError` when there is none.
+
+    ``fastest``: the case's max-SPM solution when the caller has it (a trade-off computes it once);
+    ``neighbour`` / ``neighbour_baseline``: the plan and baseline of a neighbouring rate (warm starts).
+    ``confirm``: run the objective's starts until two agree on the optimum (else the first verified
+    start, from the baseline, is the answer: a trade-off's speed).
+    """
+    placement = placement or case.planner.placement
+    objective, target = case.planner.objective, case.planner.target_spm
+    if fastest is None:
+        fastest = solve(case.with_objective("max-spm"), placement)
+    _check_reachable(target, fastest, case)
+    period = 60.0 / target
+    baseline = _baseline(case, placement, fastest, period, neighbour_baseline, confirm)
+    base_figures = rate_figures(baseline.plan, case)
+    scale = objective_value(base_figures, objective)
+
+    if baseline is fastest:  # at the fastest rate the limits leave (generically) that one plan
+        return replace(
+            fastest, at_rate=AtRate(objective, target, fastest.plan.spm, base_figures, base_figures, fastest, False)
+        )
+    search = _rate_search(case, placement, period)
+    # normalised by the baseline: its objective is 1 (heat [N^2 m^2 s], energy [J] in the NLP)
+    heat_weight = 1.0 / (base_figures.rms_torque_Nm**2 * period)
+    if objective == "min-rms-torque":
+        search.parameters[DRIVE_INDEX["weight_heat"]] = heat_weight
+    else:  # the energy has flat directions (a plan's speeds can trade without changing it): the heat breaks ties
+        search.parameters[DRIVE_INDEX["weight_energy"]] = 1.0 / (base_figures.energy_kJ * 1e3)
+        search.parameters[DRIVE_INDEX["weight_heat"]] = HEAT_TIE_BREAK * heat_weight
+    search.score = lambda plan: objective_value(rate_figures(plan, case), objective) / scale
+    search.consider(baseline, 1.0)
+    starts = [baseline.plan.nlp_values, _slowed(fastest.plan, period / fastest.plan.period, search)]
+    _run_starts(search, starts, neighbour, placement, confirm)
+    improved = search.best is not baseline
+    answer = search.answer()
+    info = answer.plan.solver
+    totals = replace(
+        info,
+        iterations=info.iterations + baseline.plan.solver.iterations,
+        starts=info.starts + baseline.plan.solver.starts,
+    )
+    answer = replace(answer, plan=replace(answer.plan, solver=totals))
+    figures = rate_figures(answer.plan, case)
+    at_rate = AtRate(
+        objective=objective,
+        target_spm=target,
+        fastest_spm=fastest.plan.spm,
+        figures=figures,
+        baseline_figures=base_figures,
+        baseline=baseline,
+        improved=improved,
+    )
+    return replace(answer, at_rate=at_rate)
+
+
+def _check_reachable(target: float, fastest: Solution, case: Case) -> None:
+    """:class:`Infeasible` when the target rate is above what the limits allow, naming the ones that bind."""
+    if target <= fastest.plan.spm * (1 + RATE_TOLERANCE):
+        return
+    binding = [
+        CHECK_FIELDS.get(c.id, c.name)
+        for c in fastest.verification.checks
+        if c.kind in ("max", "min") and abs(c.margin) <= BINDING_SHARE * max(abs(c.limit), 1e-12)
+    ]
+    named = ", ".join(dict.fromkeys(binding)) or "the key points and limits together"
+    raise Infeasible(
+        f"planner.target_spm = {target:g} is above the {fastest.plan.spm:.3f} strokes/min the limits allow "
+        f"(binding there: {named})",
+        limit=binding[0] if binding else "planner.target_spm",
+        value=target,
+        needed=fastest.plan.spm,
+    )
+
+
+def _rate_search(case: Case, placement: Placement, period: float) -> _Search:
+    """The drive NLP's search with the cycle time held at ``period`` [s] and every objective weight 0."""
+    search = _prepare(case, placement)
+    search.parameters = search.parameters.copy()
+    search.parameters[DRIVE_INDEX["target_period"]] = period
+    search.parameters[DRIVE_INDEX["weight_period"]] = 0.0
+    search.fixed_period = True
+    return search
+
+
+def _baseline(
+    case: Case, placement: Placement, fastest: Solution, period: float, neighbour: Plan | None, confirm: bool
+) -> Solution:
+    """The max-SPM plan run at cycle time ``period`` [s] with the spare time spent at the transfer speed:
+    the longest transfer dwell (see the module docstring). At the fastest rate it is the fastest plan."""
+    if abs(fastest.plan.period - period) <= SAME_PERIOD_S:
+        return fastest
+    search = _rate_search(case, placement, period)
+    time_unit = search.scale[VARIABLE_INDEX["transfer_dwell"]]
+    search.parameters[DRIVE_INDEX["weight_dwell"]] = 1.0 / time_unit
+    search.score = lambda plan: -float(plan.parameters.transfer_dwell) / period
+    _run_starts(search, [_slowed(fastest.plan, period / fastest.plan.period, search)], neighbour, placement, confirm)
+    try:
+        return search.answer()
+    except NoPlanFound as exc:
+        raise NoPlanFound(f"no baseline at {60 / period:.4g} strokes/min: {exc.reason}", exc.attempts) from None
+
+
+def _slowed(plan: Plan, factor: float, search: _Search) -> dict[str, float]:
+    """``plan``'s NLP values run ``factor`` times slower: every angle, so every key point and the cycle's
+    closure, stays where it was (a start; speeds held within their bounds, the draw's in particular)."""
+    values = {}
+    for name, j in VARIABLE_INDEX.items():
+        kind = VARIABLES[j][1]
+        value = plan.nlp_values[name]
+        if kind == "speed":
+            value /= factor
+        elif kind in ("half", "time"):
+            value *= factor
+        values[name] = float(min(max(value, search.lbx[j]), search.ubx[j]))
+    return values
+
+
+def _run_starts(
+    search: _Search, starts: list[dict[str, float]], neighbour: Plan | None, placement: Placement, confirm: bool
+) -> None:
+    """A neighbouring rate's plan alone when it leads to a verified plan (a trade-off following its rates,
+    as a sweep does), else the ``starts`` until two agree (``confirm``) or one verifies."""
+    fits = neighbour is not None and bool(neighbour.nlp_values)
+    if fits and (placement == "free" or neighbour.placement == placement):
+        if search.attempt(neighbour.nlp_values, placement) is not None:
+            return
+    search.multi_start(starts, placement, confirm)

@@ -1,0 +1,211 @@
+"""The motor-sizing curve: at each line rate the gentlest verified plan beside the baseline it beats.
+
+The fastest plan (max-SPM) is solved once, in this process; then the rates are cut into contiguous
+blocks, one per worker, and each block is solved from its highest rate down, every rate starting from
+the plan and baseline of the rate before (``planning.solver.objectives.solve_at_rate``). The blocks run
+on local worker processes or a Dask cluster through the sweep's machinery (``planning.sweep.execute``).
+A rate above what the limits allow becomes a row that says why.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from planning.model.case import Case, Placement
+from planning.sweep import SweepError, execute
+
+# one row per rate: the plan's figures, the baseline's, the savings
+FIGURE_FIELDS = (
+    "rms_torque_Nm",
+    "peak_motor_torque_Nm",
+    "peak_motor_power_kW",
+    "energy_drawn_kJ",
+    "energy_returned_kJ",
+    "energy_net_kJ",
+    "energy_kJ",
+    "transfer_time_s",
+)
+COLUMNS = (
+    "target_spm",
+    "status",
+    *FIGURE_FIELDS,
+    *(f"baseline_{k}" for k in FIGURE_FIELDS),
+    "saving_rms_pct",
+    "saving_energy_pct",
+    "improved_on_baseline",
+    "solve_time_s",
+    "message",
+)
+MAX_RATES = 1000
+
+
+@dataclass(frozen=True)
+class Rates:
+    """``count`` rates from ``start`` to ``stop`` [strokes/min]; ``stop`` None: the fastest rate."""
+
+    start: float
+    stop: float | None
+    count: int
+
+    def values(self, fastest_spm: float) -> np.ndarray:
+        """The rates, rounded to 12 significant digits."""
+        stop = fastest_spm if self.stop is None else self.stop
+        return np.array([float(f"{v:.12g}") for v in np.linspace(self.start, stop, self.count)])
+
+
+def parse_rates(text: str) -> Rates:
+    """``START:STOP:COUNT`` (``STOP`` may be ``max``, the fastest rate the limits allow) -> :class:`Rates`."""
+    parts = text.split(":")
+    if len(parts) != 3:
+        raise SweepError(f"--spm: expected START:STOP:COUNT, STOP a rate or 'max' (got {text!r})")
+    try:
+        start = float(parts[0])
+        stop = None if parts[1].strip().lower() == "max" else float(parts[1])
+        count = int(parts[2])
+    except ValueError:
+        raise SweepError(
+            f"--spm: START and STOP must be numbers (STOP may be 'max'), COUNT a whole number (got {text!r})"
+        ) from None
+    for value in (start, stop):
+        if value is not None and not (math.isfinite(value) and 0 < value <= 1e4):
+            raise SweepError(f"--spm: rates must lie in (0, 10000] strokes/min (got {text!r})")
+    if not 1 <= count <= MAX_RATES:
+        raise SweepError(f"--spm: COUNT must be 1 ... {MAX_RATES} (got {count})")
+    return Rates(start, stop, count)
+
+
+def rate_block(case: Case, placement: Placement | None, fastest: Any, rates: list[tuple[int, float]]) -> list[dict]:
+    """Solve the ``rates`` (index, rate) in order, each from the plan and baseline of the one before."""
+    from planning.solver.objectives import solve_at_rate
+    from planning.solver.outcomes import PlanningError
+
+    rows = []
+    previous = None
+    for index, rate in rates:
+        row: dict[str, Any] = {"index": index, "target_spm": rate}
+        t = time.perf_counter()
+        try:
+            at_rate = case.with_objective(None, rate)
+            sol = solve_at_rate(
+                at_rate,
+                placement,
+                neighbour=previous.plan if previous else None,
+                fastest=fastest,
+                neighbour_baseline=previous.at_rate.baseline.plan if previous else None,
+                confirm=False,
+            )
+            previous = sol
+            row.update(solved_row(sol, at_rate))
+        except PlanningError as exc:
+            row.update(status=exc.kind, message=exc.reason)
+        row["solve_time_s"] = time.perf_counter() - t
+        rows.append(row)
+    return rows
+
+
+def solved_row(sol: Any, case: Case) -> dict[str, Any]:
+    """The figures of a solution at a rate and of its baseline (exact, ``planning.model.drive``)."""
+    from planning.model.drive import drive_figures
+
+    a = sol.at_rate
+    row: dict[str, Any] = {"status": "verified", "message": "", "improved_on_baseline": a.improved}
+    for prefix, plan, figures in (("", sol.plan, a.figures), ("baseline_", a.baseline.plan, a.baseline_figures)):
+        d = drive_figures(plan.profile, case).as_dict()
+        row.update({f"{prefix}{k}": d[k] for k in FIGURE_FIELDS if k in d})
+        row.update({f"{prefix}{k}": v for k, v in figures.as_dict().items() if k in FIGURE_FIELDS})
+    row["saving_rms_pct"] = a.saving_pct("rms_torque_Nm")
+    row["saving_energy_pct"] = a.saving_pct("energy_kJ")
+    return row
+
+
+@dataclass
+class TradeoffResult:
+    """``rows`` in rate order, the ``fastest`` max-SPM solution, and the case's motor ratings."""
+
+    rows: list[dict[str, Any]]
+    fastest: Any
+    objective: str
+
+    def thermal_statement(self, case: Case) -> str:
+        """What the motor's thermal limit allows: whether it sets the fastest rate, and the RMS there."""
+        from planning.model.drive import drive_figures
+        from planning.reports.report import binding
+
+        fast = self.fastest.plan
+        rms = drive_figures(fast.profile, case).rms_motor_torque_Nm
+        rated = case.drive.motor.rated_torque_Nm
+        names = binding(self.fastest)
+        if any("RMS" in n for n in names):
+            return (
+                f"the motor's thermal limit sets the highest rate: {fast.spm:.3f} strokes/min "
+                f"(RMS torque {rms:.0f} N m = rated {rated:g} N m)"
+            )
+        return (
+            f"the motor's thermal limit allows every rate the other limits allow: at the highest, "
+            f"{fast.spm:.3f} strokes/min (set by {', '.join(names) or 'the key points'}), the RMS torque is "
+            f"{rms:.0f} N m, {100 * rms / rated:.1f} % of rated"
+        )
+
+
+def run_tradeoff(
+    case: Case,
+    rates: Rates,
+    workers: int = 2,
+    scheduler: str | None = None,
+    placement: Placement | None = None,
+) -> TradeoffResult:
+    """One plan per rate at ``case.planner.objective`` (min-rms-torque or min-energy)."""
+    from planning.solver.optimize import solve
+
+    fastest = solve(case.with_objective("max-spm"), placement)
+    values = rates.values(fastest.plan.spm)
+    order = list(enumerate(values.tolist()))[::-1]  # from the fastest rate down: each starts from the faster one
+    size = max(1, math.ceil(len(order) / max(1, workers)))
+    work = [(case, placement, fastest, order[k : k + size]) for k in range(0, len(order), size)]
+    rows: dict[int, dict[str, Any]] = {}
+    for block in execute(rate_block, work, workers, scheduler):
+        for row in block:
+            rows[row["index"]] = row
+    return TradeoffResult([rows[i] for i in sorted(rows)], fastest, case.planner.objective)
+
+
+def write_rows(path: Path, rows: list[dict[str, Any]], columns: tuple[str, ...]) -> None:
+    """``rows`` as CSV with ``columns`` (floats in full precision, empty cells for missing values)."""
+    with open(path, "w", newline="", encoding="utf-8") as fh:
+        writer = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({k: _cell(row.get(k)) for k in columns})
+
+
+def _cell(value: Any) -> Any:
+    if isinstance(value, float):
+        return repr(value)
+    return "" if value is None else value
+
+
+def table_text(result: TradeoffResult, case: Case) -> str:
+    """The console table: per rate the RMS torque and the energy, optimised against the baseline."""
+    lines = [
+        f"{case.name}: {result.objective} at the line's rate ({case.planner.motion_law}); "
+        f"rated torque {case.drive.motor.rated_torque_Nm:g} N m, peak {case.drive.motor.peak_torque_Nm:g} N m",
+        f"  {'SPM':>8} {'RMS kN m':>9} {'baseline':>9} {'saving':>7} {'energy kJ':>10} {'baseline':>9} {'saving':>7}",
+    ]
+    for r in result.rows:
+        if r["status"] != "verified":
+            lines.append(f"  {r['target_spm']:8.3f}  {r['status']}: {r['message']}")
+            continue
+        lines.append(
+            f"  {r['target_spm']:8.3f} {r['rms_torque_Nm'] / 1e3:9.2f} {r['baseline_rms_torque_Nm'] / 1e3:9.2f} "
+            f"{r['saving_rms_pct']:6.1f}% {r['energy_kJ']:10.1f} {r['baseline_energy_kJ']:9.1f} "
+            f"{r['saving_energy_pct']:6.1f}%"
+        )
+    lines.append("  " + result.thermal_statement(case))
+    return "\n".join(lines)

@@ -1,0 +1,142 @@
+"""Objectives at the line's rate: the least RMS torque or energy at a target SPM, the baseline it beats,
+and the trade-off over rates (issue "At the line's rate")."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from planning.cli import main
+from planning.model.case import CaseError
+from planning.model.case_file import read_case
+from planning.model.drive import drive_figures
+from planning.solver.objectives import solve_at_rate
+from planning.solver.optimize import solve
+from planning.solver.outcomes import Infeasible
+from planning.sweep import SweepError
+from planning.tradeoff import Rates, parse_rates, run_tradeoff
+
+CASES = Path(__file__).resolve().parent.parent / "cases"
+SIDE_PANEL = CASES / "wang2023-side-panel-drive.yaml"
+CUP = CASES / "cup-2000kN-drive.yaml"
+TRAJECTORY_REL = 2e-3  # a 1 ms trapezoid over trajectory.csv against the exact quadrature (kinks of max(P, 0))
+
+
+@cache
+def fastest(path: Path):
+    return solve(read_case(path))
+
+
+def test_objective_needs_a_rate_and_a_drive() -> None:
+    case = read_case(CUP)
+    with pytest.raises(CaseError, match="target_spm"):
+        case.with_objective("min-rms-torque")
+    no_drive = read_case(CASES / "small-fast-cup.yaml")
+    with pytest.raises(CaseError, match="planner.objective: needs a drive"):
+        no_drive.with_objective("min-energy", 10.0)
+
+
+def test_cli_objective_errors_are_one_line_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    out = str(tmp_path / "out")
+    assert main(["solve", str(CUP), "--objective", "min-energy", "--out", out]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "planner.target_spm" in err
+    assert main(["solve", str(CUP), "--spm", "20", "--out", out]) == 2
+    assert "--spm" in capsys.readouterr().err
+    assert main(["tradeoff", str(CASES / "small-fast-cup.yaml"), "--spm", "10:20:3", "--out", out]) == 2
+    assert "drive" in capsys.readouterr().err
+    assert not Path(out).exists()
+
+
+def test_rates_are_parsed_with_max() -> None:
+    assert parse_rates("5:max:3").values(9.0).tolist() == [5.0, 7.0, 9.0]
+    assert parse_rates("4:8:5") == Rates(4.0, 8.0, 5)
+    for bad in ("5:9", "a:9:3", "5:9:0", "-1:9:3", "5:inf:3"):
+        with pytest.raises(SweepError, match="--spm"):
+            parse_rates(bad)
+
+
+def test_target_above_the_fastest_rate_names_the_binding_limit(capsys: pytest.CaptureFixture, tmp_path: Path) -> None:
+    fast = fastest(SIDE_PANEL)
+    case = read_case(SIDE_PANEL).with_objective("min-rms-torque", fast.plan.spm * 1.01)
+    with pytest.raises(Infeasible) as err:
+        solve_at_rate(case, fastest=fast)
+    assert err.value.limit == "drive.motor.rated_torque_Nm"  # the RMS torque binds this case's fastest plan
+    code = main(["solve", str(SIDE_PANEL), "--objective", "min-rms-torque", "--spm", "9.5", "--out", str(tmp_path)])
+    assert code == 3
+    assert "rated_torque_Nm" in capsys.readouterr().err
+
+
+def test_at_the_fastest_rate_the_plan_is_the_fastest() -> None:
+    for path in (SIDE_PANEL, CUP):
+        fast = fastest(path)
+        case = read_case(path).with_objective("min-rms-torque", fast.plan.spm)
+        sol = solve_at_rate(case, fastest=fast)
+        assert sol.verification.passed
+        assert abs(sol.plan.spm - fast.plan.spm) <= 1e-3 * fast.plan.spm
+        assert sol.at_rate.figures.rms_torque_Nm <= drive_figures(fast.plan.profile, case).rms_motor_torque_Nm * (1 + 1e-12)
+
+
+@pytest.mark.parametrize(("path", "objective", "start"), [(SIDE_PANEL, "min-rms-torque", 5.0), (CUP, "min-energy", 20.0)])
+def test_tradeoff_never_worse_than_the_baseline(path: Path, objective: str, start: float) -> None:
+    """7 rates up to the fastest: every plan verified at its rate, its exact objective <= the baseline's,
+    and the optimiser beats the baseline at most rates below the fastest."""
+    case = read_case(path).with_objective(objective, start)
+    result = run_tradeoff(case, parse_rates(f"{start}:max:7"), workers=1)
+    rows = result.rows
+    assert [r["status"] for r in rows] == ["verified"] * 7
+    key = "rms_torque_Nm" if objective == "min-rms-torque" else "energy_kJ"
+    for r in rows:
+        assert r[key] <= r[f"baseline_{key}"] * (1 + 1e-12)
+    improved = [r for r in rows[:-1] if r[key] < r[f"baseline_{key}"] * (1 - 1e-3)]
+    assert len(improved) >= 3, [(r["target_spm"], r[key], r[f"baseline_{key}"]) for r in rows]
+    assert rows[-1]["target_spm"] == pytest.approx(result.fastest.plan.spm, rel=1e-9)
+    # the RMS torque of the optimised plans grows with the rate (heat over a shorter cycle)
+    if objective == "min-rms-torque":
+        rms = [r["rms_torque_Nm"] for r in rows]
+        assert all(b > a for a, b in zip(rms, rms[1:], strict=False))
+
+
+def test_trajectory_recomputes_rms_and_energy(tmp_path: Path) -> None:
+    """``result.json``'s RMS torque and supply energy equal a trapezoid over ``trajectory.csv``."""
+    out = tmp_path / "cup"
+    code = main(["solve", str(CUP), "--objective", "min-energy", "--spm", "30", "--no-plots", "--out", str(out)])
+    assert code == 0
+    result = json.loads((out / "result.json").read_text())
+    assert result["objective"] == "min-energy" and result["target_spm"] == 30.0
+    assert result["spm"] == pytest.approx(30.0, rel=1e-9)
+    with open(out / "trajectory.csv") as fh:
+        rows = [r for r in csv.reader(fh) if r and not r[0].startswith("#")]
+    head, data = rows[0], np.array(rows[1:], dtype=float)
+    col = {name: data[:, head.index(name)] for name in ("time_s", "motor_torque_Nm", "motor_power_kW")}
+    t, period = col["time_s"], col["time_s"][-1]
+    rms = math.sqrt(np.trapezoid(col["motor_torque_Nm"] ** 2, t) / period)
+    drawn = np.trapezoid(np.maximum(col["motor_power_kW"], 0.0), t)
+    returned = np.trapezoid(np.minimum(col["motor_power_kW"], 0.0), t)
+    regen = read_case(CUP).drive.regen_efficiency
+    assert rms == pytest.approx(result["rms_torque_Nm"], rel=TRAJECTORY_REL)
+    assert drawn + regen * returned == pytest.approx(result["energy_kJ"], rel=TRAJECTORY_REL)
+    assert result["energy_kJ"] <= result["baseline"]["energy_kJ"]
+    saving = 100 * (1 - result["energy_kJ"] / result["baseline"]["energy_kJ"])
+    assert result["saving_pct"]["energy"] == pytest.approx(saving, rel=1e-9)
+
+
+def test_both_placements_and_another_law_at_a_rate() -> None:
+    base = read_case(CUP)
+    for placement, law in (("published", "improved-s-curve"), ("free", "seven-segment")):
+        case = base.with_law(law).with_objective("min-rms-torque", 30.0)
+        fast = solve(case.with_objective("max-spm"), placement)
+        sol = solve_at_rate(case, placement, fastest=fast)
+        assert sol.verification.passed and sol.plan.spm == pytest.approx(30.0, rel=1e-9)
+        assert sol.plan.motion_law == law
+        assert sol.at_rate.figures.rms_torque_Nm <= sol.at_rate.baseline_figures.rms_torque_Nm
+        # the baseline runs at the rate too, and spends the spare time in a longer transfer dwell
+        baseline = sol.at_rate.baseline.plan
+        assert baseline.spm == pytest.approx(30.0, rel=1e-9)
+        assert float(baseline.parameters.transfer_dwell) > float(fast.plan.parameters.transfer_dwell)
