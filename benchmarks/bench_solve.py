@@ -3,9 +3,10 @@
 Measures (a) the in-process solve after a warm-up (the NLP already built), a cold ``pressplan solve``
 process beside a process that only imports casadi, numpy, matplotlib and yaml, and the NLP build
 alone; (b) a 41-point transfer-time sweep with 1 and 2 workers (whole process, points per second);
-(c) the SPM of every motion law and its share of the time-optimal bound, with each law's NLP build and
-solve time (``pressplan laws``). Medians; run with
-``python benchmarks/bench_solve.py`` from the project root where pressplan is installed.
+(c) a 7-point trade-off (``pressplan tradeoff``) on both drive cases with 2 workers; (d) the SPM of
+every motion law and its share of the time-optimal bound, with each law's NLP build and solve time
+(``pressplan laws``). Medians; run with ``python benchmarks/bench_solve.py`` from the project root
+where pressplan is installed.
 """
 
 from __future__ import annotations
@@ -23,6 +24,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 CASE = ROOT / "cases" / "wang2023-side-panel.yaml"
 DRIVE_CASE = ROOT / "cases" / "wang2023-side-panel-drive.yaml"
+CUP_DRIVE_CASE = ROOT / "cases" / "cup-2000kN-drive.yaml"
+TRADEOFF_RUNS = 3
 COLD_RUNS = 5
 WARM_RUNS = 7
 
@@ -76,6 +79,17 @@ def main() -> None:
                 ]
             )
             sweep_rows.append((workers, wall))
+    tradeoff_rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for drive_path, start in ((DRIVE_CASE, 5.0), (CUP_DRIVE_CASE, 20.0)):
+            walls = [
+                timed(
+                    [str(exe), "tradeoff", str(drive_path), "--spm", f"{start:g}:max:7", "--workers", "2"]
+                    + ["--out", f"{tmp}/t{k}"]
+                )
+                for k in range(TRADEOFF_RUNS)
+            ]
+            tradeoff_rows.append((drive_path.name, start, statistics.median(walls)))
     law_rows = _laws(case)
     drive_case = read_case(DRIVE_CASE)
     drive_warm, drive_sol = _warm_times(drive_case, solve)
@@ -104,6 +118,14 @@ def main() -> None:
     for workers, wall in sweep_rows:
         rows.append((f"41-point transfer-time sweep, {workers} worker(s), whole `pressplan sweep` process", wall))
         rows.append((f"  sweep throughput, {workers} worker(s) [points/s]", 41 / wall))
+    for name, start, wall in tradeoff_rows:
+        rows.append(
+            (
+                f"7-point `pressplan tradeoff {name} --spm {start:g}:max:7`, 2 workers, whole process "
+                f"(median of {TRADEOFF_RUNS}; target 10 s)",
+                wall,
+            )
+        )
     lines = [
         "# Benchmarks",
         "",

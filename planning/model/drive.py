@@ -1,7 +1,8 @@
 """What the drive does over one planned cycle: torques, RMS, power and energy, from the closed-form profile.
 
 The integrals over the cycle use Gauss-Legendre quadrature (:data:`GAUSS_NODES` nodes) on pieces of at
-most :data:`MAX_PIECE_S` between breakpoints: every knot of the profile, theta2 and BDC (where the
+most :data:`MAX_PIECE_S`, and at least :data:`MIN_PIECES` per span, between breakpoints: every knot of
+the profile, theta2 and BDC (where the
 forming force starts and ends) and every height of the forming-force table on the way down (its
 kinks). The integrands are smooth on each piece, so the crank work ``integral T_c omega dt`` is exact to
 about 1e-12 relative and can be checked against the forming work, which is integrated exactly from the
@@ -25,6 +26,8 @@ from press.dynamics import drive_state, forming_work
 GAUSS_NODES = 4
 MAX_PIECE_S = 5e-3  # [s] (4-point Gauss-Legendre is exact for polynomials of degree 7 on each piece)
 MAX_PIECES = 400_000  # a longer cycle gets longer pieces
+MIN_PIECES = 8  # per span between breakpoints: a short segment of a trigonometric law (a cycloidal half of
+# a few ms is one period of its cosine) is resolved as finely as a long one
 
 
 @dataclass(frozen=True)
@@ -73,7 +76,7 @@ def quadrature(profile: Profile, case: Case) -> tuple[np.ndarray, np.ndarray]:
     edges = _breakpoints(profile, case)
     span = np.diff(edges)
     step = max(MAX_PIECE_S, profile.duration / MAX_PIECES)
-    counts = np.maximum(1, np.ceil(span / step).astype(int))
+    counts = np.maximum(MIN_PIECES, np.ceil(span / step).astype(int))
     starts = np.repeat(edges[:-1], counts) + np.concatenate(
         [np.arange(c) * (s / c) for c, s in zip(counts, span, strict=True)]
     )

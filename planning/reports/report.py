@@ -242,7 +242,7 @@ def summary_text(result: dict[str, Any]) -> str:
             f"  objective {r['objective']} at {r['target_spm']:g} strokes/min (the limits allow up to "
             f"{r['fastest_spm']:.3f}): RMS motor torque {r['rms_torque_Nm'] / 1e3:.2f} kN m, "
             f"energy from the supply {r['energy_kJ']:.1f} kJ per stroke",
-            f"  baseline (max-SPM plan, spare time to the transfer: window {b['transfer_time_s']:.3f} s): RMS "
+            f"  baseline (max-SPM plan, spare time in the transfer dwell; window {b['transfer_time_s']:.3f} s): RMS "
             f"{b['rms_torque_Nm'] / 1e3:.2f} kN m, energy {b['energy_kJ']:.1f} kJ; saving {saving['rms_torque']:.1f} % "
             f"RMS torque, {saving['energy']:.1f} % energy"
             + ("" if r["improved_on_baseline"] else " (no solve beat the baseline: it is the plan)"),

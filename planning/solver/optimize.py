@@ -26,6 +26,7 @@ from planning.model.cycle import HALVES
 from planning.model.laws import get_law
 from planning.model.laws import improved_scurve as sc
 from planning.model.plan import Plan, SolverInfo, params_from_numbers, profile_from_tdc
+from planning.solver.ipopt import NLPStatus
 from planning.solver.nlp import (
     BLOCK_FIELDS,
     DRIVE_INDEX,
@@ -366,8 +367,13 @@ class _Search:
         self.starts += 1
         for _ in range(REFINEMENTS + 1):
             res = self.nlp.solve(values, q, self.lbx, self.ubx, placement, self.scale, multipliers, self.fixed_period)
-            values, multipliers = values_of(res), res.multipliers
             self.iterations += res.iterations
+            if self.fixed_period and res.status == NLPStatus.STOPPED_AT_LIMIT:
+                # at a target rate the optimum may sit where a half of the law degenerates (a monotone speed
+                # change: peak = end speed); IPOPT then crawls, and a fresh start from its last iterate ends it
+                res = self.nlp.solve(values_of(res), q, self.lbx, self.ubx, placement, self.scale, None, True)
+                self.iterations += res.iterations
+            values, multipliers = values_of(res), res.multipliers
             if not res.success:
                 block, amount = self.nlp.worst_violation(placement, res.g, self.fixed_period)
                 field = BLOCK_FIELDS[block]
