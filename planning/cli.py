@@ -90,6 +90,11 @@ def _parser() -> argparse.ArgumentParser:
     lw.add_argument("--out", help="output folder (default: out/<case name>)")
     lw.add_argument("--json", action="store_true", help="print laws.json instead of the table")
     lw.add_argument("--format", choices=PLOT_FORMATS, default="png", help="figure format (default png)")
+    sv = sub.add_parser("serve", help="a local web page to plan a motion interactively (extra 'web')")
+    sv.add_argument("case", nargs="?", help="case file (YAML) to open first (default: the first in cases/)")
+    sv.add_argument("--port", type=_whole(1, 65535), default=8050, help="port (default 8050)")
+    sv.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1: this machine only)")
+    sv.add_argument("--cases", default="cases", help="folder whose *.yaml the page offers (default cases)")
     pl = sub.add_parser("plot", help="redraw the figures of a finished output folder (no solve)")
     pl.add_argument("folder", help="output folder of `pressplan solve`")
     pl.add_argument("--format", choices=PLOT_FORMATS, default="png", help="figure format (default png)")
@@ -160,9 +165,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         "bound": _bound,
         "laws": _laws,
         "plot": _plot,
+        "serve": _serve,
     }[args.command]
     try:
-        if args.command == "plot":
+        if args.command in ("plot", "serve"):
             return command(args)
         from planning.model.case_file import read_case
 
@@ -383,6 +389,22 @@ def _plot(args) -> int:
     return EXIT_OK
 
 
+def _serve(args) -> int:
+    try:
+        from planning.web.server import serve
+    except ImportError as exc:
+        raise CommandError(f"serve needs the web extra: pip install -e '.[web]' ({exc.name} is missing)") from None
+    case_path = None
+    if args.case is not None:
+        from planning.model.case_file import read_case
+
+        read_case(args.case)  # a bad case file is the usual one line, exit 2
+        case_path = Path(args.case).resolve()
+    cases = Path(args.cases)
+    serve(case_path, args.host, args.port, cases if cases.is_dir() else None)
+    return EXIT_OK
+
+
 class _Terminated(BaseException):
     """SIGTERM, raised in the main thread so that clean-up (worker processes, temporary folders) runs."""
 
@@ -402,12 +424,22 @@ def run() -> None:
     try:
         code = main()
     except KeyboardInterrupt:
-        print("pressplan: interrupted", file=sys.stderr)
-        code = EXIT_INTERRUPTED
+        _stop("pressplan: interrupted", EXIT_INTERRUPTED)
     except _Terminated:
-        print("pressplan: terminated", file=sys.stderr)
-        code = EXIT_TERMINATED
+        _stop("pressplan: terminated", EXIT_TERMINATED)
     sys.exit(code)
+
+
+def _stop(message: str, code: int) -> NoReturn:
+    """End an interrupted run with one line: the clean-up in ``finally`` blocks has run on the way here;
+    the interpreter's own exit is skipped, since a worker pool's thread torn down mid-read would print
+    a traceback after the line."""
+    import os
+
+    print(message, file=sys.stderr)
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(code)
 
 
 if __name__ == "__main__":

@@ -120,15 +120,19 @@ def test_trajectory_recomputes_rms_and_energy(tmp_path: Path) -> None:
     head, data = rows[0], np.array(rows[1:], dtype=float)
     col = {name: data[:, head.index(name)] for name in ("time_s", "motor_torque_Nm", "motor_power_kW")}
     t, period = col["time_s"], col["time_s"][-1]
-    rms = math.sqrt(np.trapezoid(col["motor_torque_Nm"] ** 2, t) / period)
-    drawn = np.trapezoid(np.maximum(col["motor_power_kW"], 0.0), t)
-    returned = np.trapezoid(np.minimum(col["motor_power_kW"], 0.0), t)
+    rms = math.sqrt(_trapezoid(col["motor_torque_Nm"] ** 2, t) / period)
+    drawn = _trapezoid(np.maximum(col["motor_power_kW"], 0.0), t)
+    returned = _trapezoid(np.minimum(col["motor_power_kW"], 0.0), t)
     regen = read_case(CUP).drive.regen_efficiency
     assert rms == pytest.approx(result["rms_torque_Nm"], rel=TRAJECTORY_REL)
     assert drawn + regen * returned == pytest.approx(result["energy_kJ"], rel=TRAJECTORY_REL)
     assert result["energy_kJ"] <= result["baseline"]["energy_kJ"]
     saving = 100 * (1 - result["energy_kJ"] / result["baseline"]["energy_kJ"])
     assert result["saving_pct"]["energy"] == pytest.approx(saving, rel=1e-9)
+
+
+def _trapezoid(y: np.ndarray, t: np.ndarray) -> float:
+    return float(np.sum(np.diff(t) * (y[1:] + y[:-1]) / 2))
 
 
 def test_both_placements_and_another_law_at_a_rate() -> None:

@@ -73,7 +73,12 @@ class _Refused(Exception):
 
 
 class CaseFileError(ValueError):
-    """A case file that cannot be used; ``str()`` is the one-line message ``FILE: field: problem``."""
+    """A case file that cannot be used; ``str()`` is the one-line message ``FILE: field: problem``;
+    ``field`` the dotted case field it names (None when the problem is the file as a whole)."""
+
+    def __init__(self, message: str, field: str | None = None):
+        super().__init__(message)
+        self.field = field
 
 
 def read_case(path: str | Path) -> Case:
@@ -136,12 +141,12 @@ def case_from_data(data: Any, label: str = "<case>") -> Case:
     try:
         case = Case.model_validate(data)
     except ValidationError as exc:
-        raise CaseFileError(_pydantic_line(exc, data, label)) from None
+        raise CaseFileError(_pydantic_line(exc, data, label), _pydantic_field(exc)) from None
     try:
         with np.errstate(all="ignore"):
             cross_checks(case)
     except CaseError as exc:
-        raise CaseFileError(exc.line(label)) from None
+        raise CaseFileError(exc.line(label), exc.field) from None
     except (ArithmeticError, ValueError) as exc:  # the ranges should prevent it; never a traceback
         raise CaseFileError(f"{label}: the numbers cannot be used together ({_first_line(str(exc))})") from None
     return case
@@ -173,10 +178,17 @@ def _first_line(text: str) -> str:
     return " ".join(text.split())
 
 
-def _pydantic_line(exc: ValidationError, data: Any, label: str) -> str:
-    errors = exc.errors(include_url=False)
+def _first_error(exc: ValidationError) -> dict:
     # an unknown key explains a "missing" one next to it (a typo): report it first
-    err = min(errors, key=lambda e: 0 if e["type"] == "extra_forbidden" else 1)
+    return min(exc.errors(include_url=False), key=lambda e: 0 if e["type"] == "extra_forbidden" else 1)
+
+
+def _pydantic_field(exc: ValidationError) -> str:
+    return ".".join(str(p) for p in _first_error(exc)["loc"])
+
+
+def _pydantic_line(exc: ValidationError, data: Any, label: str) -> str:
+    err = _first_error(exc)
     loc = [str(p) for p in err["loc"]]
     field = ".".join(loc)
     kind = err["type"]

@@ -36,6 +36,9 @@ BASE_OPTIONS = {
     "ipopt.max_wall_time": MAX_SOLVE_WALL_S,
 }
 _SIGNALS = ("SIGINT", "SIGTERM")
+# One IPOPT call at a time in a process: a compiled CasADi function keeps its work memory per instance,
+# and IPOPT's linear solver (MUMPS) is not thread-safe; threads (the web server's, a Dask worker's) queue here.
+_IPOPT_LOCK = threading.Lock()
 WARM_START_OPTIONS = {  # a start from a nearby solution and its multipliers: a few iterations
     "ipopt.warm_start_init_point": "yes",
     "ipopt.mu_init": 1e-6,
@@ -151,8 +154,9 @@ class NLPSolver:
         if warm_start is not None:
             solver = self._warm_function()
             args.update(lam_x0=warm_start[0], lam_g0=warm_start[1])
-        res = _call_passing_signals_on(solver, args)
-        stats = solver.stats()
+        with _IPOPT_LOCK:
+            res = _call_passing_signals_on(solver, args)
+            stats = solver.stats()
         x = np.array(res["x"]).ravel() * unit
         return_status = str(stats["return_status"])
         return NLPResult(

@@ -284,9 +284,10 @@ def _trapezoid(values: ca.SX, times: ca.SX) -> ca.SX:
     return ca.sum1((times[1:n] - times[0 : n - 1]) * (values[1:n] + values[0 : n - 1]) / 2)
 
 
-def _build(law_name: str, drive: bool = False) -> CycleNLP:
+def _build(law_name: str, drive: bool = False, rate: bool = False) -> CycleNLP:
     law = get_law(law_name)
     x = ca.SX.sym("x", len(VARIABLES))
+    drive = drive or rate
     p_case = ca.SX.sym("p", len(PARAMETERS) + (len(DRIVE_PARAMETERS) + FORMING_SAMPLES if drive else 0))
     p_scale = ca.SX.sym("scale", len(VARIABLES))  # physical value = scale * x, chosen per case
     p = ca.vertcat(p_case, p_scale)
@@ -413,7 +414,9 @@ def _build(law_name: str, drive: bool = False) -> CycleNLP:
     add("crank jerk limit", ca.vertcat(*params.peak_jerks()) / q["crank_jerk_max"], -np.inf, 1.0)
     objective = params.period
     period_rows = die_zone_rows = None
-    if drive:
+    if drive and not rate:
+        _drive_constraints(add, p_case, th, om, al, d1, d2, ca.vertcat(*t_s), params.period)
+    elif rate:
         # at a target rate a plan may peak in speed inside the die zone, between the crossings: below the die
         # height every sample keeps the die speed (max(h - h_die, v_die - |v|) >= 0, continuous; the draw's
         # constant speed is bounded already). The samples of the draw are the last FORMING_SAMPLES.
@@ -429,12 +432,14 @@ def _build(law_name: str, drive: bool = False) -> CycleNLP:
         period_rows = add("cycle time", params.period - p_case[DRIVE_INDEX["target_period"]], -np.inf, np.inf)
 
     nlp = {"x": x, "p": p, "f": objective, "g": ca.vertcat(*g)}
-    program = NLPSolver("press_cycle_" + law_name.replace("-", "_") + ("_drive" if drive else ""), nlp, CYCLE_OPTIONS)
+    kind = "_rate" if rate else "_drive" if drive else ""
+    program = NLPSolver("press_cycle_" + law_name.replace("-", "_") + kind, nlp, CYCLE_OPTIONS)
     return CycleNLP(program, np.array(lb), np.array(ub), tuple(blocks), published_rows, period_rows, die_zone_rows)
 
 
 @cache
-def cycle_nlp(law: str = DEFAULT_LAW, drive: bool = False) -> CycleNLP:
-    """The compiled NLP of motion law ``law``, with the motor's limits when ``drive`` (built on first use
-    in a process, then reused for every case and start)."""
-    return _build(law, drive)
+def cycle_nlp(law: str = DEFAULT_LAW, drive: bool = False, rate: bool = False) -> CycleNLP:
+    """The compiled NLP of motion law ``law``, with the motor's limits when ``drive``; ``rate``: the drive
+    NLP of a target rate (the objectives' terms, the "cycle time" row, the die-zone rows; see
+    ``planning.solver.objectives``). Built on first use in a process, then reused for every case and start."""
+    return _build(law, drive, rate)

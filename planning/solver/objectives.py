@@ -1,7 +1,8 @@
 """At the line's rate: the gentlest verified plan at a target SPM, and the baseline it beats.
 
 In a press line the rate is set by the line, not by one press's maximum. At a target rate (cycle time
-``60 / target_spm``, the drive NLP's "cycle time" row held fixed) the planner minimises
+``60 / target_spm``, the "cycle time" row of the rate NLP ``cycle_nlp(law, rate=True)`` held fixed) the
+planner minimises
 
 - ``min-rms-torque``: the heat ``integral T_m^2 dt`` over the cycle (the RMS torque squared times the
   cycle time, which is fixed);
@@ -28,7 +29,7 @@ from dataclasses import dataclass, replace
 from planning.model.case import Case, Placement
 from planning.model.drive import cycle_integrals
 from planning.model.plan import Plan
-from planning.solver.nlp import DRIVE_INDEX, VARIABLE_INDEX, VARIABLES
+from planning.solver.nlp import DRIVE_INDEX, VARIABLE_INDEX, VARIABLES, cycle_nlp
 from planning.solver.optimize import Solution, _prepare, _Search, solve
 from planning.solver.outcomes import Infeasible, NoPlanFound
 from planning.solver.verify import CHECK_FIELDS
@@ -177,6 +178,7 @@ def _check_reachable(target: float, fastest: Solution, case: Case) -> None:
 def _rate_search(case: Case, placement: Placement, period: float) -> _Search:
     """The drive NLP's search with the cycle time held at ``period`` [s] and every objective weight 0."""
     search = _prepare(case, placement)
+    search.nlp = cycle_nlp(case.planner.motion_law, drive=True, rate=True)
     search.parameters = search.parameters.copy()
     search.parameters[DRIVE_INDEX["target_period"]] = period
     search.parameters[DRIVE_INDEX["weight_period"]] = 0.0

@@ -1,0 +1,66 @@
+"""Edit-to-chart latency of ``pressplan serve`` in a real browser; rewrites the web section of RESULTS.md.
+
+The published case is opened in headless Chromium (Debian's ``chromium`` through Playwright), then
+θ2 is edited 20 times (131.6 ... 133.5 deg); each time is measured in the page, from the change event
+to the charts redrawn with the new plan (the server's warm re-solve included). Run with
+``python benchmarks/bench_web.py`` from the project root with the test extra installed.
+"""
+
+from __future__ import annotations
+
+import statistics
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+EDITS = 20
+BEGIN, END = "<!-- web:begin -->", "<!-- web:end -->"
+
+
+def main() -> None:
+    from tests.web_page import CASES, chromium, running_server, wait_rendered
+
+    times, parts = [], []
+    with running_server(CASES / "wang2023-side-panel.yaml") as url, chromium() as browser:
+        page = browser.new_page(viewport={"width": 1400, "height": 1000})
+        page.goto(url)
+        wait_rendered(page)
+        box = page.locator('[data-field="key_points.draw_start_deg"]')
+        for k in range(1, EDITS + 1):
+            before = int(page.evaluate("document.body.dataset.rendered"))
+            box.fill(f"{131.5 + 0.1 * k:.1f}")
+            start = page.evaluate(
+                "() => { const t = performance.now(); "
+                "document.querySelector('[data-field=\"key_points.draw_start_deg\"]')"
+                ".dispatchEvent(new Event('change')); return t; }"
+            )
+            wait_rendered(page, before)
+            assert page.evaluate("document.body.dataset.state") == "ready"
+            times.append(page.evaluate("window.renderedAt") - start)
+            parts.append(page.evaluate("[window.solveSentAt, window.solveAnsweredAt, window.renderedAt]"))
+            parts[-1] = [parts[-1][0] - start, parts[-1][1] - parts[-1][0], parts[-1][2] - parts[-1][1]]
+    print("until sent, request to answer, answer to charts [ms]:", [[round(v) for v in p] for p in parts])
+    times.sort()
+    median = statistics.median(times)
+    p95 = times[min(len(times) - 1, int(round(0.95 * (len(times) - 1))))]
+    section = (
+        f"{BEGIN}\n"
+        f"`pressplan serve`, published case, {EDITS} edits of θ2 in headless Chromium "
+        "(`python benchmarks/bench_web.py`): "
+        f"edit to updated charts, median {median:.0f} ms, 95th percentile {p95:.0f} ms (target: median ≤ 300 ms); "
+        f"fastest {times[0]:.0f} ms, slowest {times[-1]:.0f} ms.\n{END}"
+    )
+    results = ROOT / "benchmarks" / "RESULTS.md"
+    text = results.read_text(encoding="utf-8")
+    if BEGIN in text:
+        head, rest = text.split(BEGIN)
+        text = head + section + rest.split(END)[1]
+    else:
+        text = text.rstrip("\n") + "\n\n" + section + "\n"
+    results.write_text(text, encoding="utf-8")
+    print(section)
+
+
+if __name__ == "__main__":
+    main()

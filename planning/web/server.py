@@ -1,0 +1,348 @@
+"""``pressplan serve``: a local web page to plan a press motion, on Flask, with plotly.js for the charts.
+
+The page (``static/``) sends the case it shows as JSON; every answer comes from the same functions as
+the CLI: ``case_from_data`` (the validated reader), ``solve``, ``time_optimal_bound``, ``result_dict``,
+``solution_writers``. Nothing here solves or checks on its own.
+
+Safety: the server binds to 127.0.0.1 unless told otherwise; a request body is at most
+:data:`MAX_REQUEST_BYTES`; an uploaded case goes through the reader's limits (256 kB, depth, values);
+case files are offered by name from one folder, and a name is looked up in that listing, never joined
+to a path; each browser tab sends its own session id, and a session's plan (its warm start) is seen by
+no other session. A solve is superseded by a newer edit of the same session: a request that was
+overtaken while it waited returns at once, so at most one solve runs and one waits per session. The
+number of sessions kept is bounded (:data:`MAX_SESSIONS`, the least recently used is dropped).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import tempfile
+import threading
+from collections import OrderedDict
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+from flask import Flask, Response, jsonify, request, send_file
+
+from planning.model.case import OBJECTIVES, Case
+from planning.model.case_file import MAX_BYTES, CaseFileError, case_from_data, load_yaml, read_case
+from planning.model.laws import LAWS
+
+STATIC = Path(__file__).resolve().parent / "static"
+MAX_REQUEST_BYTES = 2 * MAX_BYTES  # a case as JSON, with the page's own fields
+MAX_SESSIONS = 64
+CHART_POINTS = 600  # samples of a plan's curves sent to the page (the files keep the full 1 ms step)
+BOUND_CACHE = 32
+DOWNLOADS = ("result.json", "trajectory.csv", "cam_table.csv")
+
+
+@dataclass
+class Session:
+    """One browser tab: its last plan (the next solve's warm start) and the newest request it sent."""
+
+    lock: threading.Lock = field(default_factory=threading.Lock)  # held while the session's solve runs
+    guard: threading.Lock = field(default_factory=threading.Lock)  # held while ``newest`` changes
+    newest: int = -1
+    plan: Any = None
+
+
+class Sessions:
+    """The sessions by id, at most :data:`MAX_SESSIONS` (least recently used dropped)."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._items: OrderedDict[str, Session] = OrderedDict()
+
+    def get(self, key: str) -> Session:
+        with self._lock:
+            session = self._items.pop(key, None) or Session()
+            self._items[key] = session
+            while len(self._items) > MAX_SESSIONS:
+                self._items.popitem(last=False)
+            return session
+
+
+def case_files(folder: Path | None) -> dict[str, Path]:
+    """The case files offered by name: ``*.yaml`` in ``folder``."""
+    if folder is None or not folder.is_dir():
+        return {}
+    return {p.name: p for p in sorted(folder.glob("*.yaml")) if p.is_file()}
+
+
+def create_app(cases_dir: Path | None = None, initial: Path | None = None) -> Flask:
+    """The application: the page, its static files and the JSON endpoints."""
+    import logging
+
+    logging.getLogger("werkzeug").setLevel(logging.WARNING)  # no line per request
+    app = Flask(__name__, static_folder=None)
+    app.config["MAX_CONTENT_LENGTH"] = MAX_REQUEST_BYTES
+    bound_pool = _BoundPool()
+    sessions = Sessions()
+    bounds: OrderedDict[str, dict] = OrderedDict()
+    bounds_lock = threading.Lock()
+    offered = case_files(cases_dir)
+    if initial is not None:
+        offered = {initial.name: initial, **{k: v for k, v in offered.items() if k != initial.name}}
+
+    @app.get("/")
+    def index() -> Response:
+        return send_file(STATIC / "index.html")
+
+    @app.get("/static/<name>")
+    def static_file(name: str) -> Response:
+        files = {"app.js": STATIC / "app.js", "style.css": STATIC / "style.css", "plotly.min.js": _plotly_js()}
+        if name not in files:
+            return Response("not found", status=404)
+        return send_file(files[name], max_age=3600)
+
+    @app.get("/api/meta")
+    def meta() -> Response:
+        return jsonify(
+            {
+                "cases": list(offered),
+                "initial": next(iter(offered), None),
+                "laws": list(LAWS),
+                "objectives": list(OBJECTIVES),
+                "placements": ["free", "published"],
+                "fields": field_specs(),
+            }
+        )
+
+    @app.get("/api/case/<name>")
+    def load_case(name: str) -> Response:
+        path = offered.get(name)
+        if path is None:
+            return jsonify({"status": "bad input", "message": f"{name}: no such case here"}), 404
+        try:
+            case = read_case(path)
+        except CaseFileError as exc:
+            return jsonify({"status": "bad input", "message": str(exc), "field": exc.field}), 400
+        return jsonify({"status": "ok", "label": _label(path), "case": _data(case)})
+
+    @app.post("/api/upload")
+    def upload() -> Response:
+        file = request.files.get("file")
+        if file is None:
+            return jsonify({"status": "bad input", "message": "no file sent"}), 400
+        name = Path(file.filename or "upload.yaml").name[:100]
+        blob = file.read(MAX_BYTES + 1)
+        try:
+            if len(blob) > MAX_BYTES:
+                raise CaseFileError(f"{name}: too large for a case file (> {MAX_BYTES} bytes)")
+            try:
+                text = blob.decode("utf-8")
+            except UnicodeDecodeError:
+                raise CaseFileError(f"{name}: not UTF-8 text, expected a YAML case") from None
+            case = case_from_data(load_yaml(text, name), name)
+        except CaseFileError as exc:
+            return jsonify({"status": "bad input", "message": str(exc), "field": exc.field}), 400
+        return jsonify({"status": "ok", "label": name, "case": _data(case)})
+
+    @app.post("/api/solve")
+    def solve_endpoint() -> Response:
+        body = _body()
+        session = sessions.get(str(body.get("session", ""))[:80])
+        seq = int(body.get("seq", 0)) if isinstance(body.get("seq", 0), int) else 0
+        with session.guard:
+            session.newest = max(session.newest, seq)
+        with session.lock:
+            if seq < session.newest:
+                return jsonify({"status": "superseded", "seq": seq})
+            answer = solve_case(body.get("case"), _label_of(body), session)
+        answer["seq"] = seq
+        return jsonify(answer)
+
+    @app.post("/api/bound")
+    def bound_endpoint() -> Response:
+        body = _body()
+        data = body.get("case")
+        key = hashlib.sha256(json.dumps(data, sort_keys=True, default=str).encode()).hexdigest()
+        with bounds_lock:
+            if key in bounds:
+                return jsonify(bounds[key])
+        answer = bound_pool.run(data, _label_of(body))
+        with bounds_lock:
+            bounds[key] = answer
+            while len(bounds) > BOUND_CACHE:
+                bounds.popitem(last=False)
+        return jsonify(answer)
+
+    @app.post("/api/download/<name>")
+    def download(name: str) -> Response:
+        body = _body()
+        label = _label_of(body)
+        try:
+            case = case_from_data(body.get("case"), label)
+        except CaseFileError as exc:
+            return jsonify({"status": "bad input", "message": str(exc), "field": exc.field}), 400
+        if name == "case.yaml":
+            text = yaml.safe_dump(_data(case), sort_keys=False, allow_unicode=True)
+            return Response(text, mimetype="application/x-yaml", headers=_attachment(f"{case.name}.yaml"))
+        if name not in DOWNLOADS:
+            return Response("not found", status=404)
+        return files_of(case, label, name)
+
+    return app
+
+
+def _body() -> dict[str, Any]:
+    body = request.get_json(silent=True)
+    return body if isinstance(body, dict) else {}
+
+
+def _label_of(body: dict[str, Any]) -> str:
+    """The name the messages use for the case (as the CLI uses the file's path), printable, short."""
+    label = str(body.get("label") or "case")
+    return "".join(ch for ch in label if ch.isprintable())[:120] or "case"
+
+
+def _label(path: Path) -> str:
+    """``cases/NAME.yaml`` for the project's cases (as the CLI is run from the project root)."""
+    return f"{path.parent.name}/{path.name}" if path.parent.name == "cases" else path.name
+
+
+def _data(case: Case) -> dict[str, Any]:
+    return case.model_dump(exclude_none=True)
+
+
+def _attachment(name: str) -> dict[str, str]:
+    safe = "".join(ch for ch in name if ch.isalnum() or ch in "._-") or "file"
+    return {"Content-Disposition": f'attachment; filename="{safe}"'}
+
+
+def _plotly_js() -> Path:
+    import plotly
+
+    return Path(plotly.__file__).resolve().parent / "package_data" / "plotly.min.js"
+
+
+def field_specs() -> list[dict[str, Any]]:
+    """The form's fields: dotted name, kind (number | choice | table), optional or not, choices."""
+    from planning.sweep import numeric_fields
+
+    specs: list[dict[str, Any]] = []
+    for name in numeric_fields():
+        model, leaf = _model_at(name)
+        info = model.model_fields[leaf]
+        specs.append({"name": name, "kind": "number", "optional": not info.is_required()})
+    specs += [
+        {"name": "planner.motion_law", "kind": "choice", "choices": list(LAWS)},
+        {"name": "planner.placement", "kind": "choice", "choices": ["free", "published"]},
+        {"name": "planner.objective", "kind": "choice", "choices": list(OBJECTIVES)},
+        {"name": "process.forming_force_kN", "kind": "table", "optional": True},
+    ]
+    return specs
+
+
+def _model_at(dotted: str) -> tuple[type, str]:
+    model: Any = Case
+    *parents, leaf = dotted.split(".")
+    for name in parents:
+        ann = model.model_fields[name].annotation
+        model = next(a for a in getattr(ann, "__args__", (ann,)) if isinstance(a, type))
+    return model, leaf
+
+
+def solve_case(data: Any, label: str, session: Session) -> dict[str, Any]:
+    """Validate and solve ``data`` from the session's last plan; the page's answer."""
+    from planning.reports.report import result_dict, sample_profile, trajectory_columns
+    from planning.solver.optimize import solve
+    from planning.solver.outcomes import Infeasible, PlanningError
+
+    try:
+        case = case_from_data(data, label)
+    except CaseFileError as exc:
+        return {"status": "bad input", "message": str(exc), "field": exc.field}
+    try:
+        # the last plan alone when it leads to a verified plan (what a sweep does between neighbours)
+        solution = solve(case, neighbour=session.plan, follow=session.plan is not None)
+    except PlanningError as exc:
+        limit = exc.limit if isinstance(exc, Infeasible) else None
+        return {"status": exc.kind, "message": f"{label}: {exc}", "field": limit}
+    session.plan = solution.plan
+    result = result_dict(solution, case)
+    plan = solution.plan
+    table = sample_profile(plan.profile, case.machine, plan.period / CHART_POINTS, case)
+    curves = {name: _rounded(col) for name, col in zip(trajectory_columns(case), table.T, strict=True)}
+    return {"status": "verified", "result": _finite(result), "curves": curves}
+
+
+class _BoundPool:
+    """The bounds are computed in one separate process: a bound takes about half a second, and in the
+    server's process it would hold IPOPT (one call at a time) while the next edit's solve waits."""
+
+    def __init__(self) -> None:
+        self._pool = None
+        self._lock = threading.Lock()
+
+    def run(self, data: Any, label: str) -> dict[str, Any]:
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor
+
+        with self._lock:
+            if self._pool is None:
+                self._pool = ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("spawn"))
+        try:
+            return self._pool.submit(bound_of, data, label).result()
+        except Exception as exc:  # noqa: BLE001 - the bound is extra information: say why it is missing
+            return {"status": "none", "message": f"no bound ({type(exc).__name__})"}
+
+
+def bound_of(data: Any, label: str) -> dict[str, Any]:
+    """The time-optimal bound of the case (``pressplan bound``), or why there is none."""
+    from planning.solver.bound import time_optimal_bound
+    from planning.solver.outcomes import PlanningError
+
+    try:
+        case = case_from_data(data, label)
+        bound = time_optimal_bound(case)
+    except (CaseFileError, PlanningError) as exc:
+        return {"status": "none", "message": str(exc)}
+    return {"status": "ok", "spm": bound.spm}
+
+
+def files_of(case: Case, label: str, name: str) -> Response:
+    """One file as ``pressplan solve`` writes it for ``case`` (the same cold solve and writers)."""
+    from planning.reports.outputs import solution_writers
+    from planning.solver.optimize import solve
+    from planning.solver.outcomes import PlanningError
+
+    try:
+        solution = solve(case)
+    except PlanningError as exc:
+        return jsonify({"status": exc.kind, "message": f"{label}: {exc}"}), 409
+    writers = solution_writers(solution, case, plot_format=None)
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / name
+        writers[name](path)
+        blob = path.read_bytes()
+    mime = "application/json" if name.endswith(".json") else "text/csv"
+    return Response(blob, mimetype=mime, headers=_attachment(name))
+
+
+def _rounded(column: np.ndarray) -> list[float]:
+    """Chart values to 7 significant digits (the page's charts need no more; the files keep all)."""
+    return [float(f"{v:.7g}") for v in column.tolist()]
+
+
+def _finite(value: Any) -> Any:
+    """``value`` with NaN and infinities as None (JSON has neither)."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite(v) for v in value]
+    return value
+
+
+def serve(case_path: Path | None, host: str, port: int, cases_dir: Path | None) -> None:
+    """Run the server until Ctrl-C; prints the address."""
+    app = create_app(cases_dir, case_path)
+    print(f"pressplan: serving on http://{host}:{port}/ (Ctrl-C stops)", flush=True)
+    app.run(host=host, port=port, threaded=True, use_reloader=False)

@@ -1,0 +1,357 @@
+// pressplan serve: the page. Every number comes from the server, which calls the same functions as the CLI.
+"use strict";
+
+const SESSION = (crypto.randomUUID ? crypto.randomUUID() : String(Math.random()).slice(2)) ;
+const SECTIONS = ["press", "key_points", "process", "limits", "drive", "drive.motor", "planner"];
+const STAGE_COLOURS = { transfer: "#d9ecff", feed: "#fff2cc", draw: "#e2f0d9", return: "#fde2e2" };
+const KEY_LABELS = { closing: "θ1", draw_start: "θ2", draw_end: "θ3", opening: "θ4" };
+const TYPING_REST_MS = 600;
+const BOUND_REST_MS = 800;
+
+const state = { meta: null, label: "case", data: null, seq: 0, shownSeq: -1, last: null, pinned: null };
+
+function $(sel) { return document.querySelector(sel); }
+
+function getPath(obj, dotted) {
+  return dotted.split(".").reduce((o, k) => (o == null ? undefined : o[k]), obj);
+}
+
+function setPath(obj, dotted, value) {
+  const keys = dotted.split(".");
+  let node = obj;
+  for (const k of keys.slice(0, -1)) { if (node[k] == null) node[k] = {}; node = node[k]; }
+  const leaf = keys[keys.length - 1];
+  if (value === undefined) delete node[leaf]; else node[leaf] = value;
+}
+
+// ---- the form ---------------------------------------------------------------------------------------
+function buildForm(data) {
+  const form = $("#case-form");
+  form.innerHTML = "";
+  const specs = state.meta.fields;
+  const hasDrive = data.drive != null;
+  for (const section of SECTIONS) {
+    if (section.startsWith("drive") && !hasDrive) continue;
+    const fields = specs.filter((f) => f.name.startsWith(section + ".") && !f.name.slice(section.length + 1).includes("."));
+    if (!fields.length) continue;
+    const fs = document.createElement("fieldset");
+    fs.innerHTML = `<legend>${section}</legend>`;
+    for (const spec of fields) fs.appendChild(fieldRow(spec, getPath(data, spec.name)));
+    form.appendChild(fs);
+  }
+  const general = document.createElement("div");
+  general.className = "field";
+  general.innerHTML = `<span class="msg" data-for=""></span>`;
+  form.appendChild(general);
+}
+
+function fieldRow(spec, value) {
+  const row = document.createElement("div");
+  row.className = "field";
+  const id = "f-" + spec.name.replaceAll(".", "-");
+  const leaf = spec.name.split(".").pop();
+  let input;
+  if (spec.kind === "choice") {
+    input = document.createElement("select");
+    for (const c of spec.choices) input.add(new Option(c, c));
+    input.value = value ?? spec.choices[0];
+  } else {
+    input = document.createElement("input");
+    input.type = "text";
+    input.inputMode = "decimal";
+    if (spec.kind === "table") input.value = value == null ? "" : JSON.stringify(value);
+    else input.value = value == null ? "" : String(value);
+    if (spec.optional) input.placeholder = "none";
+  }
+  input.id = id;
+  input.dataset.field = spec.name;
+  input.dataset.kind = spec.kind;
+  row.innerHTML = `<label for="${id}" title="${spec.name}">${leaf}</label>`;
+  row.appendChild(input);
+  const msg = document.createElement("span");
+  msg.className = "msg";
+  msg.dataset.for = spec.name;
+  row.appendChild(msg);
+  input.addEventListener("change", onEdit);
+  if (spec.kind !== "choice") {  // typing: solve once the keys rest (a change solves at once)
+    input.addEventListener("input", () => { clearTimeout(editTimer); editTimer = setTimeout(onEdit, TYPING_REST_MS); });
+  }
+  return row;
+}
+
+function formValue(input) {
+  const text = input.value.trim();
+  if (input.dataset.kind === "choice") return text;
+  if (text === "") return undefined;
+  if (input.dataset.kind === "table") { try { return JSON.parse(text); } catch (e) { return text; } }
+  const number = Number(text);
+  return Number.isFinite(number) && /^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$/.test(text) ? number : text;
+}
+
+function caseFromForm() {
+  const data = structuredClone(state.data);
+  for (const input of document.querySelectorAll("#case-form [data-field]")) setPath(data, input.dataset.field, formValue(input));
+  return data;
+}
+
+// ---- solving ----------------------------------------------------------------------------------------
+let editTimer = null;
+function onEdit() { clearTimeout(editTimer); solveNow(); }
+
+async function post(url, body) {
+  const response = await fetch(url, { method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body) });
+  return response;
+}
+
+async function solveNow() {
+  const data = caseFromForm();
+  const seq = ++state.seq;
+  setStatus("solving…", "busy");
+  document.body.dataset.state = "solving";
+  let answer;
+  window.solveSentAt = performance.now();
+  try {
+    answer = await (await post("/api/solve", { session: SESSION, seq, label: state.label, case: data })).json();
+    window.solveAnsweredAt = performance.now();
+  } catch (e) {
+    answer = { status: "error", message: "the server did not answer: " + e };
+  }
+  if (answer.status === "superseded" || seq < state.seq) return; // a newer edit is on its way
+  clearMessages();
+  if (answer.status === "verified") {
+    state.data = data;
+    render(answer, seq);
+    // the bound (half a second, in the server's other process) once the edits rest
+    setTimeout(() => { if (seq === state.shownSeq) requestBound(data, seq); }, BOUND_REST_MS);
+  } else {
+    // keep the last good plan on screen; say what is wrong, next to the field when one is named
+    const field = answer.field || "";
+    showMessage(field, answer.message);
+    setStatus(answer.message + (field && answer.status !== "bad input" ? ` (the limit: ${field})` : ""), "failed");
+    document.body.dataset.state = answer.status;
+    document.body.dataset.rendered = String(seq);
+  }
+}
+
+async function requestBound(data, seq) {
+  const answer = await (await post("/api/bound", { label: state.label, case: data })).json();
+  if (seq !== state.shownSeq) return;
+  const spm = state.last.result.spm;
+  $("#bound-share").textContent = answer.status === "ok" ? (100 * spm / answer.spm).toFixed(1) + " %" : "no bound";
+  $("#bound-share").title = answer.status === "ok" ? `bound ${answer.spm.toFixed(3)} strokes/min` : answer.message;
+}
+
+function clearMessages() {
+  for (const el of document.querySelectorAll(".msg[data-for]")) el.textContent = "";
+  for (const el of document.querySelectorAll("#case-form .bad")) el.classList.remove("bad");
+}
+
+function showMessage(field, message) {
+  let target = document.querySelector(`.msg[data-for="${CSS.escape(field)}"]`);
+  const input = document.querySelector(`[data-field="${CSS.escape(field)}"]`);
+  if (!target) target = document.querySelector('.msg[data-for=""]');
+  target.textContent = message;
+  if (input) input.classList.add("bad");
+}
+
+function setStatus(text, kind) {
+  const el = $("#status");
+  el.textContent = text;
+  el.className = "status " + (kind || "");
+}
+
+// ---- rendering --------------------------------------------------------------------------------------
+function render(answer, seq) {
+  if (seq !== state.shownSeq) $("#bound-share").textContent = "…";
+  state.last = answer;
+  state.shownSeq = seq;
+  const r = answer.result;
+  $("#spm").textContent = r.spm.toFixed(3);
+  $("#cycle").textContent = r.cycle_time_s.toFixed(4);
+  $("#binding").textContent = r.binding_constraints.join(", ") || "none";
+  setStatus(`${r.motion_law}, ${r.placement} placement, ${r.status} on ${r.verification.samples} points`, "");
+  $("#objective-line").textContent = r.baseline
+    ? `${r.objective} at ${r.target_spm} SPM: RMS ${(r.rms_torque_Nm / 1e3).toFixed(2)} kN m, energy ${r.energy_kJ.toFixed(1)} kJ/stroke; ` +
+      `saving ${r.saving_pct.rms_torque.toFixed(1)} % RMS, ${r.saving_pct.energy.toFixed(1)} % energy against waiting`
+    : "";
+  $("#drive-line").textContent = r.drive
+    ? `motor: peak ${(r.drive.peak_motor_torque_Nm / 1e3).toFixed(2)} kN m (${r.drive.peak_torque_use_pct.toFixed(1)} % of the envelope), ` +
+      `RMS ${(r.drive.rms_motor_torque_Nm / 1e3).toFixed(2)} kN m (${r.drive.rms_torque_use_pct.toFixed(1)} % of rated), ` +
+      `peak power ${r.drive.peak_motor_power_kW.toFixed(0)} kW, ${r.drive.energy_drawn_kJ.toFixed(1)} kJ drawn per stroke`
+    : "";
+  $("#pin-line").textContent = state.pinned
+    ? `pinned ${state.pinned.result.spm.toFixed(3)} SPM: difference ${(r.spm - state.pinned.result.spm >= 0 ? "+" : "")}${(r.spm - state.pinned.result.spm).toFixed(3)} SPM`
+    : "";
+  const body = $("#key-points tbody");
+  body.innerHTML = "";
+  for (const k of r.key_points) {
+    const tr = document.createElement("tr");
+    tr.innerHTML = `<td>${k.name}</td><td>${k.angle_deg.toFixed(2)}</td><td>${k.time_s.toFixed(4)}</td><td>${k.height_mm.toFixed(1)}</td>` +
+      `<td>${k.slider_speed_mm_s.toFixed(1)} ${k.direction}</td><td>${k.crank_speed_rpm.toFixed(3)}</td>`;
+    body.appendChild(tr);
+  }
+  drawCharts();
+  window.renderedAt = performance.now(); // the edit-to-chart benchmark reads it
+  document.body.dataset.state = "ready";
+  document.body.dataset.rendered = String(seq);
+}
+
+function xOf(curves) {
+  return $("#x-axis").value === "time" ? curves.time_s : curves.crank_angle_deg;
+}
+
+function stageShapes(r, axis) {
+  const shapes = [];
+  for (const s of r.segments) {
+    const stage = s.name.split(":")[0];
+    const x0 = axis === "time" ? s.start_time_s : s.start_angle_deg;
+    const x1 = axis === "time" ? s.start_time_s + s.duration_s : s.end_angle_deg;
+    shapes.push({ type: "rect", xref: "x", yref: "paper", x0, x1, y0: 0, y1: 1, fillcolor: STAGE_COLOURS[stage] || "#eee", opacity: 0.5, line: { width: 0 }, layer: "below" });
+  }
+  for (const k of r.key_points) {
+    const x = axis === "time" ? k.time_s : k.angle_deg;
+    shapes.push({ type: "line", xref: "x", yref: "paper", x0: x, x1: x, y0: 0, y1: 1, line: { dash: "dot", width: 1, color: "#555" } });
+  }
+  return shapes;
+}
+
+function limitLine(x, value, yaxis, name) {
+  return { x: [x[0], x[x.length - 1]], y: [value, value], yaxis, mode: "lines", name, line: { dash: "dash", width: 1, color: "#c0392b" }, hoverinfo: "name+y", showlegend: false };
+}
+
+function drawCharts() {
+  const ans = state.last;
+  const r = ans.result, c = ans.curves, axis = $("#x-axis").value;
+  const x = xOf(c);
+  const lim = r.limits, proc = r.process;
+  const traces = [
+    { x, y: c.slider_height_mm, name: "slider height [mm]", yaxis: "y", line: { color: "#1f77b4" } },
+    { x, y: c.crank_speed_rpm, name: "crank speed [rpm]", yaxis: "y2", line: { color: "#ff7f0e" } },
+    { x, y: c.crank_accel_rad_s2, name: "crank acceleration [rad/s²]", yaxis: "y3", line: { color: "#2ca02c" } },
+    { x, y: c.slider_speed_mm_s, name: "slider speed [mm/s]", yaxis: "y4", line: { color: "#9467bd" } },
+    { x, y: c.slider_accel_mm_s2, name: "slider acceleration [mm/s²]", yaxis: "y5", line: { color: "#8c564b" } },
+    limitLine(x, proc.safety_height_mm, "y", "safety height"),
+    limitLine(x, lim.die_height_mm, "y", "die height"),
+    limitLine(x, lim.slider_accel_mm_s2, "y5", "slider acceleration limit"),
+    limitLine(x, -lim.slider_accel_mm_s2, "y5", "slider acceleration limit"),
+    limitLine(x, -lim.die_speed_mm_s, "y4", "die speed (below the die height)"),
+  ];
+  const keyX = r.key_points.map((k) => (axis === "time" ? k.time_s : k.angle_deg));
+  const keyIndex = keyX.map((v) => nearest(x, v));
+  traces.push({ x: keyX, y: keyIndex.map((i) => c.slider_height_mm[i]), text: r.key_points.map((k) => KEY_LABELS[k.name]), mode: "markers+text", textposition: "top center", yaxis: "y", name: "key points", marker: { color: "#000", size: 7 }, showlegend: false });
+  if (state.pinned) {
+    const p = state.pinned.curves, px = xOf(p), dash = { dash: "dash", color: "#777", width: 1 };
+    traces.push({ x: px, y: p.crank_speed_rpm, name: "pinned crank speed", yaxis: "y2", line: dash });
+    traces.push({ x: px, y: p.crank_accel_rad_s2, name: "pinned crank acceleration", yaxis: "y3", line: dash });
+    traces.push({ x: px, y: p.slider_accel_mm_s2, name: "pinned slider acceleration", yaxis: "y5", line: dash });
+  }
+  const layout = {
+    margin: { l: 60, r: 60, t: 10, b: 40 },
+    hovermode: "x unified",
+    legend: { orientation: "h", y: -0.1, yanchor: "top" },
+    xaxis: { title: { text: axis === "time" ? "time from TDC [s]" : "crank angle from TDC [deg]" }, anchor: "y5" },
+    yaxis: { domain: [0.70, 1.0], title: { text: "height [mm]" } },
+    yaxis2: { overlaying: "y", side: "right", title: { text: "crank [rpm]" } },
+    yaxis3: { domain: [0.37, 0.63], title: { text: "crank accel [rad/s²]" } },
+    yaxis4: { domain: [0.0, 0.30], title: { text: "slider [mm/s]" } },
+    yaxis5: { overlaying: "y4", side: "right", title: { text: "slider [mm/s²]" } },
+    shapes: stageShapes(r, axis),
+  };
+  Plotly.react("motion-chart", traces, layout, { responsive: true, displaylogo: false });
+  drawDrive(r, c, x, axis);
+}
+
+function nearest(xs, v) {
+  let best = 0;
+  for (let i = 1; i < xs.length; i++) if (Math.abs(xs[i] - v) < Math.abs(xs[best] - v)) best = i;
+  return best;
+}
+
+function drawDrive(r, c, x, axis) {
+  const el = $("#drive-chart");
+  if (!r.drive || !c.motor_torque_Nm) { Plotly.purge(el); el.style.display = "none"; return; }
+  el.style.display = "block";
+  const m = r.drive.motor;
+  const torque = c.motor_torque_Nm.map((v) => v / 1e3);
+  const speeds = [0, m.base_speed_rpm];
+  for (let k = 1; k <= 20; k++) speeds.push(m.base_speed_rpm + (k / 20) * (m.max_speed_rpm - m.base_speed_rpm));
+  const envelope = speeds.map((n) => (m.peak_torque_Nm / 1e3) * Math.min(1, m.base_speed_rpm / Math.max(n, 1e-9)));
+  const traces = [
+    { x, y: torque, name: "motor torque [kN m]", line: { color: "#d62728" } },
+    { x, y: c.motor_power_kW, name: "motor power [kW]", yaxis: "y2", line: { color: "#17becf" } },
+    { x: c.motor_speed_rpm, y: torque, xaxis: "x2", yaxis: "y3", mode: "lines", name: "cycle in the torque–speed plane", line: { color: "#d62728" } },
+    { x: speeds, y: envelope, xaxis: "x2", yaxis: "y3", name: "peak envelope", line: { dash: "dash", color: "#c0392b" } },
+    { x: speeds, y: envelope.map((v) => -v), xaxis: "x2", yaxis: "y3", showlegend: false, line: { dash: "dash", color: "#c0392b" } },
+    { x: [0, m.max_speed_rpm], y: [m.rated_torque_Nm / 1e3, m.rated_torque_Nm / 1e3], xaxis: "x2", yaxis: "y3", name: "rated torque", line: { dash: "dot", color: "#1f77b4" } },
+  ];
+  const layout = {
+    margin: { l: 60, r: 60, t: 10, b: 40 },
+    hovermode: "closest",
+    legend: { orientation: "h", y: -0.2, yanchor: "top" },
+    xaxis: { domain: [0, 0.55], title: { text: axis === "time" ? "time from TDC [s]" : "crank angle [deg]" } },
+    yaxis: { title: { text: "torque [kN m]" } },
+    yaxis2: { overlaying: "y", side: "right", title: { text: "power [kW]" }, anchor: "x" },
+    xaxis2: { domain: [0.68, 1], title: { text: "motor speed [rpm]" }, anchor: "y3" },
+    yaxis3: { anchor: "x2", title: { text: "torque [kN m]" } },
+    shapes: stageShapes(r, axis).map((s) => ({ ...s, xref: "x" })),
+  };
+  Plotly.react(el, traces, layout, { responsive: true, displaylogo: false });
+}
+
+// ---- cases, uploads, downloads ----------------------------------------------------------------------
+async function loadCase(name) {
+  const answer = await (await fetch("/api/case/" + encodeURIComponent(name))).json();
+  showLoaded(answer);
+}
+
+function showLoaded(answer) {
+  $("#load-message").textContent = answer.status === "ok" ? "" : answer.message;
+  if (answer.status !== "ok") return;
+  state.label = answer.label;
+  state.data = answer.case;
+  $("#case-label").textContent = answer.label;
+  buildForm(answer.case);
+  solveNow();
+}
+
+async function upload(file) {
+  const body = new FormData();
+  body.append("file", file);
+  const answer = await (await fetch("/api/upload", { method: "POST", body })).json();
+  showLoaded(answer);
+}
+
+async function download(name) {
+  const data = caseFromForm();
+  const response = await post("/api/download/" + name, { label: state.label, case: data });
+  if (!response.ok) {
+    const answer = await response.json();
+    clearMessages();
+    showMessage(answer.field || "", answer.message);
+    return;
+  }
+  const blob = await response.blob();
+  const a = document.createElement("a");
+  a.href = URL.createObjectURL(blob);
+  a.download = name === "case.yaml" ? `${data.name || "case"}.yaml` : name;
+  document.body.appendChild(a);
+  a.click();
+  setTimeout(() => { URL.revokeObjectURL(a.href); a.remove(); }, 1000);
+}
+
+async function start() {
+  state.meta = await (await fetch("/api/meta")).json();
+  const select = $("#case-select");
+  for (const name of state.meta.cases) select.add(new Option(name, name));
+  select.addEventListener("change", () => loadCase(select.value));
+  $("#upload").addEventListener("change", (e) => { if (e.target.files.length) upload(e.target.files[0]); });
+  $("#x-axis").addEventListener("change", () => { if (state.last) drawCharts(); });
+  $("#pin").addEventListener("click", () => { if (state.last) { state.pinned = state.last; render(state.last, state.shownSeq); } });
+  $("#unpin").addEventListener("click", () => { state.pinned = null; if (state.last) render(state.last, state.shownSeq); });
+  $("#download-case").addEventListener("click", () => download("case.yaml"));
+  for (const b of document.querySelectorAll("[data-download]")) b.addEventListener("click", () => download(b.dataset.download));
+  if (state.meta.initial) { select.value = state.meta.initial; loadCase(state.meta.initial); }
+  else setStatus("no case: upload one", "failed");
+}
+
+start();

@@ -1,0 +1,224 @@
+"""``pressplan serve`` in a real browser: Chromium headless through Playwright (see tests/web_page.py).
+
+Every number the page shows is compared with what the CLI gives for the same case, and the downloaded
+files with what ``pressplan solve`` writes."""
+
+from __future__ import annotations
+
+import copy
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+from planning.model.case_file import case_from_data, load_yaml
+from planning.reports.report import result_dict
+from planning.solver.bound import time_optimal_bound
+from planning.solver.optimize import solve
+
+from .web_page import ARTIFACTS, CASES, chromium, edit, missing_browser, running_server, wait_rendered
+
+PUBLISHED = CASES / "wang2023-side-panel.yaml"
+LABEL = "cases/wang2023-side-panel.yaml"
+
+why = missing_browser()
+if why is not None and os.environ.get("CI") == "true":
+    raise RuntimeError(f"the browser tests must run in CI: {why}")
+pytestmark = pytest.mark.skipif(why is not None, reason=why or "")
+
+
+@pytest.fixture(scope="module")
+def site():
+    with running_server(PUBLISHED) as url, chromium() as browser:
+        yield url, browser
+
+
+@pytest.fixture
+def page(site):
+    url, browser = site
+    context = browser.new_context(viewport={"width": 1400, "height": 1000}, accept_downloads=True)
+    tab = context.new_page()
+    tab.goto(url)
+    wait_rendered(tab)
+    yield tab
+    context.close()
+
+
+def published_data() -> dict:
+    return load_yaml(PUBLISHED.read_text(encoding="utf-8"))
+
+
+def cli_numbers(data: dict) -> dict:
+    """What the CLI's solve gives for ``data``: the numbers the page shows, formatted as it shows them."""
+    case = case_from_data(data, LABEL)
+    result = result_dict(solve(case), case)
+    return {
+        "spm": f"{result['spm']:.3f}",
+        "cycle": f"{result['cycle_time_s']:.4f}",
+        "binding": ", ".join(result["binding_constraints"]) or "none",
+        "key_points": [
+            [k["name"], f"{k['angle_deg']:.2f}", f"{k['time_s']:.4f}", f"{k['height_mm']:.1f}"]
+            for k in result["key_points"]
+        ],
+    }
+
+
+def shown_numbers(tab) -> dict:  # noqa: ANN001 - a Playwright page
+    rows = tab.locator("#key-points tbody tr").all()
+    return {
+        "spm": tab.locator("#spm").inner_text(),
+        "cycle": tab.locator("#cycle").inner_text(),
+        "binding": tab.locator("#binding").inner_text(),
+        "key_points": [[c.inner_text() for c in row.locator("td").all()[:4]] for row in rows],
+    }
+
+
+def screenshot(tab, name: str) -> None:  # noqa: ANN001
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    tab.screenshot(path=str(ARTIFACTS / f"{name}.png"), full_page=True)
+
+
+def test_page_shows_what_the_cli_gives_and_follows_an_edit(page) -> None:
+    assert page.locator("#case-label").inner_text() == LABEL
+    assert shown_numbers(page) == cli_numbers(published_data())
+    # the share of the bound follows once the edits rest, as `pressplan bound` computes it
+    page.wait_for_function("document.querySelector('#bound-share').textContent.endsWith('%')", timeout=60_000)
+    case = case_from_data(published_data(), LABEL)
+    share = 100 * solve(case).plan.spm / time_optimal_bound(case).spm
+    assert page.locator("#bound-share").inner_text() == f"{share:.1f} %"
+    screenshot(page, "web-published")
+    edit(page, "key_points.draw_start_deg", "133")
+    data = published_data()
+    data["key_points"]["draw_start_deg"] = 133.0
+    assert shown_numbers(page) == cli_numbers(data)
+    assert page.locator("#status").get_attribute("class") == "status "
+    # pin, edit again: the page overlays the pinned plan and states the difference
+    page.locator("#pin").click()
+    edit(page, "process.transfer_time_s", "2.5")
+    data["process"]["transfer_time_s"] = 2.5
+    shown = shown_numbers(page)
+    assert shown == cli_numbers(data)
+    assert "pinned" in page.locator("#pin-line").inner_text()
+    page.locator("#x-axis").select_option("time")
+    page.wait_for_function("document.querySelector('#bound-share').textContent.endsWith('%')", timeout=60_000)
+    screenshot(page, "web-pinned-time")
+
+
+def test_a_bad_value_shows_the_cli_line_next_to_the_field(page, tmp_path: Path) -> None:
+    good = page.locator("#spm").inner_text()
+    edit(page, "limits.slider_accel_mm_s2", "-5")
+    message = page.locator('.msg[data-for="limits.slider_accel_mm_s2"]').inner_text()
+    # the CLI on the same edit: the same line after the file's name
+    data = published_data()
+    data["limits"]["slider_accel_mm_s2"] = -5  # as typed
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.safe_dump(data), encoding="utf-8")
+    cli = subprocess.run(
+        [sys.executable, "-m", "planning.cli", "solve", str(bad), "--out", str(tmp_path / "o")],
+        capture_output=True,
+        text=True,
+    )
+    assert cli.returncode == 2
+    assert message == LABEL + cli.stderr.strip().removeprefix(f"pressplan: {bad}")
+    assert page.locator("#spm").inner_text() == good  # the last good plan stays on screen
+    assert "bad" in (page.locator('[data-field="limits.slider_accel_mm_s2"]').get_attribute("class") or "")
+    screenshot(page, "web-bad-value")
+    edit(page, "limits.slider_accel_mm_s2", "abc")
+    assert (
+        "limits.slider_accel_mm_s2: input should be a valid number"
+        in page.locator('.msg[data-for="limits.slider_accel_mm_s2"]').inner_text()
+    )
+
+
+def test_an_infeasible_case_shows_the_limit(page) -> None:
+    edit(page, "process.transfer_time_s", "60")
+    status = page.locator("#status").inner_text()
+    assert status.startswith(f"{LABEL}: infeasible: transfer_time_s = 60 cannot be met")
+    assert status.endswith("(the limit: process.transfer_time_s)")
+    assert "cannot be met" in page.locator('.msg[data-for="process.transfer_time_s"]').inner_text()
+
+
+def test_downloads_equal_the_files_of_solve(page, tmp_path: Path) -> None:
+    edit(page, "key_points.draw_end_deg", "200")
+    data = published_data()
+    data["key_points"]["draw_end_deg"] = 200.0
+    case_file = tmp_path / "edited.yaml"
+    case_file.write_text(yaml.safe_dump(data), encoding="utf-8")
+    out = tmp_path / "solve"
+    cli = subprocess.run(
+        [sys.executable, "-m", "planning.cli", "solve", str(case_file), "--no-plots", "--out", str(out)]
+    )
+    assert cli.returncode == 0
+    got = {}
+    for name in ("cam_table.csv", "trajectory.csv", "result.json", "case.yaml"):
+        button = page.locator("#download-case") if name == "case.yaml" else page.locator(f'[data-download="{name}"]')
+        with page.expect_download(timeout=60_000) as info:
+            button.click()
+        path = tmp_path / f"page-{name}"
+        info.value.save_as(path)
+        got[name] = path.read_bytes()
+    assert got["cam_table.csv"] == (out / "cam_table.csv").read_bytes()
+    assert got["trajectory.csv"] == (out / "trajectory.csv").read_bytes()
+    page_result, cli_result = json.loads(got["result.json"]), json.loads((out / "result.json").read_text())
+    for r in (page_result, cli_result):
+        r["solver"]["wall_time_s"] = None  # a measurement, not a result
+    assert page_result == cli_result
+    assert yaml.safe_load(got["case.yaml"])["key_points"]["draw_end_deg"] == 200.0
+
+
+def test_two_pages_stay_separate(site) -> None:
+    url, browser = site
+    tabs = []
+    for _ in range(2):
+        context = browser.new_context(viewport={"width": 1200, "height": 900})
+        tab = context.new_page()
+        tab.goto(url)
+        wait_rendered(tab)
+        tabs.append(tab)
+    a, b = tabs
+    # edits in both before either answer is read: each page keeps its own case and plan
+    a.locator('[data-field="key_points.draw_start_deg"]').fill("134")
+    b.locator('[data-field="process.transfer_time_s"]').fill("3")
+    before_a, before_b = (int(t.evaluate("document.body.dataset.rendered")) for t in tabs)
+    a.locator('[data-field="key_points.draw_start_deg"]').dispatch_event("change")
+    b.locator('[data-field="process.transfer_time_s"]').dispatch_event("change")
+    wait_rendered(a, before_a)
+    wait_rendered(b, before_b)
+    data_a, data_b = published_data(), published_data()
+    data_a["key_points"]["draw_start_deg"] = 134.0
+    data_b["process"]["transfer_time_s"] = 3.0
+    assert shown_numbers(a) == cli_numbers(data_a)
+    assert shown_numbers(b) == cli_numbers(data_b)
+    assert shown_numbers(a)["spm"] != shown_numbers(b)["spm"]
+    for tab in tabs:
+        tab.context.close()
+
+
+def test_a_drive_case_shows_its_motor(site) -> None:
+    url, browser = site
+    context = browser.new_context(viewport={"width": 1400, "height": 1200})
+    tab = context.new_page()
+    tab.goto(url)
+    wait_rendered(tab)
+    before = int(tab.evaluate("document.body.dataset.rendered"))
+    tab.locator("#case-select").select_option("cup-2000kN-drive.yaml")
+    wait_rendered(tab, before)
+    data = load_yaml((CASES / "cup-2000kN-drive.yaml").read_text(encoding="utf-8"))
+    expected = cli_numbers(copy.deepcopy(data))
+    assert tab.locator("#spm").inner_text() == expected["spm"]
+    assert "% of rated" in tab.locator("#drive-line").inner_text()
+    assert tab.locator("#drive-chart .main-svg").count() > 0
+    # the objective at the line's rate, chosen in the form: without a rate the field says so
+    before = int(tab.evaluate("document.body.dataset.rendered"))
+    tab.locator('[data-field="planner.objective"]').select_option("min-energy")
+    wait_rendered(tab, before)
+    assert "needs the line's rate" in tab.locator('.msg[data-for="planner.target_spm"]').inner_text()
+    edit(tab, "planner.target_spm", "30")
+    assert tab.locator("#spm").inner_text() == "30.000"
+    assert tab.locator("#objective-line").inner_text().startswith("min-energy at 30 SPM")
+    screenshot(tab, "web-drive")
+    context.close()

@@ -1,0 +1,86 @@
+"""Helpers of the browser tests and the web benchmark: the server in a thread, Chromium through Playwright.
+
+Playwright's own browser download does not work on these machines: the tests launch Debian's
+``chromium`` through ``executable_path``. Without it (or without Playwright) the browser tests skip
+with the reason, except under CI (``CI=true``), where a missing browser fails them.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+CASES = ROOT / "cases"
+ARTIFACTS = ROOT / "tests" / "artifacts"  # screenshots of the browser tests (not in git)
+RENDER_TIMEOUT_MS = 60_000
+
+
+def chromium_path() -> str | None:
+    """Debian's chromium (or ``PRESSPLAN_CHROMIUM``), None when there is none."""
+    return os.environ.get("PRESSPLAN_CHROMIUM") or shutil.which("chromium") or shutil.which("chromium-browser")
+
+
+def missing_browser() -> str | None:
+    """Why the browser tests cannot run here, None when they can."""
+    try:
+        import flask  # noqa: F401
+        import playwright  # noqa: F401
+        import plotly  # noqa: F401
+    except ImportError as exc:
+        return f"the web extra or Playwright is not installed ({exc.name})"
+    if chromium_path() is None:
+        return "no chromium (apt-get install -y chromium)"
+    return None
+
+
+@contextmanager
+def running_server(initial: Path | None = None) -> Iterator[str]:
+    """The app on a free port of 127.0.0.1 in a thread; yields its address."""
+    from werkzeug.serving import make_server
+
+    from planning.web.server import create_app
+
+    server = make_server("127.0.0.1", 0, create_app(CASES, initial), threaded=True)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    try:
+        yield f"http://127.0.0.1:{server.server_port}/"
+    finally:
+        server.shutdown()
+        thread.join(timeout=10)
+
+
+@contextmanager
+def chromium() -> Iterator[object]:
+    """A headless Chromium browser (Playwright)."""
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=chromium_path(), headless=True, args=["--no-sandbox"])
+        try:
+            yield browser
+        finally:
+            browser.close()
+
+
+def wait_rendered(page, after: int = 0) -> int:  # noqa: ANN001 - a Playwright page
+    """Wait until the page has answered an edit after number ``after``; returns the answer's number."""
+    page.wait_for_function(
+        f"Number(document.body.dataset.rendered) > {after} && document.body.dataset.state !== 'solving'",
+        timeout=RENDER_TIMEOUT_MS,
+    )
+    return int(page.evaluate("document.body.dataset.rendered"))
+
+
+def edit(page, field: str, value: str) -> int:  # noqa: ANN001 - a Playwright page
+    """Type ``value`` into the form's ``field`` and leave it (a change); returns the number of the answer."""
+    before = int(page.evaluate("document.body.dataset.rendered"))
+    box = page.locator(f'[data-field="{field}"]')
+    box.fill(value)
+    box.dispatch_event("change")
+    return wait_rendered(page, before)
