@@ -94,7 +94,9 @@ def _parser() -> argparse.ArgumentParser:
     sv.add_argument("case", nargs="?", help="case file (YAML) to open first (default: the first in cases/)")
     sv.add_argument("--port", type=_whole(1, 65535), default=8050, help="port (default 8050)")
     sv.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1: this machine only)")
-    sv.add_argument("--cases", default="cases", help="folder whose *.yaml the page offers (default cases)")
+    sv.add_argument(
+        "--cases", default="cases", help="folder whose *.yaml the page offers (default: cases, else the project's)"
+    )
     pl = sub.add_parser("plot", help="redraw the figures of a finished output folder (no solve)")
     pl.add_argument("folder", help="output folder of `pressplan solve`")
     pl.add_argument("--format", choices=PLOT_FORMATS, default="png", help="figure format (default png)")
@@ -401,6 +403,8 @@ def _serve(args) -> int:
         read_case(args.case)  # a bad case file is the usual one line, exit 2
         case_path = Path(args.case).resolve()
     cases = Path(args.cases)
+    if not cases.is_dir() and args.cases == "cases":  # not run from the project root: the project's own cases
+        cases = Path(__file__).resolve().parents[1] / "cases"
     serve(case_path, args.host, args.port, cases if cases.is_dir() else None)
     return EXIT_OK
 

@@ -1,9 +1,10 @@
 """The motor-sizing curve: at each line rate the gentlest verified plan beside the baseline it beats.
 
-The fastest plan (max-SPM) is solved once, in this process; then the rates are cut into contiguous
-blocks, one per worker, and each block is solved from its highest rate down, every rate starting from
-the plan and baseline of the rate before (``planning.solver.objectives.solve_at_rate``). The blocks run
-on local worker processes or a Dask cluster through the sweep's machinery (``planning.sweep.execute``).
+The fastest plan (max-SPM) is solved once, in this process, and the rate NLP is built before the
+workers fork; then the rates are cut into contiguous blocks, one per worker, and each block is solved
+from its highest rate down, every rate starting from the plan and baseline of the rate before
+(``planning.solver.objectives.solve_at_rate``). The blocks run on local worker processes or a Dask
+cluster through the sweep's machinery (``planning.sweep.execute``).
 A rate above what the limits allow becomes a row that says why.
 """
 
@@ -162,12 +163,14 @@ def run_tradeoff(
     placement: Placement | None = None,
 ) -> TradeoffResult:
     """One plan per rate at ``case.planner.objective`` (min-rms-torque or min-energy)."""
+    from planning.solver.nlp import cycle_nlp
     from planning.solver.optimize import solve
 
     fastest = solve(case.with_objective("max-spm"), placement)
+    cycle_nlp(case.planner.motion_law, drive=True, rate=True)  # built once here, inherited by forked workers
     values = rates.values(fastest.plan.spm)
     order = list(enumerate(values.tolist()))[::-1]  # from the fastest rate down: each starts from the faster one
-    size = max(1, math.ceil(len(order) / max(1, workers)))
+    size = max(1, math.ceil(len(order) / max(1, workers)))  # one contiguous block per worker
     work = [(case, placement, fastest, order[k : k + size]) for k in range(0, len(order), size)]
     rows: dict[int, dict[str, Any]] = {}
     for block in execute(rate_block, work, workers, scheduler):

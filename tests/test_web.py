@@ -6,6 +6,7 @@ files with what ``pressplan solve`` writes."""
 from __future__ import annotations
 
 import copy
+import io
 import json
 import os
 import subprocess
@@ -28,7 +29,7 @@ LABEL = "cases/wang2023-side-panel.yaml"
 why = missing_browser()
 if why is not None and os.environ.get("CI") == "true":
     raise RuntimeError(f"the browser tests must run in CI: {why}")
-pytestmark = pytest.mark.skipif(why is not None, reason=why or "")
+browser = pytest.mark.skipif(why is not None, reason=why or "")
 
 
 @pytest.fixture(scope="module")
@@ -82,6 +83,7 @@ def screenshot(tab, name: str) -> None:  # noqa: ANN001
     tab.screenshot(path=str(ARTIFACTS / f"{name}.png"), full_page=True)
 
 
+@browser
 def test_page_shows_what_the_cli_gives_and_follows_an_edit(page) -> None:
     assert page.locator("#case-label").inner_text() == LABEL
     assert shown_numbers(page) == cli_numbers(published_data())
@@ -108,6 +110,7 @@ def test_page_shows_what_the_cli_gives_and_follows_an_edit(page) -> None:
     screenshot(page, "web-pinned-time")
 
 
+@browser
 def test_a_bad_value_shows_the_cli_line_next_to_the_field(page, tmp_path: Path) -> None:
     good = page.locator("#spm").inner_text()
     edit(page, "limits.slider_accel_mm_s2", "-5")
@@ -134,6 +137,7 @@ def test_a_bad_value_shows_the_cli_line_next_to_the_field(page, tmp_path: Path) 
     )
 
 
+@browser
 def test_an_infeasible_case_shows_the_limit(page) -> None:
     edit(page, "process.transfer_time_s", "60")
     status = page.locator("#status").inner_text()
@@ -142,6 +146,7 @@ def test_an_infeasible_case_shows_the_limit(page) -> None:
     assert "cannot be met" in page.locator('.msg[data-for="process.transfer_time_s"]').inner_text()
 
 
+@browser
 def test_downloads_equal_the_files_of_solve(page, tmp_path: Path) -> None:
     edit(page, "key_points.draw_end_deg", "200")
     data = published_data()
@@ -170,6 +175,7 @@ def test_downloads_equal_the_files_of_solve(page, tmp_path: Path) -> None:
     assert yaml.safe_load(got["case.yaml"])["key_points"]["draw_end_deg"] == 200.0
 
 
+@browser
 def test_two_pages_stay_separate(site) -> None:
     url, browser = site
     tabs = []
@@ -198,6 +204,7 @@ def test_two_pages_stay_separate(site) -> None:
         tab.context.close()
 
 
+@browser
 def test_a_drive_case_shows_its_motor(site) -> None:
     url, browser = site
     context = browser.new_context(viewport={"width": 1400, "height": 1200})
@@ -222,3 +229,34 @@ def test_a_drive_case_shows_its_motor(site) -> None:
     assert tab.locator("#objective-line").inner_text().startswith("min-energy at 30 SPM")
     screenshot(tab, "web-drive")
     context.close()
+
+
+# ---- the server without a browser (Flask's test client) ------------------------------------------------
+
+
+def test_uploads_and_requests_are_checked() -> None:
+    pytest.importorskip("flask")
+    from planning.web.server import MAX_REQUEST_BYTES, create_app
+
+    client = create_app(CASES).test_client()
+    big = b"name: x\n" + b"#" * 300_000
+    answer = client.post("/api/upload", data={"file": (io.BytesIO(big), "big.yaml")})
+    assert answer.status_code in (400, 413)
+    ok = client.post("/api/upload", data={"file": (io.BytesIO(PUBLISHED.read_bytes()), "mine.yaml")})
+    assert ok.get_json()["status"] == "ok" and ok.get_json()["label"] == "mine.yaml"
+    bad = client.post("/api/upload", data={"file": (io.BytesIO(b"a: [1,\n"), "broken.yaml")})
+    assert bad.status_code == 400 and bad.get_json()["message"].startswith("broken.yaml: YAML syntax error")
+    assert client.get("/api/case/..%2Fpyproject.toml").status_code == 404  # names are looked up, never paths
+    assert client.get("/static/../pyproject.toml").status_code == 404
+    too_much = client.post("/api/solve", data=b"{" + b" " * MAX_REQUEST_BYTES + b"}", content_type="application/json")
+    assert too_much.status_code == 413
+
+
+def test_serve_without_the_web_extra_says_what_to_install(monkeypatch, capsys) -> None:
+    from planning.cli import main
+
+    monkeypatch.setitem(sys.modules, "flask", None)  # import flask now fails
+    monkeypatch.delitem(sys.modules, "planning.web.server", raising=False)
+    assert main(["serve"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == "pressplan: serve needs the web extra: pip install -e '.[web]' (flask is missing)"
