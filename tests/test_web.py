@@ -62,9 +62,18 @@ def cli_numbers(data: dict) -> dict:
         "cycle": f"{result['cycle_time_s']:.4f}",
         "binding": ", ".join(result["binding_constraints"]) or "none",
         "key_points": [
-            [k["name"], f"{k['angle_deg']:.2f}", f"{k['time_s']:.4f}", f"{k['height_mm']:.1f}"]
+            [
+                k["name"],
+                f"{k['angle_deg']:.2f}",
+                f"{k['time_s']:.4f}",
+                f"{k['height_mm']:.1f}",
+                f"{k['slider_speed_mm_s']:.1f} {k['direction']}",
+                f"{k['crank_speed_rpm']:.3f}",
+            ]
             for k in result["key_points"]
         ],
+        "status": f"{result['motion_law']}, {result['placement']} placement, verified: every limit holds on the "
+        f"dense {result['verification']['step_s'] * 1e3:.3f} ms grid",
     }
 
 
@@ -74,7 +83,8 @@ def shown_numbers(tab) -> dict:  # noqa: ANN001 - a Playwright page
         "spm": tab.locator("#spm").inner_text(),
         "cycle": tab.locator("#cycle").inner_text(),
         "binding": tab.locator("#binding").inner_text(),
-        "key_points": [[c.inner_text() for c in row.locator("td").all()[:4]] for row in rows],
+        "key_points": [[c.inner_text() for c in row.locator("td").all()] for row in rows],
+        "status": tab.locator("#status").inner_text(),
     }
 
 
@@ -260,3 +270,40 @@ def test_serve_without_the_web_extra_says_what_to_install(monkeypatch, capsys) -
     assert main(["serve"]) == 2
     err = capsys.readouterr().err.strip()
     assert err == "pressplan: serve needs the web extra: pip install -e '.[web]' (flask is missing)"
+
+
+def test_a_newer_edit_supersedes_a_waiting_one() -> None:
+    """While a tab's solve runs, a second request waits; a third, newer one makes the second return at once
+    as superseded, so work never queues up behind a user's typing."""
+    pytest.importorskip("flask")
+    import threading
+
+    from planning.web.server import create_app
+
+    app = create_app(CASES)
+    client = app.test_client()
+    data = published_data()
+    session = app.extensions["pressplan_sessions"].get("tab-1")
+    answers: dict[int, dict] = {}
+
+    def send(seq: int) -> None:
+        body = {"session": "tab-1", "seq": seq, "label": LABEL, "case": data}
+        answers[seq] = client.post("/api/solve", json=body).get_json()
+
+    with session.lock:  # a solve of this tab is running
+        first = threading.Thread(target=send, args=(1,))
+        first.start()
+        while session.newest < 1:
+            pass
+        second = threading.Thread(target=send, args=(2,))
+        second.start()
+        while session.newest < 2:
+            pass
+    first.join(60)
+    second.join(60)
+    assert answers[1]["status"] == "superseded"
+    assert answers[2]["status"] == "verified" and answers[2]["seq"] == 2
+    other = create_app(CASES).test_client()  # another tab's plan is its own
+    assert (
+        other.post("/api/solve", json={"session": "tab-2", "seq": 1, "case": data}).get_json()["status"] == "verified"
+    )

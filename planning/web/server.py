@@ -83,6 +83,7 @@ def create_app(cases_dir: Path | None = None, initial: Path | None = None) -> Fl
     app.config["MAX_CONTENT_LENGTH"] = MAX_REQUEST_BYTES
     bound_pool = _BoundPool()
     sessions = Sessions()
+    app.extensions["pressplan_sessions"] = sessions  # the tests hold a session's lock to see superseding
     bounds: OrderedDict[str, dict] = OrderedDict()
     bounds_lock = threading.Lock()
     offered = case_files(cases_dir)
