@@ -139,6 +139,7 @@ class CommandError(Exception):
 
 def _exit_code(exc: Exception, case_path: str | None) -> tuple[str, int] | None:
     """The one place where outcomes become exit statuses: ``(message, code)`` for a known error."""
+    from planning.model.case import CaseError
     from planning.model.case_file import CaseFileError
     from planning.reports.folder import OutputError
     from planning.solver.outcomes import PlanningError
@@ -148,6 +149,8 @@ def _exit_code(exc: Exception, case_path: str | None) -> tuple[str, int] | None:
         return str(exc), exc.code
     if isinstance(exc, (CaseFileError, OutputError, SweepError)):
         return str(exc), EXIT_INPUT
+    if isinstance(exc, CaseError):  # a case changed by an option (--law) that no longer holds together
+        return exc.line(case_path), EXIT_INPUT
     if isinstance(exc, PlanningError):  # no feasible or no verified plan
         return f"{case_path}: {exc}", EXIT_INFEASIBLE
     if isinstance(exc, OSError):  # a file or folder the command needs cannot be used

@@ -14,7 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from planning.model.case_file import read_case
-from planning.model.laws import LAWS
+from planning.model.laws import LAWS, SHAPED_LAWS
 from planning.model.laws.shapes import Cycloidal, Logistic, Quintic
 from planning.model.profile import Profile, split_segment
 from planning.solver.optimize import solve
@@ -76,7 +76,7 @@ def half_profile(law: str, v0: float, dv: float, D: float, param: float | None) 
 
 LAW_PARAMS = [
     (law, p)
-    for law in LAWS
+    for law in SHAPED_LAWS
     for p in ([0.2, 0.6, 1.0] if law == "seven-segment" else [4.0, 6.0] if law == "logistic" else [None])
 ]
 
@@ -100,7 +100,7 @@ def test_one_half_of_every_law(law, param):
     assert np.max(np.abs(je)) == pytest.approx(jerk, rel=1e-3)  # the grid may miss the exact peak
 
 
-@pytest.mark.parametrize("law", list(LAWS))
+@pytest.mark.parametrize("law", list(SHAPED_LAWS))
 def test_stated_continuity(law):
     """A jerk-continuous law starts and ends its halves at zero jerk (it joins constant speed and the
     opposite half smoothly); an acceleration-continuous one has a jerk step somewhere."""
@@ -135,11 +135,11 @@ def test_splitting_a_half_keeps_its_motion(law, cut):
         assert np.max(np.abs(a - b)) < 1e-11
 
 
-@pytest.mark.parametrize("law", [law for law in LAWS if law != "improved-s-curve"])
+@pytest.mark.parametrize("law", [law for law in SHAPED_LAWS if law != "improved-s-curve"])
 @pytest.mark.parametrize("path", CASES, ids=lambda p: p.stem)
 def test_every_law_solves_every_case(path, law):
-    """Every law gives a verified plan on every case under both placements, free never worse (the
-    improved S-curve: tests/test_cases.py)."""
+    """Every law with halves gives a verified plan on every case under both placements, free never worse
+    (the improved S-curve: tests/test_cases.py; the optimal law: tests/test_optimal.py)."""
     case = read_case(path).with_law(law)
     published = solve(case, "published")
     sol = solve(case, "free")

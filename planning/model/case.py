@@ -256,11 +256,14 @@ class Case(_Model):
         return case
 
     def with_law(self, law: str) -> Case:
-        """The same case under motion law ``law``; a fixed ``law_parameter`` is kept for the same law only."""
+        """The same case under motion law ``law``; a fixed ``law_parameter`` is kept for the same law only.
+        :class:`CaseError` when the case lacks what the law needs (the optimal law: a crank-jerk limit)."""
         if law == self.planner.motion_law:
             return self
         planner = self.planner.model_copy(update={"motion_law": law, "law_parameter": None})
-        return self.model_copy(update={"planner": planner})
+        case = self.model_copy(update={"planner": planner})
+        _law_checks(case)
+        return case
 
 
 KEY_POINT_NAMES = ("closing", "draw_start", "draw_end", "opening")
@@ -344,6 +347,7 @@ def cross_checks(case: Case) -> None:
             )
     _drive_checks(case)
     _objective_checks(case)
+    _law_checks(case)
     top = case.limits.crank_speed_rpm
     if top is not None and top <= case.limits.min_crank_speed_rpm:
         raise CaseError(
@@ -416,6 +420,17 @@ def _drive_checks(case: Case) -> None:
             "drive.motor.max_speed_rpm",
             f"must be above the minimum crank speed through the gear ({w_min_motor:g} rpm)",
             d.motor.max_speed_rpm,
+        )
+
+
+def _law_checks(case: Case) -> None:
+    """The optimal law plans under a jerk limit: the case must give one."""
+    if LAWS[case.planner.motion_law].free_profile and case.limits.crank_jerk_rad_s3 is None:
+        raise CaseError(
+            "limits.crank_jerk_rad_s3",
+            f"the {case.planner.motion_law} law needs a crank-jerk limit (the jerk it may use)",
+            None,
+            False,
         )
 
 

@@ -115,9 +115,14 @@ def profile_from_tdc(params: CycleParameters) -> Profile:
     The NLP lays the cycle out from theta3; here it is rotated so that time 0 is the TDC crossing,
     splitting the segment that holds it. Segments of zero length are dropped.
     """
-    segs = [_numeric(s) for s in cycle_segments(params)]
-    th3 = float(params.draw_end)
-    w2 = float(params.draw_speed)
+    return rotate_to_tdc(
+        [_numeric(s) for s in cycle_segments(params)], float(params.draw_end), float(params.draw_speed)
+    )
+
+
+def rotate_to_tdc(segs: list, th3: float, w2: float) -> Profile:
+    """The cycle of numeric segments ``segs`` laid out from theta3 [rad] at speed ``w2`` [rad/s] (zero
+    acceleration) as a profile from TDC over one period; the segment holding TDC is split."""
     states = knot_states(th3, w2, 0.0, segs)
     two_pi = 2 * math.pi
     k = next(i for i in range(len(segs)) if states[i + 1][0] >= two_pi)

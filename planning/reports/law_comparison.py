@@ -93,14 +93,20 @@ def compare_laws(case: Case, laws: tuple[str, ...] = tuple(LAWS)) -> tuple[dict[
         bound, bound_failure = None, str(exc)
     rows, tables = [], {}
     for law in laws:
-        variant = case.with_law(law)
+        note = {}
+        if LAWS[law].free_profile:  # the optimal law plans under a jerk limit: the case's, or the S-curve's own
+            variant, note = _jerk_limited(case, law, rows)
+        else:
+            variant = case.with_law(law)
         try:
+            if variant is None:
+                raise PlanningError(note.pop("reason"))
             sol = solve(variant)
         except PlanningError as exc:
-            rows.append({"law": law, "status": f"failed: {exc}", "continuity": LAWS[law].continuity})
+            rows.append({"law": law, "status": f"failed: {exc}", "continuity": LAWS[law].continuity, **note})
             continue
         tables[law] = sample_profile(sol.plan.profile, variant.machine)
-        rows.append(law_row(law, sol, variant, bound, tables[law]))
+        rows.append({**law_row(law, sol, variant, bound, tables[law]), **note})
     return {
         "case": case.name,
         "placement": case.planner.placement,
@@ -110,6 +116,25 @@ def compare_laws(case: Case, laws: tuple[str, ...] = tuple(LAWS)) -> tuple[dict[
         **({"drive": True} if case.drive is not None else {}),
         "laws": rows,
     }, tables
+
+
+def _jerk_limited(case: Case, law: str, rows: list[dict[str, Any]]) -> tuple[Case | None, dict[str, Any]]:
+    """The case for the optimal law: at the case's crank-jerk limit, else at the peak crank jerk of the
+    improved S-curve's plan (a row already in ``rows``); the note says which."""
+    from planning.model.case_file import case_from_data
+    from planning.model.laws import DEFAULT_LAW
+
+    if case.limits.crank_jerk_rad_s3 is not None:
+        return case.with_law(law), {"jerk_limit_rad_s3": case.limits.crank_jerk_rad_s3, "jerk_limit_from": "case"}
+    ref = next((r for r in rows if r["law"] == DEFAULT_LAW and r["status"] == "verified"), None)
+    if ref is None:
+        return None, {"reason": f"no jerk limit: the case sets none and the {DEFAULT_LAW} law has no plan"}
+    data = case.model_dump(exclude_none=True)
+    data["limits"]["crank_jerk_rad_s3"] = ref["peak_crank_jerk_rad_s3"]
+    data["planner"] = {**data.get("planner", {}), "motion_law": law}
+    data["planner"].pop("law_parameter", None)
+    note = {"jerk_limit_rad_s3": ref["peak_crank_jerk_rad_s3"], "jerk_limit_from": f"the {DEFAULT_LAW} plan's peak"}
+    return case_from_data(data, case.name), note
 
 
 def _cell(value: Any, fmt: str) -> str:
@@ -137,7 +162,8 @@ def laws_markdown(data: dict[str, Any]) -> str:
     kind = "jerk-limited bound" if data["jerk_limited_bound"] else "time-optimal bound"
     tail = " |" * (len(columns) - len(COLUMNS))
     lines.append(f"| *{kind}* | {b['spm']:.3f} | 100.0 | {b['peak_crank_speed_rpm']:.2f} | | | | | shape free |{tail}")
-    return "\n".join(lines) + "\n"
+    notes = [f"{r['law']}: {_jerk_note(r)}." for r in data["laws"] if r.get("jerk_limit_rad_s3") is not None]
+    return "\n".join(lines) + "\n" + "".join(f"\n{n}\n" for n in notes)
 
 
 def laws_text(data: dict[str, Any]) -> str:
@@ -166,4 +192,9 @@ def laws_text(data: dict[str, Any]) -> str:
                 f"net {r['energy_net_kJ']:.1f} kJ/stroke"
             )
     lines.append("  units: rpm, rad/s^2, rad/s^3, mm/s^3; RMS over one cycle")
+    lines += [f"  {r['law']}: {_jerk_note(r)}" for r in data["laws"] if r.get("jerk_limit_rad_s3") is not None]
     return "\n".join(lines)
+
+
+def _jerk_note(row: dict[str, Any]) -> str:
+    return f"planned under |crank jerk| <= {row['jerk_limit_rad_s3']:.4g} rad/s^3 ({row['jerk_limit_from']})"

@@ -142,7 +142,8 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
         "peak_crank_jerk_rad_s3": float(max(p.peak_jerks())),
         "peak_crank_accel_rad_s2": float(max(p.peak_accelerations())),
         "law_parameter": float(p.law_parameter),
-        "half_durations_s": {k: float(p.half(k)[0]) for k in HALVES},
+        "half_durations_s": {k: float(p.half(k)[0]) for k in HALVES} if hasattr(p, "half") else None,
+        "segment_count": len(plan.profile.segments),
         "transfer_dwell_s": float(p.transfer_dwell),
         "transfer_time_s": plan.transfer_window(),
         "max_abs_slider_accel_mm_s2": accel.value,
@@ -211,7 +212,10 @@ def summary_text(result: dict[str, Any]) -> str:
         f"  peaks: crank acceleration {r['peak_crank_accel_rad_s2']:.3f} rad/s^2, "
         f"crank jerk {r['peak_crank_jerk_rad_s3']:.3f} rad/s^3",
         f"  halves: feed {hd['feed_accel']:.4f} / {hd['feed_decel']:.4f} s, return {hd['return_accel']:.4f} / "
-        f"{hd['return_decel']:.4f} s; draw {r['cycle_time_s'] - sum(hd.values()) - r['transfer_dwell_s']:.4f} s",
+        f"{hd['return_decel']:.4f} s; draw {r['cycle_time_s'] - sum(hd.values()) - r['transfer_dwell_s']:.4f} s"
+        if hd
+        else f"  free profile: {r['segment_count']} segments of constant jerk (no halves), "
+        f"|jerk| <= {r['limits']['crank_jerk_rad_s3']:g} rad/s^3",
         f"  transfer window theta4 -> theta1: {r['transfer_time_s']:.4f} s; "
         f"max |slider accel| {r['max_abs_slider_accel_mm_s2']:.1f} mm/s^2",
         "",

@@ -96,6 +96,7 @@ PARAMETERS: tuple[str, ...] = (
     "crank_accel_max",
     "crank_jerk_max",
     "die_height",  # [mm above BDC] (the drive NLP holds the die speed at every sample below it)
+    "min_crank_speed",  # [rad/s] (the optimal law's samples; the laws' halves are monotone, bounded by w1, w2)
 )
 PARAMETER_INDEX = {name: i for i, name in enumerate(PARAMETERS)}
 # Parameters of a drive (the NLP of a case with a ``drive:`` section has them after PARAMETERS), SI units
@@ -196,6 +197,12 @@ class CycleNLP:
     published_rows: slice
     period_rows: slice | None = None  # the drive NLP's "cycle time" row (period - target_period)
     die_zone_rows: slice | None = None  # the drive NLP's die-zone speed at every sample below the die height
+    variables: tuple[tuple[str, str], ...] = VARIABLES  # name and scale kind of each decision variable
+    sampled_speed_limits: bool = False  # the crank speed limits are sampled rows (the optimal law's NLP)
+
+    def values_of(self, result: NLPResult) -> dict[str, float]:
+        """The variables of a solve by name."""
+        return {k: float(result.x[j]) for j, (k, _) in enumerate(self.variables)}
 
     def bounds(self, placement: Placement, fixed_period: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """``(lbg, ubg)`` for ``placement``; ``fixed_period``: the cycle time held at the parameter
@@ -224,7 +231,7 @@ class CycleNLP:
         (:data:`PARAMETERS` order), physical bounds ``lbx``/``ubx`` and the variables' ``scale``;
         ``warm_start``: the multipliers of a nearby solve; ``fixed_period``: see :meth:`bounds`."""
         lbg, ubg = self.bounds(placement, fixed_period)
-        x0 = np.array([start[k] for k, _ in VARIABLES])
+        x0 = np.array([start[k] for k, _ in self.variables])
         return self.program.solve(x0, lbx, ubx, lbg, ubg, p=case_parameters, scale=scale, warm_start=warm_start)
 
     def worst_violation(self, placement: Placement, g: np.ndarray, fixed_period: bool = False) -> tuple[str, float]:

@@ -38,7 +38,6 @@ from planning.solver.nlp import (
     VARIABLES,
     CycleNLP,
     cycle_nlp,
-    values_of,
     variable_scales,
 )
 from planning.solver.outcomes import Attempt, Infeasible, NoPlanFound, Unverified
@@ -61,6 +60,8 @@ POWER_SMOOTHING = 1e-3  # epsilon of the NLP's smooth max(P, 0), as a share of r
 REFINED = {
     CheckId.SLIDER_ACCEL: PARAMETER_INDEX["accel_limit"],
     CheckId.DIE_SPEED: PARAMETER_INDEX["die_speed"],  # the drive NLP's die-zone rows (see CycleNLP.die_zone_rows)
+    CheckId.MIN_CRANK_SPEED: PARAMETER_INDEX["min_crank_speed"],  # the optimal law's sampled speed limits
+    CheckId.CRANK_SPEED: PARAMETER_INDEX["crank_speed_max"],
     CheckId.MOTOR_PEAK: DRIVE_INDEX["motor_peak"],
     CheckId.MOTOR_RMS: DRIVE_INDEX["motor_rms"],
 }
@@ -197,6 +198,7 @@ def nlp_parameters(case: Case) -> np.ndarray:
         "crank_accel_max": lim.crank_accel_rad_s2 or NO_LIMIT,
         "crank_jerk_max": lim.crank_jerk_rad_s3 or NO_LIMIT,
         "die_height": lim.die_height_mm,
+        "min_crank_speed": lim.min_crank_speed_rpm * RPM,
     }
     out = np.array([values[k] for k in PARAMETERS], dtype=float)
     if case.drive is None:
@@ -351,6 +353,7 @@ class _Search:
     starts: int = 0
     fixed_period: bool = False  # the cycle time held at the parameter target_period (a target rate)
     score: Callable[[Plan], float] | None = None  # what "better" means, lower is better; None: the period
+    make_plan: Callable[..., Plan] | None = None  # values -> Plan (None: a plan of the case's law's cycle)
     best_score: float = math.inf
 
     def score_of(self, plan: Plan) -> float:
@@ -371,16 +374,16 @@ class _Search:
             if self.fixed_period and res.status == NLPStatus.STOPPED_AT_LIMIT:
                 # at a target rate the optimum may sit where a half of the law degenerates (a monotone speed
                 # change: peak = end speed); IPOPT then crawls, and a fresh start from its last iterate ends it
-                res = self.nlp.solve(values_of(res), q, self.lbx, self.ubx, placement, self.scale, None, True)
+                res = self.nlp.solve(self.nlp.values_of(res), q, self.lbx, self.ubx, placement, self.scale, None, True)
                 self.iterations += res.iterations
-            values, multipliers = values_of(res), res.multipliers
+            values, multipliers = self.nlp.values_of(res), res.multipliers
             if not res.success:
                 block, amount = self.nlp.worst_violation(placement, res.g, self.fixed_period)
                 field = BLOCK_FIELDS[block]
                 self.attempts.append(Attempt(res.return_status, block, amount, case_field=field))
                 return None
             info = SolverInfo(self.iterations, time.perf_counter() - self.t_start, self.starts, res.return_status)
-            plan = _plan(self.case, values, placement, info)
+            plan = (self.make_plan or _plan)(self.case, values, placement, info)
             check = verify(plan, self.case)
             if check.passed:
                 score = self.score_of(plan)
@@ -391,6 +394,9 @@ class _Search:
             refinable = {cid: k for cid, k in REFINED.items() if k < q.size}  # the NLP's own limits
             if self.nlp.die_zone_rows is None:  # the kinematic NLP holds the die speed at the crossings only
                 refinable.pop(CheckId.DIE_SPEED)
+            if not self.nlp.sampled_speed_limits:  # the laws' halves are monotone: their end and peak speeds hold them
+                refinable.pop(CheckId.MIN_CRANK_SPEED)
+                refinable.pop(CheckId.CRANK_SPEED)
             if any(c.id not in refinable for c in bad):
                 return None
             for c in bad:  # lower the NLP's sampled limit by the measured overshoot
@@ -411,7 +417,7 @@ class _Search:
         found: list[tuple[float, dict[str, float]]] = []
         tried: list[np.ndarray] = []
         for x0 in x0s:
-            key = np.array([x0[k] for k, _ in VARIABLES])
+            key = np.array([x0[k] for k, _ in self.nlp.variables])
             if any(np.allclose(key, other, rtol=1e-9, atol=1e-12) for other in tried):
                 continue  # the same start again would only repeat its answer
             tried.append(key)
@@ -462,6 +468,10 @@ def solve(
         from planning.solver.objectives import solve_at_rate
 
         return solve_at_rate(case, placement, neighbour)
+    if get_law(case.planner.motion_law).free_profile:
+        from planning.solver.optimal import solve_optimal
+
+        return solve_optimal(case, neighbour)
     search = _prepare(case, placement or case.planner.placement)
     neighbour = _adopt(search, neighbour)
     if follow and _follow(search, neighbour):

@@ -16,6 +16,8 @@ seven-segment      seeds 000/002/004: jerk phase r D/2, constant          accele
 quintic            seed 001: s = 10u^3 - 15u^4 + 6u^5                     jerk
 logistic           seed 000 Eq. 4 with its end slope removed, flexible a  acceleration (small jerk steps)
 cycloidal          cam classic, acceleration 1 - cos(2 pi u)              jerk
+optimal            no halves: a piecewise-constant jerk profile from       acceleration (jerk steps)
+                   theta3 round to theta2, planned whole under |jerk| <= J
 =================  ====================================================  ===========================
 
 Each law is a class (``base.MotionLaw``) in a file of its own; this module is the registry. The
@@ -31,16 +33,20 @@ from typing import Literal, get_args
 from planning.model.laws.base import MotionLaw, ShapeParameter
 from planning.model.laws.improved_scurve import ImprovedSCurve
 from planning.model.laws.one_segment import CycloidalLaw, LogisticLaw, QuinticLaw
+from planning.model.laws.optimal import OptimalLaw
 from planning.model.laws.seven_segment import SevenSegment
 
 LAWS: dict[str, MotionLaw] = {
-    law.name: law for law in (ImprovedSCurve(), SevenSegment(), QuinticLaw(), LogisticLaw(), CycloidalLaw())
+    law.name: law
+    for law in (ImprovedSCurve(), SevenSegment(), QuinticLaw(), LogisticLaw(), CycloidalLaw(), OptimalLaw())
 }
 DEFAULT_LAW = ImprovedSCurve.name
-LawName = Literal["improved-s-curve", "seven-segment", "quintic", "logistic", "cycloidal"]
+OPTIMAL_LAW = OptimalLaw.name
+SHAPED_LAWS = tuple(name for name, law in LAWS.items() if not law.free_profile)  # the laws with halves
+LawName = Literal["improved-s-curve", "seven-segment", "quintic", "logistic", "cycloidal", "optimal"]
 assert set(get_args(LawName)) == set(LAWS)
 
-__all__ = ["DEFAULT_LAW", "LAWS", "LawName", "MotionLaw", "ShapeParameter", "get_law"]
+__all__ = ["DEFAULT_LAW", "LAWS", "OPTIMAL_LAW", "SHAPED_LAWS", "LawName", "MotionLaw", "ShapeParameter", "get_law"]
 
 
 def get_law(name: str) -> MotionLaw:

@@ -34,7 +34,8 @@ class MotionLaw(ABC):
     of the speed that is continuous), ``source``, ``parameter`` (a :class:`ShapeParameter` or None),
     ``samples`` (slider-acceleration samples the NLP takes per segment of a half; the dense
     verification decides between them), ``one_jerk_per_curve`` (Eq. 14: both halves of an S-curve
-    share one jerk). Every method works on floats, numpy arrays and CasADi symbols.
+    share one jerk), ``free_profile`` (no halves: the optimal law). Every method works on floats, numpy
+    arrays and CasADi symbols.
     """
 
     name: ClassVar[str]
@@ -43,6 +44,7 @@ class MotionLaw(ABC):
     parameter: ClassVar[ShapeParameter | None] = None
     samples: ClassVar[int] = 5
     one_jerk_per_curve: ClassVar[bool] = False
+    free_profile: ClassVar[bool] = False  # True: no halves, the profile is planned whole (the optimal law)
 
     @abstractmethod
     def half(self, prefix: str, duration: Any, dv: Any, param: Any = None) -> list[Segment]:

@@ -1,0 +1,93 @@
+"""The free profile of the optimal law: piecewise-constant crank jerk from theta3 round to theta2.
+
+The cycle starts at theta3 with the draw speed w2 and zero acceleration and runs through three phases
+of segments of constant jerk ``j_k`` [rad/s^3]: the return (theta3 -> theta4, :data:`PHASES` gives the
+number of segments), the robot's window (theta4 -> theta1) and the feed (theta1 -> theta2), every
+segment of a phase lasting the phase's step ``h`` [s]; it arrives at theta2 + 2 pi with w2 and zero
+acceleration and draws at w2 to theta3.
+The acceleration is continuous everywhere (piecewise linear); the jerk steps at the knots. There are no
+halves, peaks or dwell: :class:`FreeProfileParameters` reports what a press engineer reads off any
+plan (speed at TDC, highest speed before and after the draw, peak acceleration and jerk).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from planning.model.profile import Segment, knot_states
+
+PHASES = (("return", 40), ("transfer", 24), ("feed", 40))  # name, segments: theta3->theta4->theta1->theta2
+SEGMENTS = sum(n for _, n in PHASES)
+OPTIMAL = "optimal"
+
+
+def free_segments(durations, jerks) -> list[Segment]:  # noqa: ANN001 - floats or CasADi symbols
+    """The segments of durations ``T_k`` [s] and constant jerks ``j_k`` [rad/s^3], named ``PHASE:k``."""
+    names = [f"{phase}:{k + 1}" for phase, n in PHASES for k in range(n)]
+    return [Segment(name, T, j, 0.0) for name, T, j in zip(names, durations, jerks, strict=True)]
+
+
+@dataclass(frozen=True)
+class FreeProfileParameters:
+    """A solved free profile (inside units): ``durations`` [s] and ``jerks`` [rad/s^3] of the segments from
+    theta3, ``draw_speed`` w2 [rad/s], ``draw_start`` / ``draw_end`` theta2, theta3 [rad]. The fields a
+    report reads of every plan are derived: ``transfer_speed`` (the speed at TDC), ``feed_peak_speed`` and
+    ``return_peak_speed`` (the highest speed before theta2 and after theta3, on either side of TDC)."""
+
+    durations: tuple[float, ...]
+    jerks: tuple[float, ...]
+    draw_speed: float
+    draw_start: float
+    draw_end: float
+    motion_law: str = OPTIMAL
+    transfer_dwell: float = 0.0
+    law_parameter: float = 0.0
+
+    def segments(self) -> list[Segment]:
+        return free_segments(self.durations, self.jerks)
+
+    @property
+    def draw_time(self) -> float:
+        return (self.draw_end - self.draw_start) / self.draw_speed
+
+    @property
+    def period(self) -> float:
+        return float(sum(self.durations)) + self.draw_time
+
+    def _knots(self) -> np.ndarray:
+        return np.array(knot_states(self.draw_end, self.draw_speed, 0.0, self.segments()), dtype=float)
+
+    def _speeds(self) -> tuple[float, float, float]:
+        """Speed at TDC, highest speed on the return side (theta3 -> TDC) and the feed side (TDC -> theta2)."""
+        from planning.model.profile import Profile
+
+        profile = Profile(tuple(self.segments()), self.draw_end, self.draw_speed)
+        t = np.linspace(0.0, profile.duration, 4001)
+        th, om, _, _ = profile.at_time(t)
+        tdc = profile.time_at_angle(2 * math.pi)
+        return_side, feed_side = t <= tdc, t >= tdc
+        w_tdc = float(profile.at_time(tdc)[1])
+        return w_tdc, float(np.max(om[return_side], initial=w_tdc)), float(np.max(om[feed_side], initial=w_tdc))
+
+    @property
+    def transfer_speed(self) -> float:
+        return self._speeds()[0]
+
+    @property
+    def return_peak_speed(self) -> float:
+        return self._speeds()[1]
+
+    @property
+    def feed_peak_speed(self) -> float:
+        return self._speeds()[2]
+
+    def peak_accelerations(self) -> list[float]:
+        """The largest |crank acceleration| [rad/s^2] (at a knot: it is piecewise linear)."""
+        return [float(np.max(np.abs(self._knots()[:, 2])))]
+
+    def peak_jerks(self) -> list[float]:
+        """The largest |crank jerk| [rad/s^3] of a segment that lasts."""
+        return [max((abs(j) for T, j in zip(self.durations, self.jerks, strict=True) if T > 0), default=0.0)]
