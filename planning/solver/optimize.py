@@ -50,6 +50,7 @@ DRIVE_BACKOFF = 5e-5  # likewise for the motor's peak and RMS torque (refined li
 MIN_HALF_S = 4e-3  # [s] lower bound on the duration of a half (1 ms per improved-S-curve sub-segment)
 MAX_TIME_S = 600.0  # [s] least upper bound on a time variable (see _bounds)
 REFINEMENTS = 8  # re-solves with a lowered sampled acceleration limit
+REFINE_MARGIN = 1e-5  # relative: a refined sampled limit is tightened this much beyond the measured overshoot
 HARDER_BACKOFF = 5e-3  # when no start verifies: once more with this back-off on the sampled limits
 NO_LIMIT = 1e9  # stands for an absent motor limit in the NLP's parameters
 AGREE_S = 1e-6  # [s] two starts whose best periods agree this closely have found the same optimum
@@ -399,8 +400,11 @@ class _Search:
                 refinable.pop(CheckId.CRANK_SPEED)
             if any(c.id not in refinable for c in bad):
                 return None
-            for c in bad:  # lower the NLP's sampled limit by the measured overshoot
-                q[refinable[c.id]] *= (c.limit / c.value) * (1 - 1e-5)
+            for c in bad:  # tighten the NLP's sampled limit by the measured overshoot
+                if c.kind == "min":  # a lower limit (the optimal law's minimum crank speed) goes up
+                    q[refinable[c.id]] *= (c.limit / max(c.value, 0.5 * c.limit)) * (1 + REFINE_MARGIN)
+                else:
+                    q[refinable[c.id]] *= (c.limit / c.value) * (1 - REFINE_MARGIN)
         return None
 
     def consider(self, solution: Solution, score: float) -> None:

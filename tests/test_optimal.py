@@ -1,0 +1,96 @@
+"""The optimal law: the fastest jerk-limited motion, against every fixed law and the jerk-limited bound."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from planning.cli import main
+from planning.model.case_file import case_from_data, read_case
+from planning.model.laws import SHAPED_LAWS
+from planning.solver.bound import time_optimal_bound
+from planning.solver.optimize import solve
+from planning.solver.verify import max_abs_jerk
+
+CASES = sorted((Path(__file__).resolve().parent.parent / "cases").glob("*.yaml"))
+JERK_SHARE = 0.98  # the issue's target: at least this share of the jerk-limited bound at every limit
+SAME_JERK = 1e-6  # relative: a law's peak crank jerk "not higher" than the reference within round-off
+
+
+def with_jerk(case, jerk: float, law: str = "optimal"):  # noqa: ANN001, ANN201 - a Case
+    data = case.model_dump(exclude_none=True)
+    data["limits"]["crank_jerk_rad_s3"] = jerk
+    data["planner"] = {**data.get("planner", {}), "motion_law": law}
+    data["planner"].pop("law_parameter", None)
+    return case_from_data(data, case.name)
+
+
+@pytest.mark.parametrize("path", CASES, ids=lambda p: p.stem)
+def test_optimal_beats_every_law_that_is_not_jerkier(path: Path) -> None:
+    """At the improved S-curve's own peak crank jerk, the optimal law makes at least as many strokes as
+    every law whose plan's peak crank jerk is not higher, on every case in cases/."""
+    case = read_case(path)
+    plans = {law: solve(case.with_law(law)).plan for law in SHAPED_LAWS}
+    reference = max_abs_jerk(plans["improved-s-curve"].profile)
+    optimal = solve(with_jerk(case, reference))
+    assert optimal.verification.passed and optimal.plan.motion_law == "optimal"
+    assert max_abs_jerk(optimal.plan.profile) <= reference * (1 + SAME_JERK)
+    smoother = {law: p.spm for law, p in plans.items() if max_abs_jerk(p.profile) <= reference * (1 + SAME_JERK)}
+    assert "improved-s-curve" in smoother
+    for law, spm in smoother.items():
+        assert optimal.plan.spm >= spm - 1e-9, (law, spm, optimal.plan.spm)
+
+
+@pytest.mark.parametrize("name", ["wang2023-side-panel", "small-fast-cup"])
+def test_strokes_rise_with_the_jerk_limit_towards_the_bound(name: str) -> None:
+    """1, 3, 10 and 100 times the improved S-curve's peak crank jerk (each from the plan before it):
+    the strokes never fall, stay below the jerk-limited bound and reach at least JERK_SHARE of it."""
+    case = read_case(Path(__file__).resolve().parent.parent / "cases" / f"{name}.yaml")
+    reference = max_abs_jerk(solve(case).plan.profile)
+    spm, previous = [], None
+    for factor in (1, 3, 10, 100):
+        limited = with_jerk(case, factor * reference)
+        plan = solve(limited, neighbour=previous).plan
+        bound = time_optimal_bound(limited).spm
+        assert JERK_SHARE * bound <= plan.spm <= bound, (factor, plan.spm, bound)
+        spm.append(plan.spm)
+        previous = plan
+    assert all(b >= a - 1e-9 for a, b in zip(spm, spm[1:], strict=False)), spm
+
+
+def test_an_optimal_plan_is_smooth_and_complete(tmp_path: Path) -> None:
+    """The servo-limited case (its own jerk limit): acceleration continuous at every knot and zero along
+    the draw, jerk within the limit on the dense grid (a verification check), every file written."""
+    path = Path(__file__).resolve().parent.parent / "cases" / "side-panel-servo-limits.yaml"
+    assert main(["solve", str(path), "--law", "optimal", "--out", str(tmp_path), "--cam-points", "720"]) == 0
+    result = json.loads((tmp_path / "result.json").read_text())
+    assert result["motion_law"] == "optimal" and result["segment_count"] == len(result["segments"])
+    assert result["half_durations_s"] is None
+    jerk = next(c for c in result["verification"]["checks"] if c["name"] == "|crank jerk| <= crank_jerk_rad_s3")
+    assert jerk["passed"] and jerk["value"] <= 40.0 * (1 + 1e-9)
+    case = read_case(path).with_law("optimal")
+    plan = solve(case).plan
+    prof = plan.profile
+    eps = 1e-9
+    inner = prof.knot_times[1:-1]
+    before = prof.at_time(inner - eps)[2]
+    after = prof.at_time(inner + eps)[2]
+    assert np.max(np.abs(after - before)) < 1e-6  # continuous acceleration at every knot
+    t2, t3 = plan.key_times()[1:3]
+    _, _, alpha, _ = prof.at_time(np.linspace(t2, t3, 101))
+    assert np.max(np.abs(alpha)) < 1e-6  # the draw at constant speed: zero acceleration, joined smoothly
+    assert {f.name for f in tmp_path.iterdir()} >= {"result.json", "trajectory.csv", "cam_table.csv", "summary.txt"}
+
+
+def test_the_optimal_law_needs_a_jerk_limit(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    published = Path(__file__).resolve().parent.parent / "cases" / "wang2023-side-panel.yaml"
+    assert main(["solve", str(published), "--law", "optimal", "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        f"pressplan: {published}: limits.crank_jerk_rad_s3: the optimal law needs a crank-jerk limit "
+        "(the jerk it may use)"
+    )
+    assert not (tmp_path / "o").exists()
