@@ -294,14 +294,17 @@ def seed_values(seed: Plan) -> dict[str, float]:
 
 
 def solve_optimal(case: Case, neighbour: Plan | None = None) -> Solution:
-    """The fastest verified cycle of ``case`` under the optimal law (needs ``limits.crank_jerk_rad_s3``)."""
+    """The fastest verified cycle of ``case`` under the optimal law (needs ``limits.crank_jerk_rad_s3``).
+
+    ``neighbour``: an optimal plan of a neighbouring case (a sweep, an edit on the web page, a looser
+    limit). When it holds here it is a candidate; its values start the NLP, and when that start verifies
+    the seed law is not solved at all (a warm re-solve)."""
     if case.limits.crank_jerk_rad_s3 is None:
         raise Infeasible(
             "the optimal law needs limits.crank_jerk_rad_s3 (the jerk it may use)", limit="limits.crank_jerk_rad_s3"
         )
     t_start = time.perf_counter()
     precheck(case)
-    seed = solve(case.with_law(SEED_LAW), "free")
     search = _prepare(case.with_law(SEED_LAW), "free")  # the case's parameters and draw-speed range
     search = replace(
         search,
@@ -310,17 +313,17 @@ def solve_optimal(case: Case, neighbour: Plan | None = None) -> Solution:
         scale=variable_scales(case),
         make_plan=make_plan,
         t_start=t_start,
-        attempts=[],
-        iterations=seed.plan.solver.iterations,
-        starts=seed.plan.solver.starts,
     )
     search.lbx, search.ubx = _bounds(case, search)
-    starts = [seed_values(seed.plan)]
     if neighbour is not None and neighbour.motion_law == OPTIMAL and neighbour.nlp_values:
-        starts.insert(0, neighbour.nlp_values)
         if np.allclose(neighbour.key_angles, case.key_angles, rtol=0, atol=1e-12):
             check = verify(neighbour, case)  # a neighbouring case's plan that holds here is an answer
             if check.passed:
                 search.consider(Solution(neighbour, check), neighbour.period)
-    search.multi_start(starts, "free", confirm=False)
+        if search.attempt(neighbour.nlp_values, "free") is not None:
+            return search.answer()
+    seed = solve(case.with_law(SEED_LAW), "free")
+    search.iterations += seed.plan.solver.iterations
+    search.starts += seed.plan.solver.starts
+    search.multi_start([seed_values(seed.plan)], "free", confirm=False)
     return search.answer()
