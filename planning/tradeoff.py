@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from planning.model.case import Case, Placement
-from planning.sweep import SweepError, execute
+from planning.sweep import SweepError, _cell, execute
 
 # one row per rate: the plan's figures, the baseline's, the savings
 FIGURE_FIELDS = (
@@ -186,12 +186,6 @@ def write_rows(path: Path, rows: list[dict[str, Any]], columns: tuple[str, ...])
         writer.writeheader()
         for row in rows:
             writer.writerow({k: _cell(row.get(k)) for k in columns})
-
-
-def _cell(value: Any) -> Any:
-    if isinstance(value, float):
-        return repr(value)
-    return "" if value is None else value
 
 
 def table_text(result: TradeoffResult, case: Case) -> str:

@@ -168,6 +168,29 @@ BLOCK_FIELDS = {
 }
 
 
+class Rows:
+    """The constraint rows of an NLP as they are added: named blocks, expressions and bounds."""
+
+    def __init__(self) -> None:
+        self.blocks: list[ConstraintBlock] = []
+        self.g: list = []
+        self.lb: list[float] = []
+        self.ub: list[float] = []
+
+    def add(self, name: str, expr: ca.SX, lo, hi) -> slice:  # noqa: ANN001 - a number or an array
+        """Rows ``lo <= expr <= hi`` as the block ``name``; returns their slice."""
+        expr = ca.vec(expr)
+        n = expr.shape[0]
+        self.blocks.append(ConstraintBlock(name, len(self.lb), len(self.lb) + n))
+        self.g.append(expr)
+        self.lb.extend(np.broadcast_to(lo, (n,)).tolist())
+        self.ub.extend(np.broadcast_to(hi, (n,)).tolist())
+        return slice(len(self.lb) - n, len(self.lb))
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        return np.array(self.lb), np.array(self.ub)
+
+
 def _angle_at(t: ca.SX, starts: list, states: list, segs: list[Segment]) -> tuple[ca.SX, ca.SX]:
     """Closed-form crank angle and speed at time ``t`` [s] over the segments (clip formulation): the
     linear-jerk parts as one vector, the shape terms of shaped segments added one by one."""
@@ -314,19 +337,8 @@ def _build(law_name: str, drive: bool = False, rate: bool = False) -> CycleNLP:
     n_before = len(segs) - 1  # the segments from theta3 to theta2 (all but the draw)
     before = (starts[:n_before], states[:n_before], segs[:n_before])
 
-    blocks: list[ConstraintBlock] = []
-    g: list = []
-    lb: list = []
-    ub: list = []
-
-    def add(name: str, expr: ca.SX, lo, hi) -> slice:
-        expr = ca.vec(expr)
-        n = expr.shape[0]
-        blocks.append(ConstraintBlock(name, len(lb), len(lb) + n))
-        g.append(expr)
-        lb.extend(np.broadcast_to(lo, (n,)).tolist())
-        ub.extend(np.broadcast_to(hi, (n,)).tolist())
-        return slice(len(lb) - n, len(lb))
+    rows = Rows()
+    add = rows.add
 
     w1, w2 = params.transfer_speed, params.draw_speed
     wm1, wm2 = params.feed_peak_speed, params.return_peak_speed
@@ -438,10 +450,10 @@ def _build(law_name: str, drive: bool = False, rate: bool = False) -> CycleNLP:
         objective -= p_case[DRIVE_INDEX["weight_dwell"]] * params.transfer_dwell
         period_rows = add("cycle time", params.period - p_case[DRIVE_INDEX["target_period"]], -np.inf, np.inf)
 
-    nlp = {"x": x, "p": p, "f": objective, "g": ca.vertcat(*g)}
+    nlp = {"x": x, "p": p, "f": objective, "g": ca.vertcat(*rows.g)}
     kind = "_rate" if rate else "_drive" if drive else ""
     program = NLPSolver("press_cycle_" + law_name.replace("-", "_") + kind, nlp, CYCLE_OPTIONS)
-    return CycleNLP(program, np.array(lb), np.array(ub), tuple(blocks), published_rows, period_rows, die_zone_rows)
+    return CycleNLP(program, *rows.bounds(), tuple(rows.blocks), published_rows, period_rows, die_zone_rows)
 
 
 @cache

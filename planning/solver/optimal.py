@@ -45,8 +45,8 @@ from planning.solver.nlp import (
     PARAMETER_INDEX,
     PARAMETERS,
     SAMPLES_CONSTANT,
-    ConstraintBlock,
     CycleNLP,
+    Rows,
     _angle_at,
     _drive_constraints,
 )
@@ -105,19 +105,8 @@ def _build(drive: bool) -> CycleNLP:
     q = {name: p_case[i] for i, name in enumerate(PARAMETERS)}
     w2 = v["draw_speed"]
 
-    blocks: list[ConstraintBlock] = []
-    g: list = []
-    lb: list = []
-    ub: list = []
-
-    def add(name: str, expr: ca.SX, lo, hi) -> slice:
-        expr = ca.vec(expr)
-        n = expr.shape[0]
-        blocks.append(ConstraintBlock(name, len(lb), len(lb) + n))
-        g.append(expr)
-        lb.extend(np.broadcast_to(lo, (n,)).tolist())
-        ub.extend(np.broadcast_to(hi, (n,)).tolist())
-        return slice(len(lb) - n, len(lb))
+    rows = Rows()
+    add = rows.add
 
     ends = {"return": q["theta4"], "transfer": q["theta1"] + 2 * np.pi, "feed": q["theta2"] + 2 * np.pi}
     start = (q["theta3"], w2, ca.SX(0.0))
@@ -204,13 +193,12 @@ def _build(drive: bool) -> CycleNLP:
         t_all = ca.vertcat(t_free, t0 + fractions * draw_time)
         _drive_constraints(add, p_case, th_all, om_all, al_all, d1a, d2a, t_all, period)
 
-    nlp = {"x": x, "p": ca.vertcat(p_case, p_scale), "f": period, "g": ca.vertcat(*g)}
+    nlp = {"x": x, "p": ca.vertcat(p_case, p_scale), "f": period, "g": ca.vertcat(*rows.g)}
     program = NLPSolver("press_cycle_optimal" + ("_drive" if drive else ""), nlp, CYCLE_OPTIONS)
     return CycleNLP(
         program,
-        np.array(lb),
-        np.array(ub),
-        tuple(blocks),
+        *rows.bounds(),
+        tuple(rows.blocks),
         published_rows=slice(0, 0),
         die_zone_rows=die_zone_rows,
         variables=VARIABLES,
