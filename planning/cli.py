@@ -21,6 +21,7 @@ from planning.model.laws import LAWS
 EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = 0, 2, 3
 EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143  # Ctrl-C, SIGTERM (128 + the signal number)
 PLOT_FORMATS = ("png", "svg", "pdf")
+SERVE_FIRST = "wang2023-side-panel.yaml"  # the case the page opens with when none is given
 
 
 class _Parser(argparse.ArgumentParser):
@@ -91,7 +92,7 @@ def _parser() -> argparse.ArgumentParser:
     lw.add_argument("--json", action="store_true", help="print laws.json instead of the table")
     lw.add_argument("--format", choices=PLOT_FORMATS, default="png", help="figure format (default png)")
     sv = sub.add_parser("serve", help="a local web page to plan a motion interactively (extra 'web')")
-    sv.add_argument("case", nargs="?", help="case file (YAML) to open first (default: the first in cases/)")
+    sv.add_argument("case", nargs="?", help="case file (YAML) to open first (default: the published case)")
     sv.add_argument("--port", type=_whole(1, 65535), default=8050, help="port (default 8050)")
     sv.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1: this machine only)")
     sv.add_argument(
@@ -408,6 +409,8 @@ def _serve(args) -> int:
     cases = Path(args.cases)
     if not cases.is_dir() and args.cases == "cases":  # not run from the project root: the project's own cases
         cases = Path(__file__).resolve().parents[1] / "cases"
+    if case_path is None and (cases / SERVE_FIRST).is_file():  # the published case first, as in the README
+        case_path = (cases / SERVE_FIRST).resolve()
     serve(case_path, args.host, args.port, cases if cases.is_dir() else None)
     return EXIT_OK
 
