@@ -159,3 +159,14 @@ def test_every_law_plans_at_a_rate(law: str) -> None:
     assert sol.verification.passed and sol.plan.motion_law == law
     assert sol.plan.spm == pytest.approx(30.0, rel=1e-9)
     assert sol.at_rate.figures.energy_kJ <= sol.at_rate.baseline_figures.energy_kJ
+
+
+def test_the_optimal_law_has_no_objective_at_a_rate() -> None:
+    """The optimal law plans for the most strokes; with an objective at a rate the case is refused (exit 2)."""
+    data = read_case(CUP).model_dump(exclude_none=True)
+    data["limits"]["crank_jerk_rad_s3"] = 4000.0
+    data["planner"] = {"motion_law": "optimal", "objective": "min-energy", "target_spm": 30.0}
+    from planning.model.case_file import CaseFileError, case_from_data
+
+    with pytest.raises(CaseFileError, match="planner.objective: the optimal law plans for the most strokes only"):
+        case_from_data(data, "x.yaml")

@@ -263,6 +263,7 @@ class Case(_Model):
         planner = self.planner.model_copy(update={"motion_law": law, "law_parameter": None})
         case = self.model_copy(update={"planner": planner})
         _law_checks(case)
+        _objective_checks(case)
         return case
 
 
@@ -443,6 +444,12 @@ def _objective_checks(case: Case) -> None:
         raise CaseError("planner.target_spm", f"the {planner.objective} objective needs the line's rate", None, False)
     if case.drive is None:
         raise CaseError("planner.objective", "needs a drive: section (the motor it weighs)", planner.objective)
+    if LAWS[planner.motion_law].free_profile:
+        raise CaseError(
+            "planner.objective",
+            f"the {planner.motion_law} law plans for the most strokes only (max-spm); choose a law with halves",
+            planner.objective,
+        )
 
 
 _SLUG = re.compile(r"[^A-Za-z0-9._-]+")

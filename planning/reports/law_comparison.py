@@ -13,7 +13,8 @@ from typing import Any
 
 import numpy as np
 
-from planning.model.case import RPM, Case
+from planning.model.case import RPM, Case, CaseError
+from planning.model.case_file import CaseFileError
 from planning.model.laws import LAWS
 from planning.reports.report import binding, sample_profile
 from planning.solver.bound import Bound, time_optimal_bound
@@ -95,7 +96,10 @@ def compare_laws(case: Case, laws: tuple[str, ...] = tuple(LAWS)) -> tuple[dict[
     for law in laws:
         note = {}
         if LAWS[law].free_profile:  # the optimal law plans under a jerk limit: the case's, or the S-curve's own
-            variant, note = _jerk_limited(case, law, rows)
+            try:
+                variant, note = _jerk_limited(case, law, rows)
+            except (CaseError, CaseFileError) as exc:  # e.g. an objective at a rate, which it does not plan
+                variant, note = None, {"reason": str(exc)}
         else:
             variant = case.with_law(law)
         try:
