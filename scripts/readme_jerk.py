@@ -13,6 +13,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from readme_block import replace_block
+
 from planning.model.case_file import case_from_data, read_case
 from planning.solver.bound import time_optimal_bound
 from planning.solver.optimize import solve
@@ -62,11 +64,7 @@ def table() -> str:
 def run() -> None:
     rows = table()
     print(rows)
-    readme = ROOT / "README.md"
-    text = readme.read_text(encoding="utf-8")
-    head, rest = text.split("<!-- jerk:begin -->")
-    _, tail = rest.split("<!-- jerk:end -->")
-    readme.write_text(f"{head}<!-- jerk:begin -->\n{rows}<!-- jerk:end -->{tail}", encoding="utf-8")
+    replace_block("jerk", rows)
 
 
 if __name__ == "__main__":

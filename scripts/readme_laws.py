@@ -11,6 +11,8 @@ from __future__ import annotations
 import tempfile
 from pathlib import Path
 
+from readme_block import replace_block
+
 from planning.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -23,11 +25,7 @@ def run() -> None:
         if main(["laws", str(CASE), "--out", str(out)]) != 0:
             raise SystemExit("pressplan laws failed")
         table = (out / "laws.md").read_text(encoding="utf-8")
-    readme = ROOT / "README.md"
-    text = readme.read_text(encoding="utf-8")
-    head, rest = text.split("<!-- laws:begin -->")
-    _, tail = rest.split("<!-- laws:end -->")
-    readme.write_text(f"{head}<!-- laws:begin -->\n{table}<!-- laws:end -->{tail}", encoding="utf-8")
+    replace_block("laws", table)
 
 
 if __name__ == "__main__":

@@ -13,6 +13,8 @@ from __future__ import annotations
 import tempfile
 from pathlib import Path
 
+from readme_block import replace_block
+
 from planning.cli import main
 from planning.model.case_file import read_case
 from planning.solver.objectives import solve_at_rate
@@ -56,11 +58,7 @@ def figures() -> None:
 
 def run() -> None:
     rows = table()
-    readme = ROOT / "README.md"
-    text = readme.read_text(encoding="utf-8")
-    head, rest = text.split("<!-- rates:begin -->")
-    _, tail = rest.split("<!-- rates:end -->")
-    readme.write_text(f"{head}<!-- rates:begin -->\n{rows}<!-- rates:end -->{tail}", encoding="utf-8")
+    replace_block("rates", rows)
     figures()
 
 

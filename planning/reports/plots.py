@@ -340,35 +340,25 @@ def tradeoff_figure(rows: list[dict[str, Any]], case: Any, title: str) -> Figure
         return np.array([float(r[name]) for r in ok])
 
     motor = case.drive.motor
-    if ok:
-        top.plot(spm, column("rms_torque_Nm") / 1e3, "o-", color="tab:blue", lw=1.5, ms=4, label="RMS, optimised")
-        top.plot(
-            spm,
-            column("baseline_rms_torque_Nm") / 1e3,
-            "o--",
-            color="tab:blue",
-            lw=1,
-            ms=3,
-            mfc="none",
-            label="RMS, baseline",
-        )
-        top.plot(
-            spm, column("peak_motor_torque_Nm") / 1e3, "s-", color="tab:orange", lw=1.5, ms=4, label="peak, optimised"
-        )
-        top.plot(
-            spm,
-            column("baseline_peak_motor_torque_Nm") / 1e3,
-            "s--",
-            color="tab:orange",
-            lw=1,
-            ms=3,
-            mfc="none",
-            label="peak, baseline",
-        )
-        bottom.plot(spm, column("energy_kJ"), "o-", color="tab:green", lw=1.5, ms=4, label="optimised")
-        bottom.plot(
-            spm, column("baseline_energy_kJ"), "o--", color="tab:green", lw=1, ms=3, mfc="none", label="baseline"
-        )
+    curves = (  # axis, column, scale, marker, colour, label; each optimised (solid) and baseline (dashed)
+        (top, "rms_torque_Nm", 1e-3, "o", "tab:blue", "RMS"),
+        (top, "peak_motor_torque_Nm", 1e-3, "s", "tab:orange", "peak"),
+        (bottom, "energy_kJ", 1.0, "o", "tab:green", ""),
+    )
+    for ax, name, unit, marker, colour, what in curves if ok else ():
+        for prefix, style, label in (
+            ("", dict(lw=1.5, ms=4), "optimised"),
+            ("baseline_", dict(lw=1, ms=3, mfc="none"), "baseline"),
+        ):
+            ls = "-" if not prefix else "--"
+            ax.plot(
+                spm,
+                column(prefix + name) * unit,
+                marker + ls,
+                color=colour,
+                label=", ".join(filter(None, (what, label))),
+                **style,
+            )
     top.axhline(motor.rated_torque_Nm / 1e3, color="tab:blue", lw=1, ls=":", label="rated torque")
     top.axhline(motor.peak_torque_Nm / 1e3, color="tab:orange", lw=1, ls=":", label="peak torque")
     failed = [float(r["target_spm"]) for r in rows if r.get("status") != "verified"]

@@ -176,9 +176,8 @@ def _check_reachable(target: float, fastest: Solution, case: Case) -> None:
 
 
 def _rate_search(case: Case, placement: Placement, period: float) -> _Search:
-    """The drive NLP's search with the cycle time held at ``period`` [s] and every objective weight 0."""
-    search = _prepare(case, placement)
-    search.nlp = cycle_nlp(case.planner.motion_law, drive=True, rate=True)
+    """The rate NLP's search with the cycle time held at ``period`` [s] and every objective weight 0."""
+    search = _prepare(case, placement, cycle_nlp(case.planner.motion_law, drive=True, rate=True))
     search.parameters = search.parameters.copy()
     search.parameters[DRIVE_INDEX["target_period"]] = period
     search.parameters[DRIVE_INDEX["weight_period"]] = 0.0

@@ -25,7 +25,6 @@ verified densely like every other.
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import replace
 from functools import cache
 
@@ -50,7 +49,7 @@ from planning.solver.nlp import (
     _angle_at,
     _drive_constraints,
 )
-from planning.solver.optimize import MAX_TIME_S, Solution, _prepare, _Search, precheck, solve
+from planning.solver.optimize import MAX_TIME_S, Solution, _prepare, _Search, solve
 from planning.solver.outcomes import Infeasible
 from planning.solver.verify import verify
 from press.kinematics import height, height_derivatives
@@ -291,17 +290,8 @@ def solve_optimal(case: Case, neighbour: Plan | None = None) -> Solution:
         raise Infeasible(
             "the optimal law needs limits.crank_jerk_rad_s3 (the jerk it may use)", limit="limits.crank_jerk_rad_s3"
         )
-    t_start = time.perf_counter()
-    precheck(case)
-    search = _prepare(case.with_law(SEED_LAW), "free")  # the case's parameters and draw-speed range
-    search = replace(
-        search,
-        case=case,
-        nlp=optimal_nlp(case.drive is not None),
-        scale=variable_scales(case),
-        make_plan=make_plan,
-        t_start=t_start,
-    )
+    search = _prepare(case, "free", optimal_nlp(case.drive is not None))  # prechecks, parameters, w2 range
+    search.scale, search.make_plan = variable_scales(case), make_plan
     search.lbx, search.ubx = _bounds(case, search)
     if neighbour is not None and neighbour.motion_law == OPTIMAL and neighbour.nlp_values:
         if np.allclose(neighbour.key_angles, case.key_angles, rtol=0, atol=1e-12):

@@ -517,15 +517,16 @@ def _try_harder(search: _Search, neighbour: Plan | None) -> None:
     _multi_start(search, neighbour)
 
 
-def _prepare(case: Case, placement: Placement) -> _Search:
-    """Prechecks, the case's parameters, the variable bounds and scales, the law's compiled NLP."""
+def _prepare(case: Case, placement: Placement, nlp: CycleNLP | None = None) -> _Search:
+    """Prechecks, the case's parameters, the variable bounds and scales, the compiled NLP: ``nlp``, or by
+    default the case's law's (with the motor's rows when it has a drive)."""
     t_start = time.perf_counter()
     w2_lo, w2_hi = precheck(case)
     p = nlp_parameters(case)
     lbx, ubx = _bounds(case, w2_lo, w2_hi, p)
     lim = case.limits
     scale = variable_scales(case.press.crank_radius_mm, case.press.rod_length_mm, lim.slider_accel_mm_s2)
-    nlp = cycle_nlp(case.planner.motion_law, case.drive is not None)
+    nlp = nlp or cycle_nlp(case.planner.motion_law, case.drive is not None)
     return _Search(case, placement, nlp, p, lbx, ubx, scale, (w2_lo, w2_hi), t_start)
 
 
