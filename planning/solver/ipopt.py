@@ -47,6 +47,9 @@ WARM_START_OPTIONS = {  # a start from a nearby solution and its multipliers: a 
     "ipopt.warm_start_slack_bound_push": 1e-9,
 }
 
+# nlpsol's options that take a derivative function, and the name of that function in a built solver
+DERIVATIVE_FUNCTIONS = {"grad_f": "nlp_grad_f", "jac_g": "nlp_jac_g", "hess_lag": "nlp_hess_l"}
+
 
 class NLPStatus(enum.Enum):
     """How IPOPT ended, grouped by what it means for the caller."""
@@ -98,21 +101,33 @@ class NLPSolver:
 
     ``options`` are added to :data:`BASE_OPTIONS`; ``fixed_scale``: the scales of a problem built in
     scaled variables with its scales as constants (physical = fixed_scale * x); the warm-start
-    variant (same problem, IPOPT set up for a start from a nearby solution's multipliers) is built on
-    first use.
+    variant (same problem, IPOPT set up for a start from a nearby solution's multipliers, with
+    ``warm_options`` added to :data:`WARM_START_OPTIONS`) is built on first use.
     """
 
-    def __init__(self, name: str, problem: dict, options: dict | None = None, fixed_scale: np.ndarray | None = None):
+    def __init__(
+        self,
+        name: str,
+        problem: dict,
+        options: dict | None = None,
+        fixed_scale: np.ndarray | None = None,
+        warm_options: dict | None = None,
+    ):
         self.fixed_scale = None if fixed_scale is None else np.asarray(fixed_scale, dtype=float)
         self.name = name
         self.problem = problem
         self.options = {**BASE_OPTIONS, **(options or {})}
-        self._cold = ca.nlpsol(name, "ipopt", problem, self.options)
+        self.warm_options = {**WARM_START_OPTIONS, **(warm_options or {})}
+        self._cold = _compiled(name, problem, self.options)
         self._warm: ca.Function | None = None
 
     def _warm_function(self) -> ca.Function:
         if self._warm is None:
-            self._warm = ca.nlpsol(f"{self.name}_warm", "ipopt", self.problem, {**self.options, **WARM_START_OPTIONS})
+            # the same problem: its derivative functions are the cold solver's (generating them again would
+            # cost as much as the first build)
+            derivatives = {option: self._cold.get_function(name) for option, name in DERIVATIVE_FUNCTIONS.items()}
+            options = {**self.options, **self.warm_options, **derivatives}
+            self._warm = ca.nlpsol(f"{self.name}_warm", "ipopt", self.problem, options)
         return self._warm
 
     def solve(
@@ -169,6 +184,19 @@ class NLPSolver:
             iterations=int(stats["iter_count"]),
             wall_time_s=time.perf_counter() - t0,
         )
+
+
+def _compiled(name: str, problem: dict, options: dict) -> ca.Function:
+    """``nlpsol`` of ``problem``. An SX problem as it is. An MX problem (vector operations, cheap to
+    differentiate) is differentiated in MX; its constraint Jacobian, evaluated at every iteration, is then
+    expanded to SX, which evaluates it about three times faster; the Hessian stays in MX (its SX expansion
+    is larger and slower), and so do the functions (expanding them costs more to set up than it saves)."""
+    if not isinstance(problem["x"], ca.MX):
+        return ca.nlpsol(name, "ipopt", problem, options)
+    derived = ca.nlpsol(f"{name}_mx", "ipopt", problem, options)
+    supplied = {option: derived.get_function(function) for option, function in DERIVATIVE_FUNCTIONS.items()}
+    supplied["jac_g"] = supplied["jac_g"].expand()
+    return ca.nlpsol(name, "ipopt", problem, {**options, **supplied})
 
 
 def _call_passing_signals_on(solver: ca.Function, args: dict) -> dict:

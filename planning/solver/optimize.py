@@ -57,6 +57,7 @@ AGREE_S = 1e-6  # [s] two starts whose best periods agree this closely have foun
 POWER_SMOOTHING = 1e-3  # epsilon of the NLP's smooth max(P, 0), as a share of rated torque x base speed
 
 
+MOTOR_CHECKS = frozenset({CheckId.MOTOR_PEAK, CheckId.MOTOR_SPEED, CheckId.MOTOR_RMS})  # the drive's limits
 # the checks whose overshoot between the NLP's samples a re-solve with a lowered sampled limit removes
 REFINED = {
     CheckId.SLIDER_ACCEL: PARAMETER_INDEX["accel_limit"],
@@ -356,6 +357,8 @@ class _Search:
     score: Callable[[Plan], float] | None = None  # what "better" means, lower is better; None: the period
     make_plan: Callable[..., Plan] | None = None  # values -> Plan (None: a plan of the case's law's cycle)
     best_score: float = math.inf
+    stop_on: frozenset[CheckId] = frozenset()  # a converged plan failing one of these checks ends the search
+    stopped_by: Plan | None = None  # that plan
 
     def score_of(self, plan: Plan) -> float:
         """The plan's score: :attr:`score`, or its period [s]."""
@@ -392,6 +395,9 @@ class _Search:
                 return values, score
             bad = check.failures()
             self.attempts.append(Attempt(check=bad[0], case_field=CHECK_FIELDS.get(bad[0].id, "")))
+            if any(c.id in self.stop_on for c in bad):
+                self.stopped_by = plan
+                return None
             refinable = {cid: k for cid, k in REFINED.items() if k < q.size}  # the NLP's own limits
             if self.nlp.die_zone_rows is None:  # the kinematic NLP holds the die speed at the crossings only
                 refinable.pop(CheckId.DIE_SPEED)
@@ -426,6 +432,8 @@ class _Search:
                 continue  # the same start again would only repeat its answer
             tried.append(key)
             out = self.attempt(x0, placement)
+            if self.stopped_by is not None:
+                break
             if out is None:
                 continue
             found.append((out[1], out[0]))
@@ -491,30 +499,52 @@ def solve(
 def _kinematic_first(search: _Search, neighbour: Plan | None) -> bool:
     """A case with a drive: solve it first without the motor's rows (the kinematic NLP, smaller and
     faster). Its optimum is the drive problem's too when the motor can drive it, because the motor's
-    limits only take plans away; the dense verification (motor checks included) decides. Whether that
-    answered the case."""
+    limits only take plans away; the dense verification (motor checks included) decides. The first
+    converged plan the motor cannot drive ends this search: the drive NLP must answer then (a verified
+    kinematic plan found before stays a candidate). Whether this answered the case."""
     law = search.case.planner.motion_law
-    kinematic = replace(search, nlp=cycle_nlp(law, False), parameters=search.parameters[: len(PARAMETERS)], attempts=[])
+    kinematic = replace(
+        search,
+        nlp=cycle_nlp(law, False),
+        parameters=search.parameters[: len(PARAMETERS)],
+        attempts=[],
+        stop_on=MOTOR_CHECKS,
+    )
     _multi_start(kinematic, neighbour)
     search.iterations, search.starts = kinematic.iterations, kinematic.starts
     search.best, search.best_score = kinematic.best, kinematic.best_score
-    return search.best is not None
+    return search.best is not None and kinematic.stopped_by is None
 
 
-def _multi_start(search: _Search, neighbour: Plan | None) -> None:
-    """The published placement's starts, then (free placement) the free starts from its best plan."""
-    published = search.multi_start(_published_starts(search, neighbour), "published")
+def first_plan(case: Case, placement: Placement) -> Solution:
+    """A verified plan of ``case`` (max-SPM, a motion law), the first one the starts find (for the free
+    placement its own guesses first, then the published placement's way): a start for another NLP,
+    quicker than :func:`solve`, which also confirms the optimum by a second start."""
+    search = _prepare(case, placement)
+    if placement == "free":
+        search.multi_start(_free_starts(search, None, None), "free", confirm=False)
+    if search.best is None:
+        _multi_start(search, None, confirm=False)
+    if search.best is None:
+        _try_harder(search, None, confirm=False)
+    return search.answer()
+
+
+def _multi_start(search: _Search, neighbour: Plan | None, confirm: bool = True) -> None:
+    """The published placement's starts, then (free placement) the free starts from its best plan;
+    ``confirm``: see :meth:`_Search.multi_start`."""
+    published = search.multi_start(_published_starts(search, neighbour), "published", confirm)
     if search.placement == "free":
-        search.multi_start(_free_starts(search, neighbour, published), "free")
+        search.multi_start(_free_starts(search, neighbour, published), "free", confirm)
 
 
-def _try_harder(search: _Search, neighbour: Plan | None) -> None:
+def _try_harder(search: _Search, neighbour: Plan | None, confirm: bool = True) -> None:
     """No start verified: run them all once more with a wider back-off on the sampled slider
     acceleration (a plan of that slightly tighter problem meets this one's limits)."""
     index = PARAMETER_INDEX["accel_limit"]
     search.parameters = search.parameters.copy()
     search.parameters[index] *= (1 - HARDER_BACKOFF) / (1 - ACCEL_BACKOFF)
-    _multi_start(search, neighbour)
+    _multi_start(search, neighbour, confirm)
 
 
 def _prepare(case: Case, placement: Placement, nlp: CycleNLP | None = None) -> _Search:
