@@ -16,11 +16,11 @@ speed between the minimum and the top speed; |crank acceleration| <= its limit a
 piecewise linear); with a drive, the motor's limits as for the laws. Placement has no meaning: theta1
 and theta4 are where the phases meet.
 
-Initial guess: a seven-segment plan of the case under the same jerk limit (the first verified one, its
-optimum unconfirmed: a start needs no more), sampled on the phases' grids (the bound's profile has no
-jerk limit and is a poorer start); a neighbouring case's optimal plan
-(a sweep, a looser limit) starts first and, when it holds here, is a candidate answer. The plans are
-verified densely like every other.
+Initial guess: a seven-segment plan of the case under the same jerk limit (the first start of its NLP
+that converges, neither verified nor confirmed as the optimum: a start needs no more), sampled on the
+phases' grids (the bound's profile has no jerk limit and is a poorer start); a neighbouring case's
+optimal plan (a sweep, a looser limit) starts first and, when it holds here, is a candidate answer.
+The plans are verified densely like every other.
 """
 
 from __future__ import annotations
@@ -49,15 +49,20 @@ from planning.solver.nlp import (
     Rows,
     _drive_constraints,
 )
-from planning.solver.optimize import MAX_TIME_S, Solution, _prepare, _Search, first_plan
+from planning.solver.optimize import MAX_TIME_S, Solution, _prepare, _Search, converged_plan, solve
 from planning.solver.outcomes import Infeasible
 from planning.solver.verify import verify
 from press.kinematics import height, height_derivatives
 
 SEED_LAW = "seven-segment"  # a jerk-limited law whose plan starts the NLP
-SAMPLES_PER_SEGMENT = 4  # the knot and points at these fractions of each segment (limits are checked there)
-SAMPLE_FRACTIONS = (0.25, 0.5, 0.75)
+# the limits are held at every knot and at evenly spaced points inside each segment, this many per
+# segment (knot included) in each phase: the robot's window has the longest segments and the highest
+# speeds (around TDC, where the slider acceleration peaks), so it is sampled finer
+SAMPLES_PER_SEGMENT = {"return": 4, "transfer": 8, "feed": 4}
 STATES = ("angle", "speed", "accel")
+# relative: the sampled minimum crank speed is held this much above the limit (the speed is cubic between
+# the samples and may dip below them; the slowest point, near TDC, is usually at the limit)
+MIN_SPEED_BACKOFF = 1e-2
 # a re-solve with a refined limit starts nearer the optimum than the laws' (about half the iterations
 # with this barrier parameter; the laws keep the wrapper's, which finds their optima as before)
 WARM_OPTIONS = {"ipopt.mu_init": 1e-8}
@@ -141,11 +146,12 @@ def _build(drive: bool) -> CycleNLP:
         end = tuple(states[n - 1, i] for i in range(3))
         knots = [(th0, om0, al0), end]
         boundary.append(end[0] - ends[phase])
-        # samples in time order: every knot of the phase and SAMPLES_PER_SEGMENT - 1 points inside each segment
-        parts = [advance(th0, om0, al0, jerk, 0.0, h * f) for f in SAMPLE_FRACTIONS]
+        # samples in time order: every knot of the phase and the points inside each segment
+        fractions = [k / SAMPLES_PER_SEGMENT[phase] for k in range(1, SAMPLES_PER_SEGMENT[phase])]
+        parts = [advance(th0, om0, al0, jerk, 0.0, h * f) for f in fractions]
         samples.append(tuple(_interleave([(th0, om0, al0)[i], *(part[i] for part in parts)]) for i in range(3)))
         local = ca.DM(np.arange(n))
-        times.append(_interleave([t0 + local * h, *(t0 + (local + f) * h for f in SAMPLE_FRACTIONS)]))
+        times.append(_interleave([t0 + local * h, *(t0 + (local + f) * h for f in fractions)]))
         knot_accels.append(ca.vertcat(al0, knots[-1][2]))
         t0 = t0 + n * h
         start = knots[-1]
@@ -305,6 +311,8 @@ def solve_optimal(case: Case, neighbour: Plan | None = None) -> Solution:
     search = _prepare(case, "free", optimal_nlp(case.drive is not None))  # prechecks, parameters, w2 range
     search.scale, search.make_plan = variable_scales(case), make_plan
     search.lbx, search.ubx = _bounds(case, search)
+    search.parameters = search.parameters.copy()
+    search.parameters[PARAMETER_INDEX["min_crank_speed"]] *= 1 + MIN_SPEED_BACKOFF
     if neighbour is not None and neighbour.motion_law == OPTIMAL and neighbour.nlp_values:
         if np.allclose(neighbour.key_angles, case.key_angles, rtol=0, atol=1e-12):
             check = verify(neighbour, case)  # a neighbouring case's plan that holds here is an answer
@@ -312,8 +320,9 @@ def solve_optimal(case: Case, neighbour: Plan | None = None) -> Solution:
                 search.consider(Solution(neighbour, check), neighbour.period)
         if search.attempt(neighbour.nlp_values, "free") is not None:
             return search.answer()
-    seed = first_plan(case.with_law(SEED_LAW), "free")
-    search.iterations += seed.plan.solver.iterations
-    search.starts += seed.plan.solver.starts
-    search.multi_start([seed_values(seed.plan)], "free", confirm=False)
+    seeded = case.with_law(SEED_LAW)
+    seed = converged_plan(seeded) or solve(seeded, "free").plan
+    search.iterations += seed.solver.iterations
+    search.starts += seed.solver.starts
+    search.multi_start([seed_values(seed)], "free", confirm=False)
     return search.answer()

@@ -426,7 +426,7 @@ class _Search:
         best verified start."""
         found: list[tuple[float, dict[str, float]]] = []
         tried: list[np.ndarray] = []
-        for x0 in x0s:
+        for x0 in x0s if self.stopped_by is None else ():
             key = np.array([x0[k] for k, _ in self.nlp.variables])
             if any(np.allclose(key, other, rtol=1e-9, atol=1e-12) for other in tried):
                 continue  # the same start again would only repeat its answer
@@ -516,35 +516,35 @@ def _kinematic_first(search: _Search, neighbour: Plan | None) -> bool:
     return search.best is not None and kinematic.stopped_by is None
 
 
-def first_plan(case: Case, placement: Placement) -> Solution:
-    """A verified plan of ``case`` (max-SPM, a motion law), the first one the starts find (for the free
-    placement its own guesses first, then the published placement's way): a start for another NLP,
-    quicker than :func:`solve`, which also confirms the optimum by a second start."""
-    search = _prepare(case, placement)
-    if placement == "free":
-        search.multi_start(_free_starts(search, None, None), "free", confirm=False)
-    if search.best is None:
-        _multi_start(search, None, confirm=False)
-    if search.best is None:
-        _try_harder(search, None, confirm=False)
-    return search.answer()
+def converged_plan(case: Case) -> Plan | None:
+    """The plan of the first free-placement start of ``case``'s law (max-SPM) that converges, not verified
+    and not refined: a start for another NLP (the optimal law's), far quicker than :func:`solve`. None
+    when no start converges."""
+    search = _prepare(case, "free")
+    for x0 in _free_starts(search, None, None):
+        res = search.nlp.solve(x0, search.parameters, search.lbx, search.ubx, "free", search.scale)
+        search.iterations += res.iterations
+        search.starts += 1
+        if res.success:
+            info = SolverInfo(search.iterations, time.perf_counter() - search.t_start, search.starts, res.return_status)
+            return _plan(case, search.nlp.values_of(res), "free", info)
+    return None
 
 
-def _multi_start(search: _Search, neighbour: Plan | None, confirm: bool = True) -> None:
-    """The published placement's starts, then (free placement) the free starts from its best plan;
-    ``confirm``: see :meth:`_Search.multi_start`."""
-    published = search.multi_start(_published_starts(search, neighbour), "published", confirm)
+def _multi_start(search: _Search, neighbour: Plan | None) -> None:
+    """The published placement's starts, then (free placement) the free starts from its best plan."""
+    published = search.multi_start(_published_starts(search, neighbour), "published")
     if search.placement == "free":
-        search.multi_start(_free_starts(search, neighbour, published), "free", confirm)
+        search.multi_start(_free_starts(search, neighbour, published), "free")
 
 
-def _try_harder(search: _Search, neighbour: Plan | None, confirm: bool = True) -> None:
+def _try_harder(search: _Search, neighbour: Plan | None) -> None:
     """No start verified: run them all once more with a wider back-off on the sampled slider
     acceleration (a plan of that slightly tighter problem meets this one's limits)."""
     index = PARAMETER_INDEX["accel_limit"]
     search.parameters = search.parameters.copy()
     search.parameters[index] *= (1 - HARDER_BACKOFF) / (1 - ACCEL_BACKOFF)
-    _multi_start(search, neighbour, confirm)
+    _multi_start(search, neighbour)
 
 
 def _prepare(case: Case, placement: Placement, nlp: CycleNLP | None = None) -> _Search:
