@@ -280,10 +280,14 @@ def _write_and_report(out: Path, writers: dict, data: dict, text: str, args, own
     return EXIT_OK
 
 
+def _load_plots() -> None:
+    """Load the plotting module (matplotlib: about a second) while the workers solve, not before them."""
+    import planning.reports.plots  # noqa: F401
+
+
 def _sweep(case, args) -> int:
     import planning.solver.optimize  # noqa: F401 - loaded once here, inherited by forked workers
     from planning.reports.folder import ensure_writable
-    from planning.reports.plots import save, sweep_figure
     from planning.sweep import parse_vary, run_sweep
 
     varies = [parse_vary(v) for v in args.vary]
@@ -299,9 +303,13 @@ def _sweep(case, args) -> int:
             bar = "#" * int(30 * done / total)
             print(f"\rsweep [{bar:<30}] {done}/{total} points, {failed} without a plan", end="", file=sys.stderr)
 
-    result = run_sweep(base, args.case, varies, out, args.workers, args.scheduler, args.placement, progress)
+    result = run_sweep(
+        base, args.case, varies, out, args.workers, args.scheduler, args.placement, progress, _load_plots
+    )
     if tty:
         print(file=sys.stderr)
+    from planning.reports.plots import save, sweep_figure
+
     rows = result.rows
     verified = sum(r["status"] == "verified" for r in rows)
     if len(varies) <= 2:
@@ -319,7 +327,6 @@ def _tradeoff(case, args) -> int:
     import planning.solver.optimize  # noqa: F401 - loaded once here, inherited by forked workers
     from planning.model.case import CaseError
     from planning.reports.folder import TRADEOFF_FILES, write_atomic
-    from planning.reports.plots import save, tradeoff_figure
     from planning.tradeoff import COLUMNS, parse_rates, run_tradeoff, table_text, write_rows
 
     rates = parse_rates(args.spm)
@@ -333,7 +340,9 @@ def _tradeoff(case, args) -> int:
     except CaseError as exc:
         raise CommandError(f"{args.case}: {exc.line()}") from None
     out = _output_folder(case, args, TRADEOFF_FILES)
-    result = run_tradeoff(case, rates, args.workers, args.scheduler, args.placement)
+    result = run_tradeoff(case, rates, args.workers, args.scheduler, args.placement, _load_plots)
+    from planning.reports.plots import save, tradeoff_figure
+
     title = f"{case.name}: {objective} at the line's rate ({case.planner.motion_law})"
     writers = {
         "tradeoff.csv": lambda p: write_rows(p, result.rows, COLUMNS),

@@ -304,8 +304,10 @@ def run_sweep(
     scheduler: str | None = None,
     placement: str | None = None,
     progress: Callable[[int, int, int], None] | None = None,
+    meanwhile: Callable[[], object] | None = None,
 ) -> SweepResult:
-    """Solve the grid into ``out/sweep.csv`` (resuming what an earlier run of the same sweep wrote)."""
+    """Solve the grid into ``out/sweep.csv`` (resuming what an earlier run of the same sweep wrote);
+    ``meanwhile``: see :func:`execute`."""
     fields = [v.field for v in varies]
     points = grid(varies)
     out.mkdir(parents=True, exist_ok=True)
@@ -332,7 +334,7 @@ def run_sweep(
         if new_file:
             writer.writeheader()
         work = [(base, fields, blk, placement, label) for blk in blocks(pending, points)]
-        for rows in execute(solve_block, work, workers, scheduler):
+        for rows in execute(solve_block, work, workers, scheduler, meanwhile):
             for row in rows:
                 writer.writerow({k: _cell(row.get(k)) for k in columns})
                 fresh[row["index"]] = row
@@ -364,11 +366,17 @@ def _cell(value: Any) -> Any:
 
 
 def execute(
-    task: Callable[..., list[dict[str, Any]]], work: list[tuple], workers: int = 2, scheduler: str | None = None
+    task: Callable[..., list[dict[str, Any]]],
+    work: list[tuple],
+    workers: int = 2,
+    scheduler: str | None = None,
+    meanwhile: Callable[[], object] | None = None,
 ) -> Iterator[list[dict[str, Any]]]:
     """``task(*args)`` for every ``args`` of ``work``, results as they finish: in this process (1
     worker), a pool of local processes, or a Dask distributed cluster at ``scheduler``. Ctrl-C and
-    SIGTERM end every worker process with the parent's."""
+    SIGTERM end every worker process with the parent's. ``meanwhile``: called in this process once the
+    work is with the workers (the local ones forked), while it would only wait (e.g. loading the
+    plotting library for the figure that follows)."""
     if not work:
         return
     if scheduler:
@@ -382,6 +390,8 @@ def execute(
             raise SweepError(f"--scheduler: cannot reach {scheduler} ({exc})") from None
         try:
             futures = [client.submit(task, *args, pure=False) for args in work]
+            if meanwhile is not None:
+                meanwhile()
             for fut in as_completed(futures):
                 yield fut.result()
         finally:
@@ -398,6 +408,8 @@ def execute(
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_signals)
     try:
         futures = [pool.submit(task, *args) for args in work]
+        if meanwhile is not None:
+            meanwhile()
         for fut in as_completed(futures):
             yield fut.result()
     except BaseException:  # Ctrl-C, SIGTERM, a failed write: no worker outlives the run

@@ -13,6 +13,7 @@ from __future__ import annotations
 import csv
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -161,8 +162,10 @@ def run_tradeoff(
     workers: int = 2,
     scheduler: str | None = None,
     placement: Placement | None = None,
+    meanwhile: Callable[[], object] | None = None,
 ) -> TradeoffResult:
-    """One plan per rate at ``case.planner.objective`` (min-rms-torque or min-energy)."""
+    """One plan per rate at ``case.planner.objective`` (min-rms-torque or min-energy); ``meanwhile``: see
+    ``planning.sweep.execute``."""
     from planning.solver.nlp import cycle_nlp
     from planning.solver.optimize import solve
 
@@ -173,7 +176,7 @@ def run_tradeoff(
     size = max(1, math.ceil(len(order) / max(1, workers)))  # one contiguous block per worker
     work = [(case, placement, fastest, order[k : k + size]) for k in range(0, len(order), size)]
     rows: dict[int, dict[str, Any]] = {}
-    for block in execute(rate_block, work, workers, scheduler):
+    for block in execute(rate_block, work, workers, scheduler, meanwhile):
         for row in block:
             rows[row["index"]] = row
     return TradeoffResult([rows[i] for i in sorted(rows)], fastest, case.planner.objective)

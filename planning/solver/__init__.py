@@ -1,3 +1,15 @@
 """Solving: the cycle NLP of each motion law and the time-optimal bound (CasADi expressions), the
 IPOPT wrapper, the orchestrator of named steps, the independent dense verification and the typed
-outcomes."""
+outcomes.
+
+IPOPT's linear solver calls the OpenBLAS that CasADi ships, which starts a thread per core. The
+systems here are small (at most a few thousand rows), so the threads only contend: a solve is 10-25 %
+faster on one, and a sweep's or trade-off's worker processes, each with a thread per core, would
+oversubscribe the cores (a 7-rate trade-off on 2 workers took 16 s instead of 10 s). OpenBLAS reads
+its thread count when CasADi's IPOPT plugin loads it, at the first solver built; a value set by the
+user is kept.
+"""
+
+import os
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")

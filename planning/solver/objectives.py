@@ -17,7 +17,8 @@ the target rate the way a controller does, with the spare time spent at the tran
 target cycle time, the plan with the longest constant-speed transfer dwell (every other limit as
 before), started from the fastest plan run slower (every speed divided and every time multiplied by
 the ratio of the cycle times, so the key angles stay put); then the objective, started from a
-neighbouring rate's plan, the baseline (feasible at the rate) and the slowed fastest plan. The answer
+neighbouring rate's plan, the slowed fastest plan and the baseline (feasible at the rate, but from it
+IPOPT often crawls for hundreds of iterations where the baseline's dwell is long). The answer
 is the verified plan with the lowest exact objective; the baseline is one candidate, so the answer
 never does worse than waiting, and ``AtRate.improved`` says whether a solve beat it.
 """
@@ -106,7 +107,7 @@ def solve_at_rate(
     ``fastest``: the case's max-SPM solution when the caller has it (a trade-off computes it once);
     ``neighbour`` / ``neighbour_baseline``: the plan and baseline of a neighbouring rate (warm starts).
     ``confirm``: run the objective's starts until two agree on the optimum (else the first verified
-    start, from the baseline, is the answer: a trade-off's speed).
+    start is the answer: a trade-off's speed).
     """
     placement = placement or case.planner.placement
     objective, target = case.planner.objective, case.planner.target_spm
@@ -132,7 +133,7 @@ def solve_at_rate(
         search.parameters[DRIVE_INDEX["weight_heat"]] = HEAT_TIE_BREAK * heat_weight
     search.score = lambda plan: objective_value(rate_figures(plan, case), objective) / scale
     search.consider(baseline, 1.0)
-    starts = [baseline.plan.nlp_values, _slowed(fastest.plan, period / fastest.plan.period, search)]
+    starts = [_slowed(fastest.plan, period / fastest.plan.period, search), baseline.plan.nlp_values]
     _run_starts(search, starts, neighbour, placement, confirm)
     improved = search.best is not baseline
     answer = search.answer()
