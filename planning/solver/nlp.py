@@ -132,7 +132,8 @@ CYCLE_OPTIONS = {  # added to the wrapper's base options
 RATE_OPTIONS = {"ipopt.tol": 1e-6}
 # the drive NLPs' rows (the motor torque at every sample, the RMS integral) depend on every variable: with
 # MUMPS's approximate-minimum-degree ordering an iteration takes 20-30 % less time than with its automatic
-# choice (measured); the kinematic NLP keeps the automatic choice (with AMD it needs more iterations)
+# choice (measured; the optimal law's NLP uses it too); the kinematic NLP keeps the automatic choice (with
+# AMD it needs more iterations)
 DRIVE_OPTIONS = {"ipopt.mumps_pivot_order": 0}
 SAMPLES_PER_SUBSEGMENT = 5
 SAMPLES_CONSTANT = 20
