@@ -200,16 +200,23 @@ class Rows:
         return np.array(self.lb), np.array(self.ub)
 
 
+def clipped_advance(tau, theta_start, omega_start, omega0, alpha0, j0, j1) -> tuple:  # noqa: ANN001 - SX or MX
+    """Crank angle and speed after consecutive linear-jerk segments with start speeds ``omega0``,
+    accelerations ``alpha0`` and jerks ``j0 + j1 tau`` (vectors), each run for its ``tau`` (the time
+    clipped to the segment: 0 before it, its duration after it), from ``theta_start``, ``omega_start``."""
+    th, om, _, _ = advance(0.0, omega0, alpha0, j0, j1, tau)
+    return theta_start + ca.sum1(th), omega_start + ca.sum1(om - omega0)
+
+
 def _angle_at(t: ca.SX, starts: list, states: list, segs: list[Segment]) -> tuple[ca.SX, ca.SX]:
     """Closed-form crank angle and speed at time ``t`` [s] over the segments (clip formulation): the
     linear-jerk parts as one vector, the shape terms of shaped segments added one by one."""
     T = ca.vertcat(*[seg.duration for seg in segs])
-    tau = ca.fmin(ca.fmax(t - ca.vertcat(*starts), 0), T)
     omega0 = ca.vertcat(*[st[1] for st in states])
     alpha0 = ca.vertcat(*[st[2] for st in states])
     j0, j1 = ca.vertcat(*[seg.j0 for seg in segs]), ca.vertcat(*[seg.j1 for seg in segs])
-    th, om, _, _ = advance(0.0, omega0, alpha0, j0, j1, tau)
-    theta, omega = states[0][0] + ca.sum1(th), states[0][1] + ca.sum1(om - omega0)
+    tau = ca.fmin(ca.fmax(t - ca.vertcat(*starts), 0), T)
+    theta, omega = clipped_advance(tau, states[0][0], states[0][1], omega0, alpha0, j0, j1)
     for k, seg in enumerate(segs):
         if seg.shape is not None:
             dth, dom, _, _ = shape_part(seg, tau[k])

@@ -49,6 +49,7 @@ from planning.solver.nlp import (
     CycleNLP,
     Rows,
     _drive_constraints,
+    clipped_advance,
 )
 from planning.solver.optimize import MAX_TIME_S, Solution, _prepare, _Search, converged_plan, solve
 from planning.solver.outcomes import Infeasible
@@ -136,16 +137,12 @@ def _build(drive: bool) -> CycleNLP:
         if phase in ("return", "feed"):  # the die-height crossing of this phase, in closed form (clip)
             when = v["die_up_time" if phase == "return" else "die_down_time"]
             tau = ca.fmin(ca.fmax(when - h * ca.DM(np.arange(n)), 0), h)
-            th_part, om_part, _, _ = advance(0.0, om0, al0, jerk, 0.0, tau)
-            angle = start[0] + ca.sum1(th_part)
-            speed = start[1] + ca.sum1(om_part - om0)
-            crossings[phase] = ((angle, speed), when, n * h)
+            crossings[phase] = (clipped_advance(tau, start[0], start[1], om0, al0, jerk, 0.0), when, n * h)
         th1, om1, al1, _ = advance(th0, om0, al0, jerk, 0.0, h)
         shooting.append(
             ca.vertcat(th1 - nxt[0], (om1 - nxt[1]) / unit["draw_speed"], (al1 - nxt[2]) / unit[f"{phase}_accel_1"])
         )
         end = tuple(states[n - 1, i] for i in range(3))
-        knots = [(th0, om0, al0), end]
         boundary.append(end[0] - ends[phase])
         # samples in time order: every knot of the phase and the points inside each segment
         fractions = [k / SAMPLES_PER_SEGMENT[phase] for k in range(1, SAMPLES_PER_SEGMENT[phase])]
@@ -153,9 +150,9 @@ def _build(drive: bool) -> CycleNLP:
         samples.append(tuple(_interleave([(th0, om0, al0)[i], *(part[i] for part in parts)]) for i in range(3)))
         local = ca.DM(np.arange(n))
         times.append(_interleave([t0 + local * h, *(t0 + (local + f) * h for f in fractions)]))
-        knot_accels.append(ca.vertcat(al0, knots[-1][2]))
+        knot_accels.append(ca.vertcat(al0, end[2]))
         t0 = t0 + n * h
-        start = knots[-1]
+        start = end
     add("segments join (closed form)", ca.vertcat(*shooting), 0.0, 0.0)
     add("key angles", ca.vertcat(*boundary[:2]), 0.0, 0.0)
     add(

@@ -358,7 +358,7 @@ class _Search:
     make_plan: Callable[..., Plan] | None = None  # values -> Plan (None: a plan of the case's law's cycle)
     best_score: float = math.inf
     stop_on: frozenset[CheckId] = frozenset()  # a converged plan failing one of these checks ends the search
-    stopped_by: Plan | None = None  # that plan
+    stopped: bool = False  # it did
 
     def score_of(self, plan: Plan) -> float:
         """The plan's score: :attr:`score`, or its period [s]."""
@@ -396,7 +396,7 @@ class _Search:
             bad = check.failures()
             self.attempts.append(Attempt(check=bad[0], case_field=CHECK_FIELDS.get(bad[0].id, "")))
             if any(c.id in self.stop_on for c in bad):
-                self.stopped_by = plan
+                self.stopped = True
                 return None
             refinable = {cid: k for cid, k in REFINED.items() if k < q.size}  # the NLP's own limits
             if self.nlp.die_zone_rows is None:  # the kinematic NLP holds the die speed at the crossings only
@@ -426,14 +426,14 @@ class _Search:
         best verified start."""
         found: list[tuple[float, dict[str, float]]] = []
         tried: list[np.ndarray] = []
-        for x0 in x0s if self.stopped_by is None else ():
+        for x0 in x0s:
+            if self.stopped:
+                break
             key = np.array([x0[k] for k, _ in self.nlp.variables])
             if any(np.allclose(key, other, rtol=1e-9, atol=1e-12) for other in tried):
                 continue  # the same start again would only repeat its answer
             tried.append(key)
             out = self.attempt(x0, placement)
-            if self.stopped_by is not None:
-                break
             if out is None:
                 continue
             found.append((out[1], out[0]))
@@ -513,7 +513,7 @@ def _kinematic_first(search: _Search, neighbour: Plan | None) -> bool:
     _multi_start(kinematic, neighbour)
     search.iterations, search.starts = kinematic.iterations, kinematic.starts
     search.best, search.best_score = kinematic.best, kinematic.best_score
-    return search.best is not None and kinematic.stopped_by is None
+    return search.best is not None and not kinematic.stopped
 
 
 def converged_plan(case: Case) -> Plan | None:
