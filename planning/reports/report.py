@@ -32,7 +32,6 @@ TRAJECTORY_COLUMNS = (
     "slider_accel_mm_s2",
 )
 DRIVE_COLUMNS = ("crank_torque_Nm", "motor_speed_rpm", "motor_torque_Nm", "motor_power_kW")  # with a drive
-BINDING_SHARE = 1e-4  # a check within this share of its limit is reported as binding
 MAX_ROWS = 200_000  # trajectory rows at most: a cycle longer than 200 s gets a step of period / MAX_ROWS
 
 
@@ -112,12 +111,8 @@ def segments(solution: Solution) -> list[dict[str, Any]]:
 
 
 def binding(solution: Solution) -> list[str]:
-    """Names of the inequality checks that sit at their limit (within :data:`BINDING_SHARE`)."""
-    out = []
-    for c in solution.verification.checks:
-        if c.kind in ("max", "min") and abs(c.margin) <= BINDING_SHARE * max(abs(c.limit), 1e-12):
-            out.append(c.name)
-    return out
+    """Names of the inequality checks that sit at their limit (``Check.binds``)."""
+    return [c.name for c in solution.verification.binding()]
 
 
 def result_dict(solution: Solution, case: Case) -> dict[str, Any]:

@@ -25,6 +25,7 @@ never does worse than waiting, and ``AtRate.improved`` says whether a solve beat
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 from planning.model.case import Case, Placement
@@ -38,7 +39,7 @@ from planning.solver.verify import CHECK_FIELDS
 RATE_TOLERANCE = 1e-9  # relative: a target this close above the fastest rate is that rate
 SAME_PERIOD_S = 1e-9  # [s] a plan whose period is this close to the target cycle time runs at the rate
 HEAT_TIE_BREAK = 1e-3  # min-energy: the heat's weight against the energy's (both normalised by the baseline's)
-BINDING_SHARE = 1e-4  # a check within this share of its limit binds (as in the reports)
+BASELINE_SCORE = 1.0  # the objective's score of the baseline (the objectives are normalised by its figures)
 
 
 @dataclass(frozen=True)
@@ -132,9 +133,9 @@ def solve_at_rate(
         search.parameters[DRIVE_INDEX["weight_energy"]] = 1.0 / (base_figures.energy_kJ * 1e3)
         search.parameters[DRIVE_INDEX["weight_heat"]] = HEAT_TIE_BREAK * heat_weight
     search.score = lambda plan: objective_value(rate_figures(plan, case), objective) / scale
-    search.consider(baseline, 1.0)
+    search.consider(baseline, BASELINE_SCORE)
     starts = [_slowed(fastest.plan, period / fastest.plan.period, search), baseline.plan.nlp_values]
-    _run_starts(search, starts, neighbour, placement, confirm)
+    _run_starts(search, starts, neighbour, placement, confirm, to_beat=BASELINE_SCORE)
     improved = search.best is not baseline
     answer = search.answer()
     info = answer.plan.solver
@@ -161,11 +162,7 @@ def _check_reachable(target: float, fastest: Solution, case: Case) -> None:
     """:class:`Infeasible` when the target rate is above what the limits allow, naming the ones that bind."""
     if target <= fastest.plan.spm * (1 + RATE_TOLERANCE):
         return
-    binding = [
-        CHECK_FIELDS.get(c.id, c.name)
-        for c in fastest.verification.checks
-        if c.kind in ("max", "min") and abs(c.margin) <= BINDING_SHARE * max(abs(c.limit), 1e-12)
-    ]
+    binding = [CHECK_FIELDS.get(c.id, c.name) for c in fastest.verification.binding()]
     named = ", ".join(dict.fromkeys(binding)) or "the key points and limits together"
     raise Infeasible(
         f"planner.target_spm = {target:g} is above the {fastest.plan.spm:.3f} strokes/min the limits allow "
@@ -220,12 +217,20 @@ def _slowed(plan: Plan, factor: float, search: _Search) -> dict[str, float]:
 
 
 def _run_starts(
-    search: _Search, starts: list[dict[str, float]], neighbour: Plan | None, placement: Placement, confirm: bool
+    search: _Search,
+    starts: list[dict[str, float]],
+    neighbour: Plan | None,
+    placement: Placement,
+    confirm: bool,
+    to_beat: float = math.inf,
 ) -> None:
-    """A neighbouring rate's plan alone when it leads to a verified plan (a trade-off following its rates,
-    as a sweep does), else the ``starts`` until two agree (``confirm``) or one verifies."""
+    """A neighbouring rate's plan alone when it leads to a verified plan scoring below ``to_beat`` (a
+    trade-off following its rates, as a sweep does; the objective's ``to_beat`` is the baseline's score:
+    a neighbour's start can end in a local optimum worse than waiting), else the ``starts`` until two
+    agree (``confirm``) or one verifies."""
     fits = neighbour is not None and bool(neighbour.nlp_values)
     if fits and (placement == "free" or neighbour.placement == placement):
-        if search.attempt(neighbour.nlp_values, placement) is not None:
+        found = search.attempt(neighbour.nlp_values, placement)
+        if found is not None and found[1] < to_beat:
             return
     search.multi_start(starts, placement, confirm)

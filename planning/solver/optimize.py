@@ -5,10 +5,11 @@ peak speeds near the constant-speed acceleration bound, and half durations that 
 between the key points (the same for every motion law: each half of every law sweeps
 ``D (v_start + v_end) / 2``). The NLP is the one of the case's motion law (``planner.motion_law``).
 ``free`` placement starts also from the ``published`` placement's solution, so it is never worse
-than that structure, and keeps the best plan that verifies. A case with a drive is solved first
-without the motor's rows; that optimum is the answer when the motor can drive it (the motor's limits
-only take plans away), else the drive NLP runs. Without a verified plan the answer is a typed
-outcome (``planning.solver.outcomes``).
+than that structure, and keeps the best plan that verifies. A case with a drive starts with one
+probe of the drive NLP (the first published start): where the motor limits that plan, the drive NLP
+answers; else the case is solved without the motor's rows, and that optimum is the answer when the
+motor can drive it (the motor's limits only take plans away), else the drive NLP runs. Without a
+verified plan the answer is a typed outcome (``planning.solver.outcomes``).
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -67,6 +68,13 @@ REFINED = {
     CheckId.MOTOR_PEAK: DRIVE_INDEX["motor_peak"],
     CheckId.MOTOR_RMS: DRIVE_INDEX["motor_rms"],
 }
+
+
+class Ran(NamedTuple):
+    """A start already solved: its ``start`` values and what it ``found`` (verified values and score), or None."""
+
+    start: dict[str, float]
+    found: tuple[dict[str, float], float] | None
 
 
 @dataclass(frozen=True)
@@ -413,23 +421,28 @@ class _Search:
                     q[refinable[c.id]] *= (c.limit / c.value) * (1 - REFINE_MARGIN)
         return None
 
+    def key(self, values: dict[str, float]) -> np.ndarray:
+        """``values`` as the NLP's variable vector (to compare starts)."""
+        return np.array([values[k] for k, _ in self.nlp.variables])
+
     def consider(self, solution: Solution, score: float) -> None:
         """Keep ``solution`` (verified) when its ``score`` beats the best so far."""
         if self.best is None or score < self.best_score - 1e-9:
             self.best, self.best_score = solution, score
 
     def multi_start(
-        self, x0s: list[dict[str, float]], placement: Placement, confirm: bool = True
+        self, x0s: list[dict[str, float]], placement: Placement, confirm: bool = True, ran: tuple[Ran, ...] = ()
     ) -> dict[str, float] | None:
         """Run the starts in order until the two best verified ones agree on the score (the optimum
         is confirmed; ``confirm`` False: until one verifies) or the starts run out; the values of the
-        best verified start."""
-        found: list[tuple[float, dict[str, float]]] = []
-        tried: list[np.ndarray] = []
+        best verified start. ``ran``: starts of this placement already solved (the drive's probe): they
+        are not run again, and what they found counts."""
+        found = sorted(((r.found[1], r.found[0]) for r in ran if r.found is not None), key=lambda item: item[0])
+        tried = [self.key(r.start) for r in ran]
         for x0 in x0s:
             if self.stopped:
                 break
-            key = np.array([x0[k] for k, _ in self.nlp.variables])
+            key = self.key(x0)
             if any(np.allclose(key, other, rtol=1e-9, atol=1e-12) for other in tried):
                 continue  # the same start again would only repeat its answer
             tried.append(key)
@@ -488,20 +501,34 @@ def solve(
     neighbour = _adopt(search, neighbour)
     if follow and _follow(search, neighbour):
         return search.answer()
-    if case.drive is not None and search.best is None and _kinematic_first(search, neighbour):
-        return search.answer()
-    _multi_start(search, neighbour)
+    ran: tuple[Ran, ...] = ()
+    if case.drive is not None and search.best is None:
+        ran = _probe(search, neighbour)
+        if _kinematic_first(search, neighbour, ran):
+            return search.answer()
+    _multi_start(search, neighbour, ran)
     if search.best is None:
         _try_harder(search, neighbour)
     return search.answer()
 
 
-def _kinematic_first(search: _Search, neighbour: Plan | None) -> bool:
-    """A case with a drive: solve it first without the motor's rows (the kinematic NLP, smaller and
-    faster). Its optimum is the drive problem's too when the motor can drive it, because the motor's
+def _probe(search: _Search, neighbour: Plan | None) -> tuple[Ran, ...]:
+    """A case with a drive: the drive NLP from the first published start, to learn whether the motor
+    limits the plan (:func:`_kinematic_first`)."""
+    start = _published_starts(search, neighbour)[0]
+    return (Ran(start, search.attempt(start, "published")),)
+
+
+def _kinematic_first(search: _Search, neighbour: Plan | None, ran: tuple[Ran, ...]) -> bool:
+    """A case with a drive whose motor did not bind at the ``ran`` probe (or the probe found no plan):
+    solve it without the motor's rows (the kinematic NLP, smaller and faster), counting the probe's
+    plan. Its optimum is the drive problem's too when the motor can drive it, because the motor's
     limits only take plans away; the dense verification (motor checks included) decides. The first
     converged plan the motor cannot drive ends this search: the drive NLP must answer then (a verified
     kinematic plan found before stays a candidate). Whether this answered the case."""
+    if search.best is not None and any(c.id in MOTOR_CHECKS for c in search.best.verification.binding()):
+        return False  # the motor limits the probe's plan: the drive NLP answers
+    ran = tuple(r for r in ran if r.found is not None)  # the probe's start once more without the motor's rows
     law = search.case.planner.motion_law
     kinematic = replace(
         search,
@@ -510,7 +537,7 @@ def _kinematic_first(search: _Search, neighbour: Plan | None) -> bool:
         attempts=[],
         stop_on=MOTOR_CHECKS,
     )
-    _multi_start(kinematic, neighbour)
+    _multi_start(kinematic, neighbour, ran)
     search.iterations, search.starts = kinematic.iterations, kinematic.starts
     search.best, search.best_score = kinematic.best, kinematic.best_score
     return search.best is not None and not kinematic.stopped
@@ -531,9 +558,10 @@ def converged_plan(case: Case) -> Plan | None:
     return None
 
 
-def _multi_start(search: _Search, neighbour: Plan | None) -> None:
-    """The published placement's starts, then (free placement) the free starts from its best plan."""
-    published = search.multi_start(_published_starts(search, neighbour), "published")
+def _multi_start(search: _Search, neighbour: Plan | None, ran: tuple[Ran, ...] = ()) -> None:
+    """The published placement's starts (but those ``ran`` before), then (free placement) the free starts
+    from its best plan."""
+    published = search.multi_start(_published_starts(search, neighbour), "published", ran=ran)
     if search.placement == "free":
         search.multi_start(_free_starts(search, neighbour, published), "free")
 

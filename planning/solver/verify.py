@@ -24,6 +24,7 @@ TIME_TOL = 1e-6  # [s] transfer time
 SPEED_TOL = 1e-9  # [rad/s] continuity and constant-speed draw
 ENERGY_REL_TOL = 1e-6  # energy balance, relative to the larger of the forming work and integral |T_c omega| dt
 CONTINUITY_TOL = 1e-9  # [rad/s, rad/s^2] jump allowed at a knot (beyond the O(eps^2) remainder)
+BINDING_SHARE = 1e-4  # relative: a check within this share of its limit binds (the reports' binding list)
 
 
 class CheckId(str, enum.Enum):
@@ -92,6 +93,11 @@ class Check:
             return self.value - self.limit
         return -abs(self.value - self.limit)
 
+    @property
+    def binds(self) -> bool:
+        """An inequality that sits at its limit, within :data:`BINDING_SHARE` of it."""
+        return self.kind in ("max", "min") and abs(self.margin) <= BINDING_SHARE * max(abs(self.limit), 1e-12)
+
     def as_dict(self) -> dict:
         """The check as ``result.json`` writes it (display name, value, limit, unit, kind, passed, margin)."""
         out = asdict(self)
@@ -113,6 +119,10 @@ class Verification:
 
     def failures(self) -> list[Check]:
         return [c for c in self.checks if not c.passed]
+
+    def binding(self) -> list[Check]:
+        """The checks at their limits (:attr:`Check.binds`)."""
+        return [c for c in self.checks if c.binds]
 
 
 def dense_times(period: float, knot_times: np.ndarray, max_step: float = MAX_STEP_S) -> np.ndarray:
