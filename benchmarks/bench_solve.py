@@ -1,6 +1,7 @@
 """Speed of the published case; writes benchmarks/RESULTS.md.
 
-Measures (a) the in-process solve after a warm-up (the NLP already built), a cold ``pressplan solve``
+Measures (a) the in-process solve after a warm-up (the NLP already built; taking turns with the
+drive cases' solves, whose times it divides), a cold ``pressplan solve``
 process beside a process that only imports casadi, numpy, matplotlib and yaml, and the NLP build
 alone; (b) a 41-point transfer-time sweep with 1 and 2 workers (whole process, points per second);
 (c) a 7-point trade-off (``pressplan tradeoff``) on both drive cases with 2 workers; (d) the SPM of
@@ -48,11 +49,15 @@ def main() -> None:
     _build("improved-s-curve")
     build = time.perf_counter() - t
     first = solve(case)  # warm-up: builds the cached NLP
-    warm = []
-    for _ in range(WARM_RUNS):
-        t = time.perf_counter()
-        sol = solve(case)
-        warm.append(time.perf_counter() - t)
+    drive_case = read_case(DRIVE_CASE)
+    strong = drive_case.model_dump(exclude_none=True)  # the same press with motors ten times as strong
+    for key in ("peak_torque_Nm", "rated_torque_Nm"):
+        strong["drive"]["motor"][key] *= 10
+    from planning.model.case_file import case_from_data
+
+    (warm, sol), (drive_warm, drive_sol), (strong_warm, _) = _interleaved(
+        [case, drive_case, case_from_data(strong)], solve
+    )
     assert sol.verification.passed and abs(sol.plan.spm - first.plan.spm) < 1e-9
 
     exe = Path(sys.executable).with_name("pressplan")
@@ -92,18 +97,10 @@ def main() -> None:
             tradeoff_rows.append((drive_path.name, start, statistics.median(walls)))
     optimal_rows = _optimal(case, exe, imports)
     law_rows = _laws(case)
-    drive_case = read_case(DRIVE_CASE)
-    drive_warm, drive_sol = _warm_times(drive_case, solve)
-    strong = drive_case.model_dump(exclude_none=True)  # the same press with motors ten times as strong
-    for key in ("peak_torque_Nm", "rated_torque_Nm"):
-        strong["drive"]["motor"][key] *= 10
-    from planning.model.case_file import case_from_data
-
-    strong_warm, _ = _warm_times(case_from_data(strong), solve)
     med = statistics.median
     rows = [
         ("NLP build (once per process)", build),
-        (f"in-process solve, warm (median of {WARM_RUNS})", med(warm)),
+        (f"in-process solve, warm (median of {WARM_RUNS}, taking turns with the two drive solves below)", med(warm)),
         (f"import casadi, numpy, matplotlib, yaml (median of {COLD_RUNS})", med(imports)),
         (f"cold `pressplan solve --no-plots` process (median of {COLD_RUNS})", med(cold)),
         ("cold solve beyond the imports (no figures)", med(cold) - med(imports)),
@@ -202,15 +199,20 @@ def _optimal(case, exe: Path, imports: list[float]) -> list[tuple[str, float]]:
     ]
 
 
-def _warm_times(case, solve) -> tuple[list[float], object]:
-    """Warm in-process solve times of ``case`` (after one solve that builds its NLPs) and the last solution."""
-    solve(case)
-    times = []
+def _interleaved(cases: list, solve) -> list[tuple[list[float], object]]:
+    """Warm in-process solve times of each case (after one solve that builds its NLPs) and its last
+    solution. The cases take turns, ``WARM_RUNS`` rounds, so a drift of the machine's speed (up to 1.7x
+    within a day here) falls on all of them alike and their ratios compare like with like."""
+    for case in cases:
+        solve(case)
+    times: list[list[float]] = [[] for _ in cases]
+    solutions: list[object] = [None] * len(cases)
     for _ in range(WARM_RUNS):
-        t = time.perf_counter()
-        sol = solve(case)
-        times.append(time.perf_counter() - t)
-    return times, sol
+        for k, case in enumerate(cases):
+            t = time.perf_counter()
+            solutions[k] = solve(case)
+            times[k].append(time.perf_counter() - t)
+    return list(zip(times, solutions, strict=True))
 
 
 def _laws(case) -> list[dict]:

@@ -27,8 +27,9 @@ acceleration and jerk of every half.
 The drive NLPs (motor torque rows, the RMS integral) sample the draw at its fixed angles theta2 ...
 theta3 at the constant speed w2 instead of following the cycle's closed form there: the two agree
 wherever the cycle closes (a constraint every solution meets), and the draw's rows then depend on w2
-alone (sparse rows; 25-45 % fewer iterations and 40 % less time per iteration on the side-panel drive,
-same optima). The kinematic NLP keeps the closed form: there the change saved nothing (more iterations).
+alone (sparse rows; on the side-panel drive a quarter fewer iterations and about half the time per
+iteration, same optima). The kinematic NLP keeps the closed form: there the change saved nothing
+(more iterations).
 """
 
 from __future__ import annotations

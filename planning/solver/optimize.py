@@ -528,7 +528,7 @@ def _kinematic_first(search: _Search, neighbour: Plan | None, ran: tuple[Ran, ..
     kinematic plan found before stays a candidate). Whether this answered the case."""
     if search.best is not None and any(c.id in MOTOR_CHECKS for c in search.best.verification.binding()):
         return False  # the motor limits the probe's plan: the drive NLP answers
-    ran = tuple(r for r in ran if r.found is not None)  # the probe's start once more without the motor's rows
+    ran = tuple(r for r in ran if r.found is not None)  # a probe that found no plan: its start runs again here
     law = search.case.planner.motion_law
     kinematic = replace(
         search,
