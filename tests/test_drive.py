@@ -185,3 +185,21 @@ def test_a_motor_too_small_for_the_draws_heat_is_exit_3_naming_it(tmp_path, caps
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "infeasible: drive.motor.rated_torque_Nm = 4000" in err[0]
     assert "limits.min_crank_speed_rpm" in err[0]
+
+
+def test_the_drive_nlps_draw_rows_depend_on_the_draw_speed_alone():
+    """The drive NLP samples the draw at its fixed angles and constant speed (``planning.solver.nlp``): each of
+    its slider-acceleration and motor-torque rows there has one nonzero in the constraint Jacobian, the draw
+    speed's."""
+    from planning.solver.nlp import FORMING_SAMPLES, VARIABLE_INDEX, cycle_nlp
+
+    nlp = cycle_nlp("improved-s-curve", drive=True)
+    pattern = nlp.program._cold.get_function("nlp_jac_g").sparsity_out(1)
+    rows, cols = (np.array(a) for a in pattern.get_triplet())
+    for name in ("slider acceleration", "motor peak torque"):
+        block = next(b for b in nlp.blocks if b.name == name)
+        draw = (rows >= block.stop - FORMING_SAMPLES) & (rows < block.stop)
+        assert set(cols[draw].tolist()) == {VARIABLE_INDEX["draw_speed"]}, name
+        assert len(set(rows[draw].tolist())) == FORMING_SAMPLES, name
+        outside = (rows >= block.start) & (rows < block.stop - FORMING_SAMPLES)
+        assert len(set(cols[outside].tolist())) > 5, name  # the other samples follow the cycle's closed form
