@@ -27,7 +27,7 @@ from planning.model.cycle import HALVES
 from planning.model.laws import get_law
 from planning.model.laws import improved_scurve as sc
 from planning.model.plan import Plan, SolverInfo, params_from_numbers, profile_from_tdc
-from planning.solver.ipopt import NLPStatus
+from planning.solver.ipopt import NLPResult, NLPStatus
 from planning.solver.nlp import (
     BLOCK_FIELDS,
     DRIVE_INDEX,
@@ -42,7 +42,7 @@ from planning.solver.nlp import (
     variable_scales,
 )
 from planning.solver.outcomes import Attempt, Infeasible, NoPlanFound, Unverified
-from planning.solver.verify import CHECK_FIELDS, CheckId, Verification, verify
+from planning.solver.verify import BINDING_SHARE, CHECK_FIELDS, CheckId, Verification, verify
 from press.dynamics import drive_state, envelope_torque, forming_force
 
 ACCEL_BACKOFF = 5e-4  # the NLP keeps |slider acceleration| <= (1 - backoff) * limit at its samples
@@ -51,6 +51,7 @@ DRIVE_BACKOFF = 5e-5  # likewise for the motor's peak and RMS torque (refined li
 MIN_HALF_S = 4e-3  # [s] lower bound on the duration of a half (1 ms per improved-S-curve sub-segment)
 MAX_TIME_S = 600.0  # [s] least upper bound on a time variable (see _bounds)
 REFINEMENTS = 8  # re-solves with a lowered sampled acceleration limit
+RMS_ROW_ACTIVE = 1e-6  # the NLP's RMS row (heat over the rating's, 1 at the limit) is active above 1 - this
 REFINE_MARGIN = 1e-5  # relative: a refined sampled limit is tightened this much beyond the measured overshoot
 HARDER_BACKOFF = 5e-3  # when no start verifies: once more with this back-off on the sampled limits
 NO_LIMIT = 1e9  # stands for an absent motor limit in the NLP's parameters
@@ -373,14 +374,19 @@ class _Search:
         return plan.period if self.score is None else self.score(plan)
 
     def attempt(self, x0: dict[str, float], placement: Placement) -> tuple[dict[str, float], float] | None:
-        """Solve from ``x0``; if only the dense slider-acceleration check fails, lower the NLP's
-        sampled limit by the measured overshoot and re-solve warm (at most ``REFINEMENTS`` times).
-        Returns the verified values and period, or None."""
+        """Solve from ``x0``; where only sampled limits fail the dense check (the slider acceleration, the
+        motor's peak and RMS torque, ...: :data:`REFINED`), lower the NLP's sampled limit by the measured
+        overshoot and re-solve warm (at most ``REFINEMENTS`` times). Where the NLP's RMS row is active but
+        the exact RMS torque stays more than :data:`BINDING_SHARE` below the rating (its trapezoid over the
+        samples overestimates the heat), raise that row's limit by the measured gap once and re-solve warm
+        (:meth:`_rms_gap`). Returns the best verified values and score, or None."""
         q = self.parameters.copy()
         values = x0
         multipliers = None
+        found: tuple[dict[str, float], float] | None = None
+        loosened = False
         self.starts += 1
-        for _ in range(REFINEMENTS + 1):
+        for _ in range(REFINEMENTS + 2):
             res = self.nlp.solve(values, q, self.lbx, self.ubx, placement, self.scale, multipliers, self.fixed_period)
             self.iterations += res.iterations
             if self.fixed_period and res.status == NLPStatus.STOPPED_AT_LIMIT:
@@ -393,19 +399,26 @@ class _Search:
                 block, amount = self.nlp.worst_violation(placement, res.g, self.fixed_period)
                 field = BLOCK_FIELDS[block]
                 self.attempts.append(Attempt(res.return_status, block, amount, case_field=field))
-                return None
+                return found
             info = SolverInfo(self.iterations, time.perf_counter() - self.t_start, self.starts, res.return_status)
             plan = (self.make_plan or _plan)(self.case, values, placement, info)
             check = verify(plan, self.case)
             if check.passed:
                 score = self.score_of(plan)
                 self.consider(Solution(plan, check), score)
-                return values, score
+                if found is None or score < found[1]:
+                    found = (values, score)
+                gap = None if loosened else self._rms_gap(res, check)
+                if gap is None:
+                    return found
+                q[DRIVE_INDEX["motor_rms"]] *= gap * (1 - REFINE_MARGIN)
+                loosened = True
+                continue
             bad = check.failures()
             self.attempts.append(Attempt(check=bad[0], case_field=CHECK_FIELDS.get(bad[0].id, "")))
             if any(c.id in self.stop_on for c in bad):
                 self.stopped = True
-                return None
+                return found
             refinable = {cid: k for cid, k in REFINED.items() if k < q.size}  # the NLP's own limits
             if self.nlp.die_zone_rows is None:  # the kinematic NLP holds the die speed at the crossings only
                 refinable.pop(CheckId.DIE_SPEED)
@@ -413,13 +426,22 @@ class _Search:
                 refinable.pop(CheckId.MIN_CRANK_SPEED)
                 refinable.pop(CheckId.CRANK_SPEED)
             if any(c.id not in refinable for c in bad):
-                return None
+                return found
             for c in bad:  # tighten the NLP's sampled limit by the measured overshoot
                 if c.kind == "min":  # a lower limit (the optimal law's minimum crank speed) goes up
                     q[refinable[c.id]] *= (c.limit / max(c.value, 0.5 * c.limit)) * (1 + REFINE_MARGIN)
                 else:
                     q[refinable[c.id]] *= (c.limit / c.value) * (1 - REFINE_MARGIN)
-        return None
+        return found
+
+    def _rms_gap(self, res: NLPResult, check: Verification) -> float | None:
+        """``rated / exact RMS torque`` when the NLP's RMS row is active at ``res`` and the exact RMS torque of
+        the verified plan is more than :data:`BINDING_SHARE` below the rating; else None."""
+        block = next((b for b in self.nlp.blocks if b.name == "motor RMS torque"), None)
+        if block is None or res.g[block.start] < 1 - RMS_ROW_ACTIVE:
+            return None
+        rms = next(c for c in check.checks if c.id == CheckId.MOTOR_RMS)
+        return rms.limit / rms.value if rms.margin > BINDING_SHARE * rms.limit else None
 
     def key(self, values: dict[str, float]) -> np.ndarray:
         """``values`` as the NLP's variable vector (to compare starts)."""
