@@ -215,6 +215,16 @@ def clipped_advance(tau, theta_start, omega_start, omega0, alpha0, j0, j1) -> tu
     return theta_start + ca.sum1(th), omega_start + ca.sum1(om - omega0)
 
 
+def draw_states(q: dict, w2, fractions: ca.DM) -> tuple:  # noqa: ANN001 - SX or MX
+    """The draw's states at ``fractions`` of it: the fixed angles theta2 ... theta3 (one turn on, as the cycle
+    reaches them after time 0 at theta3), the constant speed ``w2``, no acceleration, and their times from the
+    draw's start [s]. Wherever the cycle closes (as at every solution) these are its states, and every row
+    built on them depends on ``w2`` alone."""
+    sweep = fractions * (q["theta3"] - q["theta2"])
+    n = fractions.shape[0]
+    return q["theta2"] + 2 * np.pi + sweep, w2 * ca.DM.ones(n), ca.DM.zeros(n), sweep / w2
+
+
 def _angle_at(t: ca.SX, starts: list, states: list, segs: list[Segment]) -> tuple[ca.SX, ca.SX]:
     """Closed-form crank angle and speed at time ``t`` [s] over the segments (clip formulation): the
     linear-jerk parts as one vector, the shape terms of shaped segments added one by one."""
@@ -441,12 +451,9 @@ def _build(law_name: str, drive: bool = False, rate: bool = False) -> CycleNLP:
         fractions = np.linspace(0.0, 1.0, count + 1)
         if seg.name != "draw:constant":
             fractions = fractions[:-1]  # the end is the next segment's start
-        if drive and seg.name == "draw:constant":
-            # the draw at its constant speed between the fixed key angles (where the cycle closes, as every
-            # solution does, these are its states): each row of the draw then depends on w2 alone
-            sweep = ca.DM(fractions) * (q["theta3"] - q["theta2"])
-            th, om, al = q["theta2"] + 2 * np.pi + sweep, w2 * ca.DM.ones(count + 1), ca.DM.zeros(count + 1)
-            t_s.append(t0 + sweep / w2)
+        if drive and seg.name == "draw:constant":  # sparse rows (see the module docstring)
+            th, om, al, since = draw_states(q, w2, ca.DM(fractions))
+            t_s.append(t0 + since)
         else:
             th, om, al, _ = advance_segment(seg, *st, ca.DM(fractions) * seg.duration)
             t_s.append(t0 + ca.DM(fractions) * seg.duration)

@@ -50,6 +50,7 @@ from planning.solver.nlp import (
     Rows,
     _drive_constraints,
     clipped_advance,
+    draw_states,
 )
 from planning.solver.optimize import MAX_TIME_S, Solution, _prepare, _Search, converged_plan, solve
 from planning.solver.outcomes import Infeasible
@@ -198,14 +199,13 @@ def _build(drive: bool) -> CycleNLP:
     # the draw's samples last (the drive's forming force is given at them)
     draw_time = (q["theta3"] - q["theta2"]) / w2
     count = DRAW_SAMPLES_DRIVE if drive else SAMPLES_CONSTANT
-    fractions = ca.DM(np.linspace(0.0, 1.0, count + 1))
-    th_d, om_d, al_d, _ = advance(q["theta2"] + 2 * np.pi, w2, 0.0, 0.0, 0.0, fractions * draw_time)
-    th_all, om_all, al_all = ca.vertcat(th, th_d), ca.vertcat(om, om_d), ca.vertcat(al, ca.DM.zeros(count + 1) + al_d)
+    th_d, om_d, al_d, since = draw_states(q, w2, ca.DM(np.linspace(0.0, 1.0, count + 1)))
+    th_all, om_all, al_all = ca.vertcat(th, th_d), ca.vertcat(om, om_d), ca.vertcat(al, al_d)
     d1a, d2a, _ = height_derivatives(th_all, q["R"], q["L"])
     add("slider acceleration", (d2a * om_all**2 + d1a * al_all) / q["accel_limit"], -1.0, 1.0)
     period = t0 + draw_time
     if drive:
-        t_all = ca.vertcat(t_free, t0 + fractions * draw_time)
+        t_all = ca.vertcat(t_free, t0 + since)
         _drive_constraints(add, p_case, th_all, om_all, al_all, d1a, d2a, t_all, period)
 
     nlp = {"x": x, "p": ca.vertcat(p_case, p_scale), "f": period, "g": ca.vertcat(*rows.g)}

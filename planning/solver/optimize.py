@@ -459,7 +459,7 @@ class _Search:
         is confirmed; ``confirm`` False: until one verifies) or the starts run out; the values of the
         best verified start. ``ran``: starts of this placement already solved (the drive's probe): they
         are not run again, and what they found counts."""
-        found = sorted(((r.found[1], r.found[0]) for r in ran if r.found is not None), key=lambda item: item[0])
+        found = sorted((r.found for r in ran if r.found is not None), key=lambda item: item[1])
         tried = [self.key(r.start) for r in ran]
         for x0 in x0s:
             if self.stopped:
@@ -471,11 +471,11 @@ class _Search:
             out = self.attempt(x0, placement)
             if out is None:
                 continue
-            found.append((out[1], out[0]))
-            found.sort(key=lambda item: item[0])
-            if not confirm or (len(found) >= 2 and found[1][0] - found[0][0] <= AGREE_S):
+            found.append(out)
+            found.sort(key=lambda item: item[1])
+            if not confirm or (len(found) >= 2 and found[1][1] - found[0][1] <= AGREE_S):
                 break
-        return found[0][1] if found else None
+        return found[0][0] if found else None
 
     def answer(self) -> Solution:
         """The best verified plan with the solver's totals; else the typed error: a converged plan
