@@ -23,7 +23,7 @@ _EXPORTS = {
     "Case": ("planning.model.case", "Case"),
     "LAWS": ("planning.model.laws", "LAWS"),
     "solve": ("planning.solver.optimize", "solve"),
-    "Solution": ("planning.solver.optimize", "Solution"),
+    "Solution": ("planning.solver.solution", "Solution"),
     "bound": ("planning.solver.bound", "time_optimal_bound"),
     "verify": ("planning.solver.verify", "verify"),
     "PlanningError": ("planning.solver.outcomes", "PlanningError"),

@@ -225,8 +225,8 @@ def _solve(case, args) -> int:
     if not solution.verification.passed:  # solve() returns only verified plans; belt and braces
         raise CommandError(f"{args.case}: unverified plan not written", EXIT_INFEASIBLE)
     plot_format = None if args.no_plots else args.format
-    writers = solution_writers(solution, case, cam_points=args.cam_points, plot_format=plot_format)
     result = result_dict(solution, case)
+    writers = solution_writers(solution, case, cam_points=args.cam_points, plot_format=plot_format, result=result)
     return _write_and_report(out, writers, result, summary_text(result), args, SOLVE_FILES)
 
 

@@ -163,10 +163,8 @@ def _solved_row(sol, case) -> dict[str, Any]:  # noqa: ANN001 - a Solution and i
         "binding": ";".join(binding(sol)),
         "message": "",
     }
-    if case.drive is not None:
-        from planning.model.drive import drive_figures
-
-        figures = drive_figures(sol.plan.profile, case).as_dict()
+    if sol.drive is not None:
+        figures = sol.drive.as_dict()
         row.update({k: figures[k] for k in DRIVE_ROW_FIELDS})
     return row
 

@@ -25,14 +25,14 @@ from planning.sweep import SweepError, _cell, execute
 
 # one row per rate: the plan's figures, the baseline's, the savings
 FIGURE_FIELDS = (
-    "rms_torque_Nm",
+    "rms_motor_torque_Nm",
     "peak_motor_torque_Nm",
     "peak_motor_power_kW",
     "energy_drawn_kJ",
     "energy_returned_kJ",
     "energy_net_kJ",
-    "energy_kJ",
-    "transfer_time_s",
+    "supply_energy_kJ",
+    "transfer_window_s",
 )
 COLUMNS = (
     "target_spm",
@@ -113,17 +113,14 @@ def rate_block(case: Case, placement: Placement | None, fastest: Any, rates: lis
 
 
 def solved_row(sol: Any, case: Case) -> dict[str, Any]:
-    """The figures of a solution at a rate and of its baseline (exact, ``planning.model.drive``)."""
-    from planning.model.drive import drive_figures
-
+    """The figures of a solution at a rate and of its baseline (the drive's figures each carries)."""
     a = sol.at_rate
     row: dict[str, Any] = {"status": "verified", "message": "", "improved_on_baseline": a.improved}
-    for prefix, plan, figures in (("", sol.plan, a.figures), ("baseline_", a.baseline.plan, a.baseline_figures)):
-        d = drive_figures(plan.profile, case).as_dict()
-        row.update({f"{prefix}{k}": d[k] for k in FIGURE_FIELDS if k in d})
-        row.update({f"{prefix}{k}": v for k, v in figures.as_dict().items() if k in FIGURE_FIELDS})
-    row["saving_rms_pct"] = a.saving_pct("rms_torque_Nm")
-    row["saving_energy_pct"] = a.saving_pct("energy_kJ")
+    for prefix, solution in (("", sol), ("baseline_", a.baseline)):
+        figures = {**solution.drive.as_dict(), "transfer_window_s": solution.plan.transfer_window()}
+        row.update({f"{prefix}{k}": figures[k] for k in FIGURE_FIELDS})
+    row["saving_rms_pct"] = sol.saving_pct("rms_motor_torque_Nm")
+    row["saving_energy_pct"] = sol.saving_pct("supply_energy_kJ")
     return row
 
 
@@ -137,14 +134,14 @@ class TradeoffResult:
 
     def thermal_statement(self, case: Case) -> str:
         """What the motor's thermal limit allows: whether it sets the fastest rate, and the RMS there."""
-        from planning.model.drive import drive_figures
+        from planning.model.limits.motor import MotorRMSTorque
         from planning.reports.report import binding
 
         fast = self.fastest.plan
-        rms = drive_figures(fast.profile, case).rms_motor_torque_Nm
+        rms = self.fastest.drive.rms_motor_torque_Nm
         rated = case.drive.motor.rated_torque_Nm
         names = binding(self.fastest)
-        if any("RMS" in n for n in names):
+        if any(c.id == MotorRMSTorque.id for c in self.fastest.verification.binding()):
             return (
                 f"the motor's thermal limit sets the highest rate: {fast.spm:.3f} strokes/min "
                 f"(RMS torque {rms:.0f} N m = rated {rated:g} N m)"
@@ -166,11 +163,11 @@ def run_tradeoff(
 ) -> TradeoffResult:
     """One plan per rate at ``case.planner.objective`` (min-rms-torque or min-energy); ``meanwhile``: see
     ``planning.sweep.execute``."""
-    from planning.solver.nlp import cycle_nlp
+    from planning.solver.halves_nlp import halves_nlp_for
     from planning.solver.optimize import solve
 
     fastest = solve(case.with_objective("max-spm"), placement)
-    cycle_nlp(case.planner.motion_law, drive=True, rate=True)  # built once here, inherited by forked workers
+    halves_nlp_for(case, drive=True, rate=True)  # built once here, inherited by forked workers
     values = rates.values(fastest.plan.spm)
     order = list(enumerate(values.tolist()))[::-1]  # from the fastest rate down: each starts from the faster one
     size = max(1, math.ceil(len(order) / max(1, workers)))  # one contiguous block per worker
@@ -203,8 +200,9 @@ def table_text(result: TradeoffResult, case: Case) -> str:
             lines.append(f"  {r['target_spm']:8.3f}  {r['status']}: {r['message']}")
             continue
         lines.append(
-            f"  {r['target_spm']:8.3f} {r['rms_torque_Nm'] / 1e3:9.2f} {r['baseline_rms_torque_Nm'] / 1e3:9.2f} "
-            f"{r['saving_rms_pct']:6.1f}% {r['energy_kJ']:10.1f} {r['baseline_energy_kJ']:9.1f} "
+            f"  {r['target_spm']:8.3f} {r['rms_motor_torque_Nm'] / 1e3:9.2f} "
+            f"{r['baseline_rms_motor_torque_Nm'] / 1e3:9.2f} "
+            f"{r['saving_rms_pct']:6.1f}% {r['supply_energy_kJ']:10.1f} {r['baseline_supply_energy_kJ']:9.1f} "
             f"{r['saving_energy_pct']:6.1f}%"
         )
     lines.append("  " + result.thermal_statement(case))

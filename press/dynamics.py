@@ -1,17 +1,18 @@
-"""Drive dynamics of a crank-slider press: crank torque, motor torque and power, forming work.
+"""Drive dynamics of a press: crank torque, motor torque and power, forming work.
 
-Conventions (as the kinematics): crank angle ``theta`` [rad] from TDC; slide height ``h`` above BDC;
-``h' = dh/dtheta``, ``h'' = d2h/dtheta2``. Inside this module lengths are in metres, forces in N,
-torques in N m, inertias in kg m^2, speeds in rad/s. Forces on the slide are positive upward; crank
-torque is positive when it drives the crank forward; motor power is positive when the motor draws
-from the supply.
+Conventions (as the mechanisms, ``press.mechanism``): crank angle ``theta`` [rad] from TDC; slide height
+``h`` above BDC; ``h' = dh/dtheta``, ``h'' = d2h/dtheta2``. Inside this module lengths are in metres,
+forces in N, torques in N m, inertias in kg m^2, speeds in rad/s. Forces on the slide are positive
+upward; crank torque is positive when it drives the crank forward; motor power is positive when the
+motor draws from the supply.
 
 Model (derived from the power balance; see the README):
 
-- Masses: the rod is split into two point masses, ``m_B = m_rod a_G / L`` at the wrist pin (moves with
-  the slide) and ``m_A = m_rod - m_B`` at the crank pin (turns on radius R). The slide side mass is
-  ``M = m_slide + m_B``, the crank side inertia ``J0 = J_crank + m_A R^2``. The crank-pin share is taken
-  as balanced (its gravity is neglected).
+- Masses: what moves with the slide (the slide, the upper die, the wrist-pin share of the rod) is one
+  mass ``M``; what turns with the crank (the crankshaft and gears, the crank-pin share of the rod) one
+  inertia ``J0`` about the crank axis. The mechanism says how its links split
+  (``press.crank_slider.CrankSlider.rod_split``). The crank-pin share is taken as balanced (its gravity is
+  neglected).
 - Forces on the slide: ``F_env = F_form + F_cb - M g``. ``F_form`` is the forming force of the case's
   table (height above BDC -> force, linear between points, zero outside), acting only while the slide
   descends between theta2 and BDC; ``F_cb`` the counterbalance (constant, upward).
@@ -31,11 +32,15 @@ Every function works on numpy arrays and on CasADi symbols (``press.backend``).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from press.backend import math_module
+
+if TYPE_CHECKING:
+    from press.crank_slider import CrankSlider
+    from press.mechanism import Mechanism
 
 GRAVITY = 9.80665  # [m/s^2] standard gravity
 
@@ -45,7 +50,7 @@ class DriveModel:
     """The drive in inside units: slide-side mass ``M`` [kg], crank-side inertia ``J0`` [kg m^2],
     counterbalance ``F_cb`` [N], gear ratio ``i``, efficiency ``eta``, motor-side inertia ``J_m``
     [kg m^2], and the forming-force table ``force_heights`` [mm above BDC, increasing] ->
-    ``force_values`` [N]; ``draw_start`` theta2 [rad] (forming acts from there to BDC)."""
+    ``force_values`` [N]; ``draw_start`` theta2 [rad] and ``bdc`` [rad] (forming acts from theta2 to BDC)."""
 
     M: float
     J0: float
@@ -56,12 +61,12 @@ class DriveModel:
     force_heights: tuple[float, ...]
     force_values: tuple[float, ...]
     draw_start: float
+    bdc: float
 
     @classmethod
     def from_parts(
         cls,
-        crank_radius_mm: float,
-        rod_length_mm: float,
+        mechanism: CrankSlider,
         slide_mass_kg: float,
         rod_mass_kg: float,
         rod_cg_from_crank_pin_mm: float,
@@ -73,14 +78,12 @@ class DriveModel:
         forming_force_kN: list[tuple[float, float]] | None,
         draw_start: float,
     ) -> DriveModel:
-        """The model from the case's engineering units (see the module docstring for the split of the rod)."""
-        R = crank_radius_mm * 1e-3
-        m_B = rod_mass_kg * rod_cg_from_crank_pin_mm / rod_length_mm
-        m_A = rod_mass_kg - m_B
+        """The model from the case's engineering units; the mechanism splits the rod (module docstring)."""
+        with_slide, at_crank = mechanism.rod_split(rod_mass_kg, rod_cg_from_crank_pin_mm)
         table = sorted(forming_force_kN or [])
         return cls(
-            M=slide_mass_kg + m_B,
-            J0=crank_inertia_kg_m2 + m_A * R**2,
+            M=slide_mass_kg + with_slide,
+            J0=crank_inertia_kg_m2 + at_crank,
             F_cb=counterbalance_kN * 1e3,
             i=gear_ratio,
             eta=gear_efficiency,
@@ -88,6 +91,7 @@ class DriveModel:
             force_heights=tuple(float(h) for h, _ in table),
             force_values=tuple(float(f) * 1e3 for _, f in table),
             draw_start=float(draw_start),
+            bdc=float(mechanism.bdc_angle),
         )
 
 
@@ -98,7 +102,7 @@ def forming_force(theta: Any, height_mm: Any, drive: DriveModel) -> Any:
     if not drive.force_heights:
         return 0 * theta
     turn = theta - 2 * np.pi * m.floor(theta / (2 * np.pi))  # in [0, 2 pi)
-    active = (turn >= drive.draw_start) * (turn <= np.pi)
+    active = (turn >= drive.draw_start) * (turn <= drive.bdc)
     hs, fs = drive.force_heights, drive.force_values
     if m is np:
         value = np.interp(height_mm, hs, fs, left=0.0, right=0.0)
@@ -161,14 +165,11 @@ def forming_work(h_start_mm: float, h_end_mm: float, drive: DriveModel) -> float
     return float(np.sum(np.diff(nodes) * (values[1:] + values[:-1]) / 2)) * 1e-3  # N * mm -> J
 
 
-def drive_state(theta: Any, omega: Any, alpha: Any, R: float, L: float, drive: DriveModel) -> dict[str, Any]:
+def drive_state(theta: Any, omega: Any, alpha: Any, mechanism: Mechanism, drive: DriveModel) -> dict[str, Any]:
     """Everything the drive does at crank states (numpy arrays): ``forming_N``, ``crank_torque_Nm``,
     ``motor_speed_rad_s``, ``motor_torque_Nm``, ``motor_power_W``; ``theta`` [rad], ``omega`` [rad/s],
-    ``alpha`` [rad/s^2], ``R``, ``L`` [mm]."""
-    from press.kinematics import height, height_derivatives
-
-    d1, d2, _ = height_derivatives(theta, R, L)
-    h = height(theta, R, L)
+    ``alpha`` [rad/s^2]."""
+    h, d1, d2, _ = mechanism.jets(theta)
     f = forming_force(theta, h, drive)
     tc = crank_torque(omega, alpha, d1, d2, f, drive)
     tm = motor_torque(tc, alpha, drive)

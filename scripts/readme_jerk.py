@@ -16,9 +16,9 @@ from pathlib import Path
 from readme_block import replace_block
 
 from planning.model.case_file import case_from_data, read_case
+from planning.model.profile import max_abs_jerk
 from planning.solver.bound import time_optimal_bound
 from planning.solver.optimize import solve
-from planning.solver.verify import max_abs_jerk
 
 ROOT = Path(__file__).resolve().parents[1]
 CASES = ("wang2023-side-panel", "small-fast-cup")

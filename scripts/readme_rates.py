@@ -34,13 +34,14 @@ def table() -> str:
         case = read_case(ROOT / "cases" / f"{name}.yaml")
         fastest = solve(case)
         for rate in rates:
-            rms = solve_at_rate(case.with_objective("min-rms-torque", rate), fastest=fastest).at_rate
-            energy = solve_at_rate(case.with_objective("min-energy", rate), fastest=fastest).at_rate
+            rms = solve_at_rate(case.with_objective("min-rms-torque", rate), fastest=fastest)
+            energy = solve_at_rate(case.with_objective("min-energy", rate), fastest=fastest)
             lines.append(
-                f"| `{name}` | {rate:g} | {rms.figures.rms_torque_Nm / 1e3:.2f} | "
-                f"{rms.baseline_figures.rms_torque_Nm / 1e3:.2f} | {rms.saving_pct('rms_torque_Nm'):.1f} % | "
-                f"{energy.figures.energy_kJ:.1f} | {energy.baseline_figures.energy_kJ:.1f} | "
-                f"{energy.saving_pct('energy_kJ'):.1f} % |"
+                f"| `{name}` | {rate:g} | {rms.drive.rms_motor_torque_Nm / 1e3:.2f} | "
+                f"{rms.at_rate.baseline.drive.rms_motor_torque_Nm / 1e3:.2f} | "
+                f"{rms.saving_pct('rms_motor_torque_Nm'):.1f} % | "
+                f"{energy.drive.supply_energy_kJ:.1f} | {energy.at_rate.baseline.drive.supply_energy_kJ:.1f} | "
+                f"{energy.saving_pct('supply_energy_kJ'):.1f} % |"
             )
     return "\n".join(lines) + "\n"
 

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 from hypothesis import strategies as st
 
-from press.kinematics import CrankSlider
+from press.crank_slider import CrankSlider
 
 
 def build_case(u: list[float], name: str = "random") -> dict[str, Any]:
@@ -60,9 +60,6 @@ def build_case(u: list[float], name: str = "random") -> dict[str, Any]:
 
 UNIT = st.floats(0.0, 1.0, exclude_max=True, allow_nan=False)
 CASES = st.lists(UNIT, min_size=14, max_size=14).map(build_case)
-# the last number decides whether the case gives its draw speed (< 0.5) or leaves it to the planner
-CASES_DRAW_SPEED_GIVEN = st.lists(UNIT, min_size=13, max_size=13).map(lambda u: build_case(u + [0.25]))
-CASES_DRAW_SPEED_FREE = st.lists(UNIT, min_size=13, max_size=13).map(lambda u: build_case(u + [0.75]))
 
 
 def seeded_case(seed: int) -> dict[str, Any]:

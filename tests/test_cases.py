@@ -24,7 +24,3 @@ def test_case_solves_and_verifies(path):
     assert abs(tab[:, -1]).max() <= case.limits.slider_accel_mm_s2 * (1 + 1e-6)
     assert free.plan.transfer_window() >= case.process.transfer_time_s - 1e-6
 
-
-def test_there_are_several_presses():
-    radii = {read_case(p).press.crank_radius_mm for p in CASES}
-    assert len(CASES) >= 3 and len(radii) >= 3

@@ -57,7 +57,7 @@ def test_solve_writes_result_json(solved):
         "placement",
         "motion_law",
         "draw_speed_rpm",
-        "transfer_time_s",
+        "transfer_window_s",
         "max_abs_slider_accel_mm_s2",
         "key_points",
         "segments",
@@ -144,15 +144,14 @@ def test_case_file_is_never_written(tmp_path):
 
 def test_solver_success_but_failed_verification_is_exit_3(monkeypatch, tmp_path, capsys):
     """No false successes: when every plan fails the dense check, nothing is written and exit is 3."""
-    import planning.solver.optimize as optimize
-    from planning.solver.verify import Check, CheckId, Verification
+    import planning.solver.search as search
+    from planning.solver.verify import Check, Verification
 
     def failing(plan, case):
-        return Verification(
-            (Check("|slider acceleration|", 9999.0, 3500.0, "mm/s^2", "max", False, CheckId.SLIDER_ACCEL),), 1e-3, 10
-        )
+        check = Check("|slider acceleration|", 9999.0, 3500.0, "mm/s^2", "max", False, "slider_accel")
+        return Verification((check,), 1e-3, 10), None
 
-    monkeypatch.setattr(optimize, "verify", failing)
+    monkeypatch.setattr(search, "assess", failing)
     out = tmp_path / "o"
     assert main(["solve", str(PUBLISHED_CASE), "--out", str(out)]) == 3
     err = capsys.readouterr().err
@@ -163,14 +162,16 @@ def test_solver_success_but_failed_verification_is_exit_3(monkeypatch, tmp_path,
 def test_last_iterate_names_the_violated_constraint():
     import numpy as np
 
-    from planning.solver.nlp import cycle_nlp
+    from planning.model.case_file import read_case
+    from planning.solver.halves_nlp import halves_nlp_for
 
-    nlp = cycle_nlp()
+    nlp = halves_nlp_for(read_case(PUBLISHED_CASE))
     lbg, ubg = nlp.bounds("free")
     g = np.where(np.isfinite(lbg), lbg, np.where(np.isfinite(ubg), ubg, 0.0))
-    block = next(b for b in nlp.blocks if b.name == "transfer time")
+    block = nlp.block_of("transfer_time")
     g[block.start] = -0.7  # 0.7 s short of the transfer time
-    assert nlp.worst_violation("free", g) == ("transfer time", 0.7)
+    worst, amount = nlp.worst_block("free", g)
+    assert (worst.name, worst.field, amount) == ("transfer time", "process.transfer_time_s", 0.7)
 
 
 def test_check_warns_when_the_slide_is_below_the_die_height_at_theta3(capsys, tmp_path):
@@ -178,7 +179,7 @@ def test_check_warns_when_the_slide_is_below_the_die_height_at_theta3(capsys, tm
     slide leaves the die zone (the ascending crossing, from the exact geometry)."""
     import math
 
-    from press.kinematics import CrankSlider
+    from press.crank_slider import CrankSlider
 
     assert main(["check", str(PUBLISHED_CASE)]) == 0
     out = capsys.readouterr().out

@@ -16,8 +16,8 @@ from planning.model.drive import drive_figures
 from planning.reports.report import binding
 from planning.solver.bound import time_optimal_bound
 from planning.solver.optimize import solve
+from press.crank_slider import CrankSlider
 from press.dynamics import DriveModel, crank_torque, motor_torque
-from press.kinematics import CrankSlider
 
 from .conftest import PUBLISHED_CASE, ROOT
 
@@ -42,7 +42,7 @@ def test_quasi_static_torque_is_the_torque_arm_formula(R, L):
     crank angle before BDC, b the rod angle (the press-rating formula)."""
     F = 2.5e6  # [N] upward on the descending slide
     still = DriveModel(
-        M=0.0, J0=0.0, F_cb=0.0, i=1.0, eta=1.0, J_m=0.0, force_heights=(), force_values=(), draw_start=0.0
+        M=0.0, J0=0.0, F_cb=0.0, i=1.0, eta=1.0, J_m=0.0, force_heights=(), force_values=(), draw_start=0.0, bdc=math.pi
     )
     theta = np.linspace(0.05, math.pi - 0.05, 200)
     d1, d2, _ = CrankSlider(R, L).derivatives(theta)
@@ -56,7 +56,16 @@ def test_quasi_static_torque_is_the_torque_arm_formula(R, L):
 def test_power_flow_signs():
     """Losses always cost the supply: driving needs more motor torque than T_c / i, braking returns less."""
     drive = DriveModel(
-        M=0.0, J0=0.0, F_cb=0.0, i=10.0, eta=0.9, J_m=0.0, force_heights=(), force_values=(), draw_start=0.0
+        M=0.0,
+        J0=0.0,
+        F_cb=0.0,
+        i=10.0,
+        eta=0.9,
+        J_m=0.0,
+        force_heights=(),
+        force_values=(),
+        draw_start=0.0,
+        bdc=math.pi,
     )
     assert motor_torque(np.array(100.0), 0.0, drive) == pytest.approx(100.0 / (10 * 0.9))
     assert motor_torque(np.array(-100.0), 0.0, drive) == pytest.approx(-100.0 * 0.9 / 10)
@@ -188,21 +197,24 @@ def test_a_motor_too_small_for_the_draws_heat_is_exit_3_naming_it(tmp_path, caps
 
 
 def test_the_drive_nlps_draw_rows_depend_on_the_draw_speed_alone():
-    """The drive NLP samples the draw at its fixed angles and constant speed (``planning.solver.nlp``): each of
-    its slider-acceleration and motor-torque rows there has one nonzero in the constraint Jacobian, the draw
-    speed's."""
-    from planning.solver.nlp import FORMING_SAMPLES, VARIABLE_INDEX, cycle_nlp
+    """The drive NLP samples the draw at its fixed angles and constant speed (``planning.solver.halves_nlp``):
+    each of its motor-torque rows there has one nonzero in the constraint Jacobian, the draw speed's. The
+    slider acceleration has no rows in the draw: at constant speed the draw speed's bound holds it exactly
+    (``planning.model.limits.slider_accel``)."""
+    from planning.solver.halves_nlp import VARIABLE_INDEX, halves_nlp_for
+    from planning.solver.parameters import FORMING_SAMPLES
 
-    nlp = cycle_nlp("improved-s-curve", drive=True)
+    nlp = halves_nlp_for(read_case(DRIVE_CASES[0]), drive=True)
     pattern = nlp.program._cold.get_function("nlp_jac_g").sparsity_out(1)
     rows, cols = (np.array(a) for a in pattern.get_triplet())
-    for name in ("slider acceleration", "motor peak torque"):
-        block = next(b for b in nlp.blocks if b.name == name)
-        draw = (rows >= block.stop - FORMING_SAMPLES) & (rows < block.stop)
-        assert set(cols[draw].tolist()) == {VARIABLE_INDEX["draw_speed"]}, name
-        assert len(set(rows[draw].tolist())) == FORMING_SAMPLES, name
-        outside = (rows >= block.start) & (rows < block.stop - FORMING_SAMPLES)
-        assert len(set(cols[outside].tolist())) > 5, name  # the other samples follow the cycle's closed form
+    torque = nlp.block_of("motor_peak_torque")
+    draw = (rows >= torque.stop - FORMING_SAMPLES) & (rows < torque.stop)
+    assert set(cols[draw].tolist()) == {VARIABLE_INDEX["draw_speed"]}
+    assert len(set(rows[draw].tolist())) == FORMING_SAMPLES
+    outside = (rows >= torque.start) & (rows < torque.stop - FORMING_SAMPLES)
+    assert len(set(cols[outside].tolist())) > 5  # the other samples follow the cycle's closed form
+    accel = nlp.block_of("slider_accel")
+    assert accel.stop - accel.start == torque.stop - torque.start - FORMING_SAMPLES
 
 
 def test_a_binding_rms_limit_is_used_to_the_rating():
@@ -213,6 +225,6 @@ def test_a_binding_rms_limit_is_used_to_the_rating():
     data = data_of(DRIVE_CASES[1])
     data["drive"]["motor"]["rated_torque_Nm"] = 2160.0
     sol = solve(case_from_data(data))
-    rms = next(c for c in sol.verification.checks if c.name == "motor RMS torque")
+    rms = sol.verification.check("motor_rms_torque")
     assert rms.passed and rms.margin <= 1e-4 * rms.limit
     assert "motor RMS torque" in binding(sol)

@@ -16,9 +16,8 @@ from hypothesis import strategies as st
 from planning.model.case_file import read_case
 from planning.model.laws import LAWS, SHAPED_LAWS
 from planning.model.laws.shapes import Cycloidal, Logistic, Quintic
-from planning.model.profile import Profile, split_segment
+from planning.model.profile import Profile, max_abs_jerk, split_segment
 from planning.solver.optimize import solve
-from planning.solver.verify import max_abs_jerk
 
 SHAPES = [Quintic(), Cycloidal(), Logistic(4.0), Logistic(5.0), Logistic(6.0), Logistic(2.0)]
 U = np.linspace(0.0, 1.0, 200_001)

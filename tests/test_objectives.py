@@ -80,7 +80,7 @@ def test_at_the_fastest_rate_the_plan_is_the_fastest() -> None:
         sol = solve_at_rate(case, fastest=fast)
         assert sol.verification.passed
         assert abs(sol.plan.spm - fast.plan.spm) <= 1e-3 * fast.plan.spm
-        assert sol.at_rate.figures.rms_torque_Nm <= drive_figures(fast.plan.profile, case).rms_motor_torque_Nm * (
+        assert sol.drive.rms_motor_torque_Nm <= drive_figures(fast.plan.profile, case).rms_motor_torque_Nm * (
             1 + 1e-12
         )
 
@@ -95,7 +95,7 @@ def test_tradeoff_never_worse_than_the_baseline(path: Path, objective: str, star
     result = run_tradeoff(case, parse_rates(f"{start}:max:7"), workers=1)
     rows = result.rows
     assert [r["status"] for r in rows] == ["verified"] * 7
-    key = "rms_torque_Nm" if objective == "min-rms-torque" else "energy_kJ"
+    key = "rms_motor_torque_Nm" if objective == "min-rms-torque" else "supply_energy_kJ"
     for r in rows:
         assert r[key] <= r[f"baseline_{key}"] * (1 + 1e-12)
     improved = [r for r in rows[:-1] if r[key] < r[f"baseline_{key}"] * (1 - 1e-3)]
@@ -103,7 +103,7 @@ def test_tradeoff_never_worse_than_the_baseline(path: Path, objective: str, star
     assert rows[-1]["target_spm"] == pytest.approx(result.fastest.plan.spm, rel=1e-9)
     # the RMS torque of the optimised plans grows with the rate (heat over a shorter cycle)
     if objective == "min-rms-torque":
-        rms = [r["rms_torque_Nm"] for r in rows]
+        rms = [r["rms_motor_torque_Nm"] for r in rows]
         assert all(b > a for a, b in zip(rms, rms[1:], strict=False))
 
 
@@ -123,7 +123,7 @@ def test_a_neighbour_worse_than_waiting_does_not_end_the_search() -> None:
         confirm=False,
     )
     assert sol.verification.passed and sol.at_rate.improved
-    assert sol.at_rate.saving_pct("rms_torque_Nm") > 1.0
+    assert sol.saving_pct("rms_motor_torque_Nm") > 1.0
 
 
 def test_trajectory_recomputes_rms_and_energy(tmp_path: Path) -> None:
@@ -143,10 +143,11 @@ def test_trajectory_recomputes_rms_and_energy(tmp_path: Path) -> None:
     drawn = _trapezoid(np.maximum(col["motor_power_kW"], 0.0), t)
     returned = _trapezoid(np.minimum(col["motor_power_kW"], 0.0), t)
     regen = read_case(CUP).drive.regen_efficiency
-    assert rms == pytest.approx(result["rms_torque_Nm"], rel=TRAJECTORY_REL)
-    assert drawn + regen * returned == pytest.approx(result["energy_kJ"], rel=TRAJECTORY_REL)
-    assert result["energy_kJ"] <= result["baseline"]["energy_kJ"]
-    saving = 100 * (1 - result["energy_kJ"] / result["baseline"]["energy_kJ"])
+    plan = result["drive"]
+    assert rms == pytest.approx(plan["rms_motor_torque_Nm"], rel=TRAJECTORY_REL)
+    assert drawn + regen * returned == pytest.approx(plan["supply_energy_kJ"], rel=TRAJECTORY_REL)
+    assert plan["supply_energy_kJ"] <= result["baseline"]["supply_energy_kJ"]
+    saving = 100 * (1 - plan["supply_energy_kJ"] / result["baseline"]["supply_energy_kJ"])
     assert result["saving_pct"]["energy"] == pytest.approx(saving, rel=1e-9)
 
 
@@ -162,7 +163,7 @@ def test_both_placements_and_another_law_at_a_rate() -> None:
         sol = solve_at_rate(case, placement, fastest=fast)
         assert sol.verification.passed and sol.plan.spm == pytest.approx(30.0, rel=1e-9)
         assert sol.plan.motion_law == law
-        assert sol.at_rate.figures.rms_torque_Nm <= sol.at_rate.baseline_figures.rms_torque_Nm
+        assert sol.drive.rms_motor_torque_Nm <= sol.at_rate.baseline.drive.rms_motor_torque_Nm
         # the baseline runs at the rate too, and spends the spare time in a longer transfer dwell
         baseline = sol.at_rate.baseline.plan
         assert baseline.spm == pytest.approx(30.0, rel=1e-9)
@@ -177,7 +178,7 @@ def test_every_law_plans_at_a_rate(law: str) -> None:
     sol = solve_at_rate(case)
     assert sol.verification.passed and sol.plan.motion_law == law
     assert sol.plan.spm == pytest.approx(30.0, rel=1e-9)
-    assert sol.at_rate.figures.energy_kJ <= sol.at_rate.baseline_figures.energy_kJ
+    assert sol.drive.supply_energy_kJ <= sol.at_rate.baseline.drive.supply_energy_kJ
 
 
 def test_the_optimal_law_has_no_objective_at_a_rate() -> None:

@@ -11,9 +11,9 @@ import pytest
 from planning.cli import main
 from planning.model.case_file import case_from_data, read_case
 from planning.model.laws import SHAPED_LAWS
+from planning.model.profile import max_abs_jerk
 from planning.solver.bound import time_optimal_bound
 from planning.solver.optimize import solve
-from planning.solver.verify import max_abs_jerk
 
 CASES = sorted((Path(__file__).resolve().parent.parent / "cases").glob("*.yaml"))
 JERK_SHARE = 0.98  # the target: at least this share of the jerk-limited bound at every limit

@@ -1,6 +1,7 @@
 """Property tests on random presses (tests/random_cases.py): every run ends in a verified plan or a
-clean answer (exit 2 or 3), never NaN; the same input gives the same output; relaxing a limit never
-costs strokes. The normal run draws FAST_EXAMPLES cases; ``pytest -m slow`` adds SLOW_CASES more."""
+clean answer (exit 2 or 3), never NaN, and at least :data:`VERIFIED_SHARE` of a fixed random set of
+presses end verified, every exit 3 naming the case field it could not meet; the same input gives the
+same output; relaxing a limit never costs strokes, solved cold. ``pytest -m slow`` adds SLOW_CASES more."""
 
 from __future__ import annotations
 
@@ -19,9 +20,10 @@ from planning.reports.report import result_dict, trajectory
 from planning.solver.optimize import solve
 from planning.solver.outcomes import PlanningError
 
-from .random_cases import CASES, CASES_DRAW_SPEED_FREE, CASES_DRAW_SPEED_GIVEN, seeded_case
+from .random_cases import CASES, build_case, seeded_case
 
-FAST_EXAMPLES = 200
+RANDOM_SET = 100  # presses of each kind (draw speed given, or left to the planner) in the normal run
+VERIFIED_SHARE = 0.9  # of them at least this share end in a verified plan
 SLOW_CASES = 2000
 SLOW_CHUNK = 100
 RELAXATION_EXAMPLES = 16
@@ -31,6 +33,10 @@ PROFILE = settings(
     database=None,
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
 )
+
+
+# a dotted case field, as every exit-3 message names the one it could not meet
+CASE_FIELD = re.compile(r"\b(?:limits|process|drive|key_points|planner|press)\.[a-z_.]+[a-zA-Z]|\bkey_points\b")
 
 
 def outcome(data: dict) -> str:
@@ -44,6 +50,7 @@ def outcome(data: dict) -> str:
         sol = solve(case)
     except PlanningError as exc:
         assert exc.kind in ("infeasible", "unverified", "no verified plan") and "\n" not in str(exc)
+        assert CASE_FIELD.search(str(exc)), f"exit 3 without the case field it could not meet: {exc}"
         return f"{exc.kind} (exit 3)"
     assert sol.verification.passed
     json.dumps(result_dict(sol, case), allow_nan=False)  # raises on NaN or infinity
@@ -55,16 +62,22 @@ def outcome(data: dict) -> str:
     return "verified"
 
 
-@settings(PROFILE, max_examples=FAST_EXAMPLES // 2)
-@given(data=CASES_DRAW_SPEED_GIVEN)
-def test_random_press_with_draw_speed_ends_verified_or_clean(data):
-    event(outcome(data))
+def random_set(draw_speed_given: bool) -> list[dict]:
+    """A fixed random set of presses: :data:`RANDOM_SET` seeds, the draw speed given or left to the planner."""
+    last = 0.25 if draw_speed_given else 0.75  # the builder's last number decides (< 0.5: given)
+    return [
+        build_case(list(np.random.default_rng(seed).random(13)) + [last], name=f"random-{seed}")
+        for seed in range(RANDOM_SET)
+    ]
 
 
-@settings(PROFILE, max_examples=FAST_EXAMPLES // 2)
-@given(data=CASES_DRAW_SPEED_FREE)
-def test_random_press_free_draw_speed_ends_verified_or_clean(data):
-    event(outcome(data))
+@pytest.mark.parametrize("draw_speed_given", [True, False], ids=["draw speed given", "draw speed free"])
+def test_random_presses_end_verified(draw_speed_given):
+    """Every press ends verified or clean (the properties of :func:`outcome`), and most end verified: a
+    planner that failed every case would fail here."""
+    outcomes = [outcome(data) for data in random_set(draw_speed_given)]
+    verified = outcomes.count("verified")
+    assert verified >= VERIFIED_SHARE * len(outcomes), sorted(set(outcomes))
 
 
 @pytest.mark.slow
@@ -102,26 +115,54 @@ def test_same_input_same_output_bytes(seed):
     assert _file_bytes(data) == _file_bytes(data)
 
 
-@settings(PROFILE, max_examples=12)
-@given(data=CASES, relax=st.sampled_from(["slider_accel_mm_s2", "transfer_time_s", "min_crank_speed_rpm"]))
-def test_relaxing_a_limit_never_costs_strokes(data, relax):
-    try:
-        case = case_from_data(data)
-        base = solve(case)
-    except (CaseFileError, PlanningError):
-        return
-    relaxed = json.loads(json.dumps(data))
-    if relax == "slider_accel_mm_s2":
-        relaxed["limits"]["slider_accel_mm_s2"] *= 1.1
-    elif relax == "transfer_time_s":
-        relaxed["process"]["transfer_time_s"] *= 0.9
-    else:
-        relaxed["limits"]["min_crank_speed_rpm"] = 0.5
-    if "draw_speed_rpm" not in relaxed["process"]:  # keep the draw speed the first plan used
-        relaxed["process"]["draw_speed_rpm"] = float(base.plan.parameters.draw_speed) * 60 / (2 * math.pi)
-    better = solve(case_from_data(relaxed), neighbour=base.plan)
-    assert better.plan.spm >= base.plan.spm - 1e-9
+# Seeds of the relaxation test: the first ones of the seeded set, and presses where a relaxed limit once cost
+# strokes cold (10, 15 and 45 ended in exit 3 with min_crank_speed_rpm 0.5; 27 lost 6 % with it and 0.6 %
+# with a shorter transfer time: refining the sampled slider acceleration squeezed the draw, whose speed the
+# test holds at the bound; 55 loses most to another local optimum, 8.6e-4)
+RELAXATION_SEEDS = (0, 1, 2, 3, 4, 5, 10, 15, 27, 45, 55)
 
+
+@pytest.mark.parametrize("seed", RELAXATION_SEEDS)
+def test_relaxing_a_limit_never_costs_strokes(seed):
+    """Each relaxation of a solved press, solved on its own (cold: no neighbour's plan to fall back on),
+    makes at least as many strokes, to :data:`RELAXED_SPM_TOL`: the planner is a multi-start of a local
+    method on a nonconvex problem, and two local optima of a press and its relaxation can differ by that
+    much (a survey of seeds 0 ... 119 x 3 relaxations: 9 of 360 below, by 7e-8 ... 8.6e-4, 8 of them relaxing
+    the minimum crank speed from 1 to 0.5 rpm)."""
+    data = seeded_case(seed)
+    try:
+        base = solve(case_from_data(data))
+    except (CaseFileError, PlanningError):
+        pytest.skip("the press itself has no plan")
+    for relax in ("slider_accel_mm_s2", "transfer_time_s", "min_crank_speed_rpm"):
+        relaxed = json.loads(json.dumps(data))
+        if relax == "slider_accel_mm_s2":
+            relaxed["limits"]["slider_accel_mm_s2"] *= 1.1
+        elif relax == "transfer_time_s":
+            relaxed["process"]["transfer_time_s"] *= 0.9
+        else:
+            relaxed["limits"]["min_crank_speed_rpm"] = 0.5
+        if "draw_speed_rpm" not in relaxed["process"]:  # keep the draw speed the first plan used
+            relaxed["process"]["draw_speed_rpm"] = float(base.plan.parameters.draw_speed) * 60 / (2 * math.pi)
+        better = solve(case_from_data(relaxed))  # raises PlanningError (a failed test) on exit 3
+        assert better.plan.spm >= base.plan.spm * (1 - RELAXED_SPM_TOL), relax
+
+
+def test_a_neighbours_plan_that_holds_is_never_lost():
+    """``solve(case, neighbour=plan)`` keeps a neighbouring case's plan that verifies here as a candidate
+    (``planning.solver.max_spm.adopt``). On this corner of the random presses (every number at the end of
+    its range) the cold solve of a 10 % higher slider-acceleration limit finds a poorer local optimum
+    (8.74 against 8.98 strokes/min), and the NLP started from the neighbour's values ends there too: only
+    keeping the neighbour's plan itself gives the answer."""
+    data = build_case([0.0] * 14)
+    base = solve(case_from_data(data))
+    relaxed = json.loads(json.dumps(data))
+    relaxed["limits"]["slider_accel_mm_s2"] *= 1.1
+    warm = solve(case_from_data(relaxed), neighbour=base.plan)
+    assert warm.plan.spm >= base.plan.spm
+
+
+RELAXED_SPM_TOL = 1e-3  # relative: two local optima of a press and of its relaxation (see the test)
 
 RELAXATIONS = {  # each makes the set of feasible motions larger (or keeps it)
     "slider_accel_mm_s2": ("limits", "slider_accel_mm_s2", 1.1),

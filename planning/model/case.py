@@ -11,78 +11,54 @@ from __future__ import annotations
 
 import math
 import re
+from functools import cache
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, create_model
 
+from planning.model.errors import CaseError, show_value
 from planning.model.laws import DEFAULT_LAW, LAWS, LawName
+from planning.model.limits import LIMITS, Draw
+from planning.model.units import (
+    RPM,
+    Angle,
+    CrankSpeed,
+    ForceKN,
+    ForceTable,
+    Inertia,
+    Length,
+    Mass,
+    MotorSpeed,
+    Offset,
+    Seconds,
+    ShapeValue,
+    SourceDuration,
+    SourceNumber,
+    SourceSpeed,
+    SourceTime,
+    Torque,
+)
+from press.crank_slider import CrankSlider
 from press.dynamics import DriveModel
-from press.kinematics import CrankSlider
 
-RPM = 2.0 * math.pi / 60.0  # [rad/s] per rpm
 Placement = Literal["free", "published"]  # where theta1 / theta4 may fall (the paper's Fig. 6, or anywhere)
 Objective = Literal["max-spm", "min-rms-torque", "min-energy"]  # what the planner optimises
 OBJECTIVES: tuple[str, ...] = Objective.__args__
-
-
-class CaseError(ValueError):
-    """A problem with a case: ``field`` (dotted path), ``message``, and the offending ``value``."""
-
-    def __init__(self, field: str, message: str, value: Any = None, has_value: bool = True):
-        self.field = field
-        self.message = message
-        self.value = value
-        self.has_value = has_value
-        super().__init__(self.line())
-
-    def line(self, file: str | None = None) -> str:
-        """One line ``FILE: field: message (got VALUE)``."""
-        parts = [p for p in (file, self.field) if p]
-        got = f" (got {show_value(self.value)})" if self.has_value else ""
-        return ": ".join(parts + [f"{self.message}{got}"])
-
-
-def show_value(value: Any) -> str:
-    """A value as an error message quotes it: strings quoted, at most 60 characters."""
-    text = repr(value) if isinstance(value, str) else str(value)
-    return text if len(text) <= 60 else text[:57] + "..."
+__all__ = ["RPM", "Case", "CaseError", "show_value"]  # RPM and CaseError: where the model's users find them
 
 
 class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False, frozen=True)
 
 
-# Every number of a case lies in a stated range, wide enough for any press and narrow enough that no
-# arithmetic on a case can overflow or underflow (the reader's guarantee; see the README).
-Length = Annotated[float, Field(ge=0.1, le=20_000)]  # [mm] press dimensions and heights
-Height = Annotated[float, Field(ge=0, le=40_000)]  # [mm above BDC]
-Angle = Annotated[float, Field(ge=0, lt=360)]  # [deg from TDC]
-Seconds = Annotated[float, Field(ge=1e-3, le=1e5)]  # [s]
-CrankSpeed = Annotated[float, Field(ge=1e-3, le=1e4)]  # [rpm]
-SliderSpeed = Annotated[float, Field(ge=1e-3, le=1e6)]  # [mm/s]
-SliderAccel = Annotated[float, Field(ge=1e-2, le=1e9)]  # [mm/s^2]
-CrankAccel = Annotated[float, Field(ge=1e-4, le=1e6)]  # [rad/s^2]
-CrankJerk = Annotated[float, Field(ge=1e-4, le=1e9)]  # [rad/s^3]
-ShapeValue = Annotated[float, Field(gt=0, le=1e3)]  # a law's shape parameter (checked per law)
-SourceNumber = Annotated[float, Field(ge=-1e9, le=1e9)]  # a number printed by the source
-SourceTime = Annotated[float, Field(ge=0, le=1e4)]  # [s] a time printed by the source
-SourceDuration = Annotated[float, Field(gt=0, le=1e4)]  # [s]
-SourceSpeed = Annotated[float, Field(gt=0, le=1e5)]  # [rpm]
-Mass = Annotated[float, Field(ge=0, le=1e7)]  # [kg]
-Inertia = Annotated[float, Field(ge=0, le=1e9)]  # [kg m^2]
-ForceKN = Annotated[float, Field(ge=0, le=1e6)]  # [kN]
-Torque = Annotated[float, Field(ge=1e-3, le=1e8)]  # [N m]
-MotorSpeed = Annotated[float, Field(ge=1e-2, le=1e5)]  # [rpm]
-ForcePoint = Annotated[list[float], Field(min_length=2, max_length=2)]  # [height above BDC mm, force kN]
-ForceTable = Annotated[list[ForcePoint], Field(min_length=2, max_length=500)]
-
-
 class PressModel(_Model):
-    """The machine: ``crank_radius_mm`` [mm], ``rod_length_mm`` [mm]."""
+    """The machine: a crank-slider of ``crank_radius_mm`` [mm] and ``rod_length_mm`` [mm], its slide's line
+    ``offset_mm`` [mm] to the side of the crank axis (0: in line; ``press.crank_slider``)."""
 
     crank_radius_mm: Length
     rod_length_mm: Length
+    offset_mm: Offset = 0.0
 
 
 class KeyPointsModel(_Model):
@@ -103,18 +79,18 @@ class ProcessModel(_Model):
     forming_force_kN: ForceTable | None = None  # [[height above BDC mm, force kN], ...], linear between points
 
 
-class LimitsModel(_Model):
-    """Process and machine limits [units in the names]; ``min_crank_speed_rpm`` keeps the crank turning
-    forward; ``crank_speed_rpm``, ``crank_accel_rad_s2``, ``crank_jerk_rad_s3`` are the drive's limits."""
+def _limits_model() -> type[_Model]:
+    """The ``limits:`` section: the keys each limit declares (``planning.model.limits``), in their order."""
+    fields: dict[str, Any] = {}
+    for limit in LIMITS:
+        fields.update(limit.section_fields)
+    return create_model("LimitsModel", __base__=_Model, **fields)
 
-    draw_start_speed_mm_s: SliderSpeed
-    die_height_mm: Height
-    die_speed_mm_s: SliderSpeed
-    slider_accel_mm_s2: SliderAccel
-    min_crank_speed_rpm: CrankSpeed = 1.0
-    crank_speed_rpm: CrankSpeed | None = None  # motor limits (optional), on the crank
-    crank_accel_rad_s2: CrankAccel | None = None
-    crank_jerk_rad_s3: CrankJerk | None = None
+
+LimitsModel = _limits_model()
+LimitsModel.__doc__ = """Process and machine limits [units in the names]: one key or two per limit class
+(``planning.model.limits``); ``min_crank_speed_rpm`` keeps the crank turning forward; ``crank_speed_rpm``,
+``crank_accel_rad_s2``, ``crank_jerk_rad_s3`` are the drive's limits (optional)."""
 
 
 class MotorModel(_Model):
@@ -214,8 +190,8 @@ class Case(_Model):
     # ---- derived quantities in inside units ----
     @property
     def machine(self) -> CrankSlider:
-        """The crank-slider of the case (exact geometry)."""
-        return CrankSlider(self.press.crank_radius_mm, self.press.rod_length_mm)
+        """The press mechanism of the case (``press.mechanism``): the crank-slider, in line or offset."""
+        return _machine(self.press.crank_radius_mm, self.press.rod_length_mm, self.press.offset_mm)
 
     @property
     def key_angles(self) -> np.ndarray:
@@ -230,8 +206,7 @@ class Case(_Model):
         if d is None:
             return None
         return DriveModel.from_parts(
-            self.press.crank_radius_mm,
-            self.press.rod_length_mm,
+            self.machine,
             d.slide_mass_kg,
             d.rod_mass_kg,
             d.rod_cg_from_crank_pin_mm,
@@ -271,38 +246,15 @@ KEY_POINT_NAMES = ("closing", "draw_start", "draw_end", "opening")
 KEY_POINT_FIELDS = ("closing_deg", "draw_start_deg", "draw_end_deg", "opening_deg")
 
 
-def draw_speed_bounds(case: Case) -> dict[str, float]:
-    """The highest draw speed [rad/s] each limit allows during the constant-speed draw.
-
-    Keys: ``draw_start_speed`` (|v| at theta2), ``die_speed`` (|v| where the slider is at or below
-    the die height inside the draw), ``slider_accel`` (|a| = |d2h/dtheta2| w^2 over the draw).
-    """
-    m = case.machine
-    _, th2, th3, _ = case.key_angles
-    d1_2 = abs(float(m.derivatives(th2)[0]))
-    out = {"draw_start_speed": case.limits.draw_start_speed_mm_s / d1_2 if d1_2 > 0 else math.inf}
-    grid = np.linspace(th2, th3, 4001)
-    d1, d2, _ = m.derivatives(grid)
-    die = m.height(grid) <= case.limits.die_height_mm
-    lo, hi = m.angles_at_height(min(case.limits.die_height_mm, m.stroke))
-    edges = [a for a in (float(lo), float(hi)) if th2 <= a <= th3]  # |dh/dtheta| peaks at the crossings
-    slopes = np.abs(np.concatenate([d1[die], m.derivatives(np.array(edges))[0]])) if (die.any() or edges) else []
-    peak = float(np.max(slopes)) if len(slopes) else 0.0
-    out["die_speed"] = case.limits.die_speed_mm_s / peak if peak > 0 else math.inf
-    curv = float(np.max(np.abs(d2)))
-    out["slider_accel"] = math.sqrt(case.limits.slider_accel_mm_s2 / curv) if curv > 0 else math.inf
-    if case.limits.crank_speed_rpm is not None:
-        out["crank_speed"] = case.limits.crank_speed_rpm * RPM
-    if case.drive is not None:
-        out["motor_speed"] = case.drive.motor.max_speed_rpm * RPM / case.drive.gear_ratio
-    return out
-
-
 def cross_checks(case: Case) -> None:
-    """Checks that need several fields; raises :class:`CaseError` naming the first bad field."""
-    R, L = case.press.crank_radius_mm, case.press.rod_length_mm
+    """Checks that need several fields; raises :class:`CaseError` naming the first bad field: the geometry
+    and the key points' order, each limit's own (``Limit.validate``), the law, the drive, the objective,
+    and a given draw speed against the limits that refuse it (``Limit.refuse_draw_speed``)."""
+    R, L, e = case.press.crank_radius_mm, case.press.rod_length_mm, case.press.offset_mm
     if not L > R:
         raise CaseError("press.rod_length_mm", f"must be longer than the crank radius {R:g} mm", L)
+    if not abs(e) < L - R:
+        raise CaseError("press.offset_mm", f"must be less than rod length - crank radius = {L - R:g} mm", e)
     angles = [getattr(case.key_points, f) for f in KEY_POINT_FIELDS]
     for i in range(1, 4):
         if not angles[i] > angles[i - 1]:
@@ -311,29 +263,8 @@ def cross_checks(case: Case) -> None:
                 f"must be greater than key_points.{KEY_POINT_FIELDS[i - 1]} = {angles[i - 1]:g} deg (cycle order)",
                 angles[i],
             )
-    m = case.machine
-    stroke = m.stroke
-    safety = case.process.safety_height_mm
-    if safety > stroke:
-        raise CaseError("process.safety_height_mm", f"is above the stroke {stroke:g} mm", safety)
-    for field in ("closing_deg", "opening_deg"):
-        deg = getattr(case.key_points, field)
-        h = float(m.height(math.radians(deg)))
-        if h < safety:
-            raise CaseError(
-                f"key_points.{field}",
-                f"slider is at {h:.1f} mm there, below process.safety_height_mm = {safety:g}",
-                deg,
-            )
-    if case.limits.die_height_mm > stroke:
-        raise CaseError("limits.die_height_mm", f"is above the stroke {stroke:g} mm", case.limits.die_height_mm)
-    h2 = float(m.height(math.radians(case.key_points.draw_start_deg)))
-    if case.limits.die_height_mm >= h2:
-        raise CaseError(
-            "limits.die_height_mm",
-            f"must be below the slider height at the draw start ({h2:.1f} mm)",
-            case.limits.die_height_mm,
-        )
+    for limit in LIMITS:
+        limit.validate(case)
     fixed = case.planner.law_parameter
     if fixed is not None:
         law = LAWS[case.planner.motion_law]
@@ -349,34 +280,14 @@ def cross_checks(case: Case) -> None:
     _drive_checks(case)
     _objective_checks(case)
     _law_checks(case)
-    top = case.limits.crank_speed_rpm
-    if top is not None and top <= case.limits.min_crank_speed_rpm:
-        raise CaseError(
-            "limits.crank_speed_rpm",
-            f"must be above limits.min_crank_speed_rpm = {case.limits.min_crank_speed_rpm:g}",
-            top,
-        )
     if case.process.draw_speed_rpm is not None:
-        bounds = draw_speed_bounds(case)
-        limit_fields = {"draw_start_speed": "limits.draw_start_speed_mm_s", "die_speed": "limits.die_speed_mm_s"}
-        for key, field in limit_fields.items():
-            if case.process.draw_speed_rpm * RPM > bounds[key] * (1 + 1e-12):
-                raise CaseError(
-                    "process.draw_speed_rpm",
-                    f"is above the {bounds[key] / RPM:.3f} rpm that {field} allows",
-                    case.process.draw_speed_rpm,
-                )
-        top = case.limits.crank_speed_rpm
-        if top is not None and case.process.draw_speed_rpm > top:
-            raise CaseError(
-                "process.draw_speed_rpm", f"is above limits.crank_speed_rpm = {top:g}", case.process.draw_speed_rpm
-            )
-        if case.process.draw_speed_rpm < case.limits.min_crank_speed_rpm:
-            raise CaseError(
-                "process.draw_speed_rpm",
-                f"is below limits.min_crank_speed_rpm = {case.limits.min_crank_speed_rpm:g}",
-                case.process.draw_speed_rpm,
-            )
+        draw = Draw.of(case)
+        for limit in LIMITS:
+            if not limit.applies(case):
+                continue
+            problem = limit.refuse_draw_speed(draw, case.process.draw_speed_rpm * RPM)
+            if problem is not None:
+                raise CaseError("process.draw_speed_rpm", problem, case.process.draw_speed_rpm)
 
 
 def _drive_checks(case: Case) -> None:
@@ -415,13 +326,6 @@ def _drive_checks(case: Case) -> None:
             f"must not exceed drive.motor.max_speed_rpm = {d.motor.max_speed_rpm:g}",
             d.motor.base_speed_rpm,
         )
-    w_min_motor = case.limits.min_crank_speed_rpm * d.gear_ratio
-    if w_min_motor >= d.motor.max_speed_rpm:
-        raise CaseError(
-            "drive.motor.max_speed_rpm",
-            f"must be above the minimum crank speed through the gear ({w_min_motor:g} rpm)",
-            d.motor.max_speed_rpm,
-        )
 
 
 def _law_checks(case: Case) -> None:
@@ -450,6 +354,12 @@ def _objective_checks(case: Case) -> None:
             f"the {planner.motion_law} law plans for the most strokes only (max-spm); choose a law with halves",
             planner.objective,
         )
+
+
+@cache
+def _machine(crank_radius_mm: float, rod_length_mm: float, offset_mm: float) -> CrankSlider:
+    """One mechanism object per geometry (its derived figures are computed once)."""
+    return CrankSlider(crank_radius_mm, rod_length_mm, offset_mm)
 
 
 _SLUG = re.compile(r"[^A-Za-z0-9._-]+")

@@ -22,7 +22,6 @@ from planning.model.laws import DEFAULT_LAW, get_law
 from planning.model.laws import improved_scurve as sc
 from planning.model.profile import Segment
 
-STAGES = ("return", "transfer", "feed", "draw")
 HALVES = ("feed_accel", "feed_decel", "return_accel", "return_decel")
 RISING = {"feed_accel": 1.0, "feed_decel": -1.0, "return_accel": 1.0, "return_decel": -1.0}  # the peaks lie above
 

@@ -2,14 +2,14 @@
 
 The integrals over the cycle use Gauss-Legendre quadrature (:data:`GAUSS_NODES` nodes) on pieces of at
 most :data:`MAX_PIECE_S`, and at least :data:`MIN_PIECES` per span, between breakpoints: every knot of
-the profile, theta2 and BDC (where the
-forming force starts and ends) and every height of the forming-force table on the way down (its
-kinks). The integrands are smooth on each piece, so the crank work ``integral T_c omega dt`` is exact to
-about 1e-12 relative and can be checked against the forming work, which is integrated exactly from the
-table (``press.dynamics.forming_work``): over a cycle the kinetic energy returns to its start, and
-gravity and the counterbalance are conservative, so the two are equal (the energy balance). The drawn
-and returned energies ``E+ = integral max(P, 0) dt`` and ``E- = integral min(P, 0) dt`` have kinks where
-the power changes sign; there the quadrature is accurate to the piece length squared.
+the profile, theta2 and BDC (where the forming force starts and ends; the mechanism says where BDC is)
+and every height of the forming-force table on the way down (its kinks). The integrands are smooth on
+each piece, so the crank work ``integral T_c omega dt`` is exact to about 1e-12 relative and can be
+checked against the forming work, which is integrated exactly from the table
+(``press.dynamics.forming_work``): over a cycle the kinetic energy returns to its start, and gravity and
+the counterbalance are conservative, so the two are equal (the energy balance). The drawn and returned
+energies ``E+ = integral max(P, 0) dt`` and ``E- = integral min(P, 0) dt`` have kinks where the power
+changes sign; there the quadrature is accurate to the piece length squared.
 """
 
 from __future__ import annotations
@@ -20,8 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from planning.model.case import RPM, Case
-from planning.model.profile import Profile
-from press.dynamics import drive_state, forming_work
+from planning.model.profile import Profile, dense_times
+from press.dynamics import drive_state, envelope_torque, forming_work
 
 GAUSS_NODES = 4
 MAX_PIECE_S = 5e-3  # [s] (4-point Gauss-Legendre is exact for polynomials of degree 7 on each piece)
@@ -43,6 +43,7 @@ class DriveFigures:
     energy_drawn_kJ: float  # E+
     energy_returned_kJ: float  # E- (negative or zero)
     energy_net_kJ: float
+    supply_energy_kJ: float  # drawn from the supply per stroke, E+ - r |E-| (r: drive.regen_efficiency)
     forming_work_kJ: float
     crank_work_kJ: float  # integral of T_c omega over the cycle: equals the forming work
     crank_work_abs_kJ: float  # integral of |T_c omega|: the scale of the energy balance
@@ -57,12 +58,14 @@ def _breakpoints(profile: Profile, case: Case) -> np.ndarray:
     """Times [s] where the drive's integrands may kink: knots, theta2, BDC, table heights going down."""
     times = list(profile.knot_times)
     th0 = profile.theta0
-    angles = [case.key_angles[1], math.pi]
+    machine = case.machine
+    bdc = machine.bdc_angle
+    angles = [case.key_angles[1], bdc]
     table = case.process.forming_force_kN or []
     for h, _ in table:
-        if 0 < h < case.machine.stroke:
-            down = float(case.machine.angles_at_height(h)[0])
-            if case.key_angles[1] < down < math.pi:
+        if 0 < h < machine.stroke:
+            down = float(machine.angles_at_height(h)[0])
+            if case.key_angles[1] < down < bdc:
                 angles.append(down)
     for a in angles:
         a = th0 + ((a - th0) % (2 * math.pi))
@@ -93,14 +96,17 @@ def cycle_integrals(profile: Profile, case: Case) -> dict[str, float]:
     quadrature's drive state (``state``, ``omega``) for the peaks."""
     t, w = quadrature(profile, case)
     th, om, al, _ = profile.at_time(t)
-    s = drive_state(th, om, al, case.press.crank_radius_mm, case.press.rod_length_mm, case.drive_model)
+    s = drive_state(th, om, al, case.machine, case.drive_model)
     tm, p = s["motor_torque_Nm"], s["motor_power_W"]
     h2 = float(case.machine.height(case.key_angles[1]))
     work = s["crank_torque_Nm"] * om
+    drawn = float(np.sum(w * np.maximum(p, 0.0))) / 1e3
+    returned = float(np.sum(w * np.minimum(p, 0.0))) / 1e3
     return {
         "rms_motor_torque_Nm": math.sqrt(float(np.sum(w * tm**2)) / profile.duration),
-        "energy_drawn_kJ": float(np.sum(w * np.maximum(p, 0.0))) / 1e3,
-        "energy_returned_kJ": float(np.sum(w * np.minimum(p, 0.0))) / 1e3,
+        "energy_drawn_kJ": drawn,
+        "energy_returned_kJ": returned,
+        "supply_energy_kJ": drawn + case.drive.regen_efficiency * returned,
         "crank_work_kJ": float(np.sum(w * work)) / 1e3,
         "crank_work_abs_kJ": float(np.sum(w * np.abs(work))) / 1e3,
         "forming_work_kJ": forming_work(h2, 0.0, case.drive_model) / 1e3,
@@ -108,55 +114,53 @@ def cycle_integrals(profile: Profile, case: Case) -> dict[str, float]:
     }
 
 
-def drive_figures(profile: Profile, case: Case) -> DriveFigures:
+def dense_drive_state(profile: Profile, case: Case) -> tuple[np.ndarray, dict]:
+    """The crank angle [rad] and the drive's state (``press.dynamics.drive_state``) on the verification's
+    dense grid (uniform, knots included)."""
+    t = dense_times(profile.duration, profile.knot_times)
+    th, om, al, _ = profile.at_time(profile.t0 + t)
+    return th, drive_state(th, om, al, case.machine, case.drive_model)
+
+
+def drive_figures(
+    profile: Profile, case: Case, integrals: dict | None = None, dense: tuple[np.ndarray, dict] | None = None
+) -> DriveFigures:
     """The drive's figures over the cycle of ``profile`` (a plan's, from TDC); needs ``case.drive``.
-    Integrals by the quadrature (:func:`cycle_integrals`); peaks on the dense grid and the quadrature's
-    nodes together."""
+    Integrals by the quadrature (:func:`cycle_integrals`); peaks on the dense grid (:func:`dense_drive_state`)
+    and the quadrature's nodes together. ``integrals`` and ``dense``: those two already computed (the
+    verification computes both), else computed here."""
     motor = case.drive.motor
-    c = cycle_integrals(profile, case)
+    c = integrals if integrals is not None else cycle_integrals(profile, case)
     s = c["state"]
     tm, p = s["motor_torque_Nm"], s["motor_power_W"]
-    dense = _dense_peaks(profile, case)
-    k = int(np.argmax(dense["abs_torque"]))
+    theta, d = dense if dense is not None else dense_drive_state(profile, case)
+    abs_torque = np.abs(d["motor_torque_Nm"])
+    k = int(np.argmax(abs_torque))
     rms = c["rms_motor_torque_Nm"]
     return DriveFigures(
-        peak_motor_torque_Nm=float(dense["abs_torque"][k]),
-        peak_motor_torque_angle_deg=float(math.degrees(dense["theta"][k]) % 360.0),
+        peak_motor_torque_Nm=float(abs_torque[k]),
+        peak_motor_torque_angle_deg=float(math.degrees(theta[k]) % 360.0),
         rms_motor_torque_Nm=rms,
-        peak_crank_torque_Nm=float(max(np.max(np.abs(s["crank_torque_Nm"])), dense["abs_crank"])),
-        peak_motor_power_kW=float(max(np.max(np.abs(p)), dense["abs_power"])) / 1e3,
+        peak_crank_torque_Nm=float(max(np.max(np.abs(s["crank_torque_Nm"])), np.max(np.abs(d["crank_torque_Nm"])))),
+        peak_motor_power_kW=float(max(np.max(np.abs(p)), np.max(np.abs(d["motor_power_W"])))) / 1e3,
         peak_motor_speed_rpm=float(np.max(s["motor_speed_rad_s"])) / RPM,
         energy_drawn_kJ=c["energy_drawn_kJ"],
         energy_returned_kJ=c["energy_returned_kJ"],
         energy_net_kJ=c["energy_drawn_kJ"] + c["energy_returned_kJ"],
+        supply_energy_kJ=c["supply_energy_kJ"],
         forming_work_kJ=c["forming_work_kJ"],
         crank_work_kJ=c["crank_work_kJ"],
         crank_work_abs_kJ=c["crank_work_abs_kJ"],
         peak_torque_use_pct=100.0
-        * max(float(np.max(np.abs(tm) / _envelope(s["motor_speed_rad_s"], case))), dense["envelope_use"]),
+        * max(float(np.max(np.abs(tm) / _envelope(s["motor_speed_rad_s"], case))), _envelope_use(d, case)),
         rms_torque_use_pct=100.0 * rms / motor.rated_torque_Nm,
     )
 
 
 def _envelope(motor_speed_rad_s: np.ndarray, case: Case) -> np.ndarray:
-    from press.dynamics import envelope_torque
-
     m = case.drive.motor
     return envelope_torque(motor_speed_rad_s, m.peak_torque_Nm, m.base_speed_rpm * RPM)
 
 
-def _dense_peaks(profile: Profile, case: Case) -> dict:
-    """Peaks on the verification's dense grid (uniform, knots included, both sides of theta2)."""
-    from planning.solver.verify import dense_times
-
-    t = dense_times(profile.duration, profile.knot_times)
-    th, om, al, _ = profile.at_time(profile.t0 + t)
-    s = drive_state(th, om, al, case.press.crank_radius_mm, case.press.rod_length_mm, case.drive_model)
-    env = _envelope(s["motor_speed_rad_s"], case)
-    return {
-        "abs_torque": np.abs(s["motor_torque_Nm"]),
-        "theta": th,
-        "abs_crank": float(np.max(np.abs(s["crank_torque_Nm"]))),
-        "abs_power": float(np.max(np.abs(s["motor_power_W"]))),
-        "envelope_use": float(np.max(np.abs(s["motor_torque_Nm"]) / env)),
-    }
+def _envelope_use(state: dict, case: Case) -> float:
+    return float(np.max(np.abs(state["motor_torque_Nm"]) / _envelope(state["motor_speed_rad_s"], case)))

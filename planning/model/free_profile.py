@@ -17,11 +17,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planning.model.profile import Segment, knot_states
+from planning.model.laws.optimal import OptimalLaw
+from planning.model.profile import Profile, Segment, knot_states
 
 PHASES = (("return", 40), ("transfer", 24), ("feed", 40))  # name, segments: theta3->theta4->theta1->theta2
-SEGMENTS = sum(n for _, n in PHASES)
-OPTIMAL = "optimal"
 
 
 def free_segments(durations, jerks) -> list[Segment]:  # noqa: ANN001 - floats or CasADi symbols
@@ -42,7 +41,7 @@ class FreeProfileParameters:
     draw_speed: float
     draw_start: float
     draw_end: float
-    motion_law: str = OPTIMAL
+    motion_law: str = OptimalLaw.name
     transfer_dwell: float = 0.0
     law_parameter: float = 0.0
 
@@ -62,8 +61,6 @@ class FreeProfileParameters:
 
     def _speeds(self) -> tuple[float, float, float]:
         """Speed at TDC, highest speed on the return side (theta3 -> TDC) and the feed side (TDC -> theta2)."""
-        from planning.model.profile import Profile
-
         profile = Profile(tuple(self.segments()), self.draw_end, self.draw_speed)
         t = np.linspace(0.0, profile.duration, 4001)
         th, om, _, _ = profile.at_time(t)

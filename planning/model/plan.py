@@ -9,9 +9,12 @@ import numpy as np
 
 from planning.model.case import Placement
 from planning.model.cycle import CycleParameters, cycle_segments
+from planning.model.free_profile import FreeProfileParameters
 from planning.model.laws import DEFAULT_LAW
 from planning.model.laws import improved_scurve as sc
 from planning.model.profile import Profile, advance_segment, knot_states, split_segment
+
+KNOT_TOL_S = 1e-9  # [s] a time this close after a knot is the knot (where a key point falls)
 
 
 @dataclass(frozen=True)
@@ -24,16 +27,21 @@ class SolverInfo:
     status: str
 
 
+PlanParameters = CycleParameters | FreeProfileParameters  # a law's cycle of halves, or the optimal law's free profile
+
+
 @dataclass(frozen=True)
 class Plan:
     """One press cycle with its key points.
 
-    ``parameters``: the S-curve cycle (inside units); ``profile``: the crank motion over one period,
+    ``parameters``: the cycle's free numbers (inside units): a law's :class:`CycleParameters`, or the
+    optimal law's :class:`FreeProfileParameters`; both give the speeds, the transfer dwell and the
+    peaks a report reads. ``profile``: the crank motion over one period,
     time 0 at TDC (theta = 0, unwrapped to 2 pi at the end); ``key_angles`` theta1..theta4 [rad];
     ``placement``: free | published; ``structure``: where theta1 and theta4 fall (segment names).
     """
 
-    parameters: CycleParameters
+    parameters: PlanParameters
     profile: Profile
     key_angles: tuple[float, float, float, float]
     placement: Placement
@@ -58,9 +66,10 @@ class Plan:
 
     def segment_at(self, t: float) -> str:
         """Where time ``t`` [s] lies: ``segment name (NN% in)``; a knot counts as the end of the earlier
-        segment (``feed:accel1 (100% in)`` is the knot where the second sub-segment starts)."""
+        segment (``feed:accel1 (100% in)`` is the knot where the second sub-segment starts), also when ``t``
+        lies within :data:`KNOT_TOL_S` after it (round-off)."""
         tk = self.profile.knot_times
-        k = int(np.clip(np.searchsorted(tk, t, side="left") - 1, 0, len(self.profile.segments) - 1))
+        k = int(np.clip(np.searchsorted(tk, t - KNOT_TOL_S, side="left") - 1, 0, len(self.profile.segments) - 1))
         share = (t - tk[k]) / max(tk[k + 1] - tk[k], 1e-300)
         return f"{self.profile.segments[k].name} ({100 * share:.0f}% in)"
 

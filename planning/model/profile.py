@@ -25,12 +25,17 @@ construction.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Any, NamedTuple
 
 import numpy as np
+
+MAX_STEP_S = 1e-3  # [s] dense grid step (at most), for cycles up to MAX_SAMPLES * MAX_STEP_S = 1000 s
+MAX_SAMPLES = 1_000_000  # grid points at most: a longer cycle gets a uniform step of period / MAX_SAMPLES
+SAME_TIME_S = 1e-12  # [s] a grid point this close to a knot is dropped for the knot
 
 
 class Segment(NamedTuple):
@@ -192,3 +197,32 @@ class Profile:
             step = tau - err / om if om > 0 else 0.5 * (lo + hi)
             tau = step if lo < step < hi else 0.5 * (lo + hi)
         return float(tk[k] + tau)
+
+
+def dense_times(period: float, knot_times: np.ndarray, max_step: float = MAX_STEP_S) -> np.ndarray:
+    """A uniform grid over ``[0, period]`` [s] with step <= ``max_step`` (at most :data:`MAX_SAMPLES`
+    points: a coarser uniform step for a cycle longer than 1000 s), merged with the knots: the grid of
+    the dense verification and of the drive's peaks."""
+    n = min(int(math.ceil(period / max_step)), MAX_SAMPLES)
+    grid = np.linspace(0.0, period, n + 1)
+    knots = np.asarray(knot_times, dtype=float)
+    # a grid point on a knot up to round-off is the knot: the grid does not hang on the last digits
+    near = np.zeros(grid.size, dtype=bool)
+    at = np.searchsorted(grid, knots)
+    for j in (np.clip(at - 1, 0, n), np.clip(at, 0, n)):
+        near[j[np.abs(grid[j] - knots) <= SAME_TIME_S]] = True
+    near[[0, n]] = False  # the ends stay
+    return np.unique(np.concatenate([grid[~near], knots]))
+
+
+def max_abs_jerk(prof: Profile) -> float:
+    """Largest |crank jerk| [rad/s^3] of a profile: at a segment's ends where the jerk is linear; for a
+    shaped segment the closed-form peak of its whole half (``|dv| / D^2`` times the shape's peak), which a
+    piece cut off at TDC may not reach, so the figure errs on the safe side."""
+    out = 0.0
+    for s in prof.segments:
+        j = max(abs(float(s.j0)), abs(float(s.j0) + float(s.j1) * float(s.duration)))
+        if s.shape is not None:
+            j += abs(float(s.dv)) / float(s.span) ** 2 * float(s.shape.peak_jerk())
+        out = max(out, j)
+    return out

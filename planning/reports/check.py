@@ -7,14 +7,16 @@ from typing import Any
 
 import numpy as np
 
-from planning.model.case import KEY_POINT_NAMES, RPM, Case, draw_speed_bounds
+from planning.model.case import KEY_POINT_NAMES, RPM, Case
+from planning.model.limits import draw_speed_bounds, limits_of
+from planning.model.limits.base import Check, Draw
 
 ROUND_OFF = 1e-9  # relative: a check at the highest draw speed sits on its limit up to floating-point round-off
 
 
 def check_case(case: Case) -> dict[str, Any]:
     """Key-point table and PASS/FAIL checks at the draw speed (the given one, else the highest the
-    limits allow); plain data with engineering units in the keys."""
+    limits allow; each limit's own ``at_draw_speed``); plain data with engineering units in the keys."""
     m = case.machine
     bounds = draw_speed_bounds(case)
     w_max = min(bounds.values())
@@ -31,31 +33,19 @@ def check_case(case: Case) -> dict[str, Any]:
         }
         for i, name in enumerate(KEY_POINT_NAMES)
     ]
-    lim = case.limits
-    safety = case.process.safety_height_mm
-    checks = [
-        _check("slider height at closing >= safety height", h[0], safety, "mm", "min"),
-        _check("slider height at opening >= safety height", h[3], safety, "mm", "min"),
-        _check(
-            "slider speed at draw start <= draw_start_speed_mm_s", abs(v[1]), lim.draw_start_speed_mm_s, "mm/s", "max"
-        ),
-        _check(
-            f"slider speed at or below {lim.die_height_mm:g} mm <= die_speed_mm_s",
-            lim.die_speed_mm_s * w2 / bounds["die_speed"] if math.isfinite(bounds["die_speed"]) else 0.0,
-            lim.die_speed_mm_s,
-            "mm/s",
-            "max",
-        ),
-        _check(
-            "|slider acceleration| during the draw <= slider_accel_mm_s2",
-            lim.slider_accel_mm_s2 * (w2 / bounds["slider_accel"]) ** 2,
-            lim.slider_accel_mm_s2,
-            "mm/s^2",
-            "max",
-        ),
-    ]
+    draw = Draw.of(case)
+    checks = [_check(c) for limit in limits_of(case) for c in limit.at_draw_speed(draw, w2)]
+    bdc = math.degrees(m.bdc_angle)
     return {
         "case": case.name,
+        "press": {
+            "mechanism": m.kind,
+            "stroke_mm": m.stroke,
+            "tdc_deg": 0.0,  # key angles count from TDC
+            "bdc_deg": bdc,
+            "down_deg": bdc,  # crank angle from TDC to BDC: the slide goes down
+            "up_deg": 360.0 - bdc,
+        },
         "draw_speed_rpm": w2 / RPM,
         "draw_speed_given": case.process.draw_speed_rpm is not None,
         "key_points": points,
@@ -84,14 +74,16 @@ def warnings(case: Case) -> list[str]:
     return out
 
 
-def _check(name: str, value: float, limit: float, unit: str, kind: str) -> dict[str, Any]:
-    value = float(value)
-    margin = limit - value if kind == "max" else value - limit
+def _check(check: Check) -> dict[str, Any]:
+    """A check as the report lists it; passed up to floating-point round-off (a check at the highest draw
+    speed sits on its limit)."""
+    value, limit = float(check.value), float(check.limit)
+    margin = limit - value if check.kind == "max" else value - limit
     return {
-        "name": name,
+        "name": check.name,
         "value": value,
-        "limit": float(limit),
-        "unit": unit,
+        "limit": limit,
+        "unit": check.unit,
         "margin": margin,
         "passed": bool(np.isfinite(value) and margin >= -ROUND_OFF * abs(limit)),
     }
@@ -100,8 +92,12 @@ def _check(name: str, value: float, limit: float, unit: str, kind: str) -> dict[
 def check_text(report: dict[str, Any]) -> str:
     """Console table of a :func:`check_case` report."""
     given = "given" if report["draw_speed_given"] else "highest allowed"
+    p = report["press"]
     lines = [
         f"{report['case']}: key points at the draw speed {report['draw_speed_rpm']:.3f} rpm ({given})",
+        f"  {p['mechanism']}: stroke {p['stroke_mm']:.3f} mm; TDC at {p['tdc_deg']:.2f} deg, BDC at "
+        f"{p['bdc_deg']:.2f} deg of crank angle (the slide goes down for {p['down_deg']:.2f} deg, up for "
+        f"{p['up_deg']:.2f} deg)",
         "",
         f"  {'key point':<11} {'angle deg':>9} {'height mm':>10} {'slider speed mm/s':>18}",
     ]

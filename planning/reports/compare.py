@@ -11,7 +11,7 @@ import numpy as np
 from planning.model.case import KEY_POINT_NAMES, Case, PublishedSolution
 from planning.reports.report import key_points
 from planning.reports.source_solution import consistency, rebuild_profile, transfer_speed_rpm
-from planning.solver.optimize import Solution
+from planning.solver.solution import Solution
 
 SYMBOLS = {
     "x1_s": ("x1", "s", "start of the feed acceleration"),

@@ -42,7 +42,6 @@ SOLVE_FILES = (
     "motion_vs_angle.*",
     "drive.*",
 )
-FIGURE_FILES = ("motion_vs_time.*", "motion_vs_angle.*", "drive.*")
 COMPARE_FILES = ("comparison.json", "comparison.md")
 LAWS_FILES = ("laws.json", "laws.md", "laws_overlay.*")
 TRADEOFF_FILES = ("tradeoff.csv", "tradeoff.png")

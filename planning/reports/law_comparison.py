@@ -16,11 +16,12 @@ import numpy as np
 from planning.model.case import RPM, Case, CaseError
 from planning.model.case_file import CaseFileError
 from planning.model.laws import LAWS
+from planning.model.profile import max_abs_jerk
 from planning.reports.report import binding, sample_profile
 from planning.solver.bound import Bound, time_optimal_bound
-from planning.solver.optimize import Solution, solve
+from planning.solver.optimize import solve
 from planning.solver.outcomes import PlanningError
-from planning.solver.verify import max_abs_jerk
+from planning.solver.solution import Solution
 
 COLUMNS = (
     ("law", "law", ""),
@@ -70,11 +71,9 @@ def law_row(law: str, solution: Solution, case: Case, bound: Bound | None, table
 
 
 def _drive_columns(solution: Solution, case: Case) -> dict[str, Any]:
-    if case.drive is None:
+    if solution.drive is None:
         return {}
-    from planning.model.drive import drive_figures
-
-    fig = drive_figures(solution.plan.profile, case).as_dict()
+    fig = solution.drive.as_dict()
     return {key: fig[key] for key, _, _ in DRIVE_COLUMNS}
 
 

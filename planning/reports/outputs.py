@@ -19,7 +19,7 @@ from planning.reports.report import (
     trajectory_columns,
 )
 from planning.reports.source_solution import rebuild_profile
-from planning.solver.optimize import Solution
+from planning.solver.solution import Solution
 
 
 def solution_writers(
@@ -28,11 +28,13 @@ def solution_writers(
     *,
     cam_points: int = DEFAULT_POINTS,
     plot_format: str | None = "png",
+    result: dict | None = None,
 ) -> dict[str, Callable[[Path], None]]:
     """The files ``pressplan solve`` writes: result.json, trajectory.csv, cam_table.csv, summary.txt,
     published_profile.csv (when the case has a published solution) and the figures
-    (``plot_format`` None: no figures)."""
-    result = result_dict(solution, case)
+    (``plot_format`` None: no figures); ``result``: the solution's :func:`result_dict` when the caller has
+    it already."""
+    result = result if result is not None else result_dict(solution, case)
     traj = trajectory(solution, case)
     cam = cam_table(solution.plan, cam_points)
     cam_head = cam_header(solution.plan, case.name, cam_points)

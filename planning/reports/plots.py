@@ -341,9 +341,9 @@ def tradeoff_figure(rows: list[dict[str, Any]], case: Any, title: str) -> Figure
 
     motor = case.drive.motor
     curves = (  # axis, column, scale, marker, colour, label; each optimised (solid) and baseline (dashed)
-        (top, "rms_torque_Nm", 1e-3, "o", "tab:blue", "RMS"),
+        (top, "rms_motor_torque_Nm", 1e-3, "o", "tab:blue", "RMS"),
         (top, "peak_motor_torque_Nm", 1e-3, "s", "tab:orange", "peak"),
-        (bottom, "energy_kJ", 1.0, "o", "tab:green", ""),
+        (bottom, "supply_energy_kJ", 1.0, "o", "tab:green", ""),
     )
     for ax, name, unit, marker, colour, what in curves if ok else ():
         for prefix, style, label in (

@@ -13,13 +13,12 @@ import numpy as np
 
 from planning.model.case import KEY_POINT_NAMES, RPM, Case
 from planning.model.cycle import HALVES
-from planning.model.drive import drive_figures
 from planning.model.laws.improved_scurve import ImprovedSCurve
-from planning.model.profile import Profile
-from planning.solver.optimize import Solution
-from planning.solver.verify import MAX_STEP_S
+from planning.model.limits.slider_accel import SliderAcceleration
+from planning.model.profile import MAX_STEP_S, Profile
+from planning.solver.solution import Solution
 from press.dynamics import drive_state
-from press.kinematics import CrankSlider
+from press.mechanism import Mechanism
 
 TRAJECTORY_COLUMNS = (
     "time_s",
@@ -36,7 +35,7 @@ MAX_ROWS = 200_000  # trajectory rows at most: a cycle longer than 200 s gets a 
 
 
 def sample_profile(
-    profile: Profile, machine: CrankSlider, max_step: float = MAX_STEP_S, case: Case | None = None
+    profile: Profile, machine: Mechanism, max_step: float = MAX_STEP_S, case: Case | None = None
 ) -> np.ndarray:
     """``profile`` over its whole duration on a uniform time grid with step <= ``max_step`` [s] (at most
     :data:`MAX_ROWS` + 1 rows: a coarser uniform step for a long cycle); columns as
@@ -48,7 +47,7 @@ def sample_profile(
     h, v, a, _ = machine.slider(th, om, al, je)
     columns = [t, np.degrees(th), om / RPM, al, je, h, v, a]
     if case is not None and case.drive is not None:
-        s = drive_state(th, om, al, case.press.crank_radius_mm, case.press.rod_length_mm, case.drive_model)
+        s = drive_state(th, om, al, case.machine, case.drive_model)
         columns += [s["crank_torque_Nm"], s["motor_speed_rad_s"] / RPM, s["motor_torque_Nm"], s["motor_power_W"] / 1e3]
     return np.column_stack(columns)
 
@@ -120,7 +119,7 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
     plan = solution.plan
     p = plan.parameters
     ver = solution.verification
-    accel = next(c for c in ver.checks if c.name == "|slider acceleration|")
+    accel = ver.check(SliderAcceleration.id)
     return {
         "case": case.name,
         "spm": plan.spm,
@@ -140,7 +139,7 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
         "half_durations_s": {k: float(p.half(k)[0]) for k in HALVES} if hasattr(p, "half") else None,
         "segment_count": len(plan.profile.segments),
         "transfer_dwell_s": float(p.transfer_dwell),
-        "transfer_time_s": plan.transfer_window(),
+        "transfer_window_s": plan.transfer_window(),
         "max_abs_slider_accel_mm_s2": accel.value,
         "binding_constraints": binding(solution),
         "process": case.process.model_dump(),
@@ -166,31 +165,32 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
 
 
 def drive_block(solution: Solution, case: Case) -> dict[str, Any]:
-    """The ``drive`` block of ``result.json``: what the motor must give over the cycle, and its limits."""
-    fig = drive_figures(solution.plan.profile, case)
-    return {**fig.as_dict(), "motor": case.drive.motor.model_dump(), "gear_ratio": case.drive.gear_ratio}
+    """The ``drive`` block of ``result.json``: what the motor must give over the cycle (the figures the
+    solve computed), and its limits."""
+    return {**solution.drive.as_dict(), "motor": case.drive.motor.model_dump(), "gear_ratio": case.drive.gear_ratio}
 
 
 def objective_block(solution: Solution, case: Case) -> dict[str, Any]:
-    """The objective keys of ``result.json``: ``objective``, ``target_spm``; with a drive the plan's
-    ``rms_torque_Nm`` and ``energy_kJ`` (drawn from the supply per stroke, ``E+ - r |E-|``); at a target
-    rate also the ``baseline``'s (the max-SPM planner with the spare time given to the transfer), the
-    ``saving_pct`` and the ``fastest_spm`` the limits allow."""
+    """The objective keys of ``result.json``: ``objective``, ``target_spm``; at a target rate also the
+    ``baseline``'s figures (the max-SPM planner with the spare time given to the transfer: its RMS motor
+    torque, energy from the supply per stroke, robot's window and SPM), the ``saving_pct`` of the plan's
+    (in the ``drive`` block) against them, and the ``fastest_spm`` the limits allow."""
     out: dict[str, Any] = {"objective": case.planner.objective, "target_spm": case.planner.target_spm}
     a = solution.at_rate
     if a is not None:
-        out.update(a.figures.as_dict())
-        out.pop("spm")
-        baseline = {k: v for k, v in a.baseline_figures.as_dict().items()}
-        out["baseline"] = baseline
-        out["saving_pct"] = {"rms_torque": a.saving_pct("rms_torque_Nm"), "energy": a.saving_pct("energy_kJ")}
+        b = a.baseline
+        out["baseline"] = {
+            "rms_motor_torque_Nm": b.drive.rms_motor_torque_Nm,
+            "supply_energy_kJ": b.drive.supply_energy_kJ,
+            "transfer_window_s": b.plan.transfer_window(),
+            "spm": b.plan.spm,
+        }
+        out["saving_pct"] = {
+            "rms_torque": solution.saving_pct("rms_motor_torque_Nm"),
+            "energy": solution.saving_pct("supply_energy_kJ"),
+        }
         out["improved_on_baseline"] = a.improved
         out["fastest_spm"] = a.fastest_spm
-    elif case.drive is not None:
-        from planning.solver.objectives import rate_figures
-
-        fig = rate_figures(solution.plan, case)
-        out.update(rms_torque_Nm=fig.rms_torque_Nm, energy_kJ=fig.energy_kJ)
     return out
 
 
@@ -211,7 +211,7 @@ def summary_text(result: dict[str, Any]) -> str:
         if hd
         else f"  free profile: {r['segment_count']} segments of constant jerk (no halves), "
         f"|jerk| <= {r['limits']['crank_jerk_rad_s3']:g} rad/s^3",
-        f"  transfer window theta4 -> theta1: {r['transfer_time_s']:.4f} s; "
+        f"  transfer window theta4 -> theta1: {r['transfer_window_s']:.4f} s; "
         f"max |slider accel| {r['max_abs_slider_accel_mm_s2']:.1f} mm/s^2",
         "",
         f"  {'key point':<11} {'angle deg':>9} {'time s':>8} {'height mm':>9} {'slider mm/s':>11} {'crank rpm':>9}",
@@ -235,14 +235,15 @@ def summary_text(result: dict[str, Any]) -> str:
             f"(crank work {d['crank_work_kJ']:.1f} kJ)",
         ]
     if r.get("baseline"):
-        b, saving = r["baseline"], r["saving_pct"]
+        b, saving, d = r["baseline"], r["saving_pct"], r["drive"]
         lines += [
             "",
             f"  objective {r['objective']} at {r['target_spm']:g} strokes/min (the limits allow up to "
-            f"{r['fastest_spm']:.3f}): RMS motor torque {r['rms_torque_Nm'] / 1e3:.2f} kN m, "
-            f"energy from the supply {r['energy_kJ']:.1f} kJ per stroke",
-            f"  baseline (max-SPM plan, spare time in the transfer dwell; window {b['transfer_time_s']:.3f} s): RMS "
-            f"{b['rms_torque_Nm'] / 1e3:.2f} kN m, energy {b['energy_kJ']:.1f} kJ; saving {saving['rms_torque']:.1f} % "
+            f"{r['fastest_spm']:.3f}): RMS motor torque {d['rms_motor_torque_Nm'] / 1e3:.2f} kN m, "
+            f"energy from the supply {d['supply_energy_kJ']:.1f} kJ per stroke",
+            f"  baseline (max-SPM plan, spare time in the transfer dwell; window {b['transfer_window_s']:.3f} s): "
+            f"RMS {b['rms_motor_torque_Nm'] / 1e3:.2f} kN m, energy {b['supply_energy_kJ']:.1f} kJ; "
+            f"saving {saving['rms_torque']:.1f} % "
             f"RMS torque, {saving['energy']:.1f} % energy"
             + ("" if r["improved_on_baseline"] else " (no solve beat the baseline: it is the plan)"),
         ]

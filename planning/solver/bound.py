@@ -13,15 +13,15 @@ With s linear between nodes the crank acceleration is constant on each interval,
                s <= (v_die / |dh/dtheta|)^2 where the slider is at or below the die height
                s >= w_min^2;   sum of tau over theta4 -> theta1 >= transfer time   (linear)
 
-Every constraint set is convex and the objective linear, so IPOPT's optimum is the global one: a
-local solution cannot be mistaken for the bound. Where ``tau_i`` exceeds the interval's time (only
+Each limit of the case states its own part (``planning.model.limits``: ``bound_speeds``, ``bound_rows``);
+the RMS torque takes none (it is not a limit at a crank angle). Every constraint set is convex and the
+objective linear, so IPOPT's optimum is the global one: a local solution cannot be mistaken for the
+bound. Where ``tau_i`` exceeds the interval's time (only
 useful inside the robot window), the problem is a relaxation and the bound is still valid (never below
 the best SPM any motion reaches); ``window_slack_s`` reports how much was used. The drive's speed and
 acceleration limits enter as bounds on s and alpha. A crank-jerk limit J enters between neighbouring
-intervals as ``|alpha_{i+1} - alpha_i| <= J (tau_i + tau_{i+1}) / 2``: the acceleration of the interval
-centres may change by at most J times the time between them. It is linear in (s, tau), so the problem
-stays convex; since tau is at least the interval's time it is a relaxation of the jerk limit, and the
-bound stays an upper bound on what a jerk-limited motion reaches. Without a crank
+intervals as ``|alpha_{i+1} - alpha_i| <= J (tau_i + tau_{i+1}) / 2`` (``planning.model.limits.crank_jerk``).
+Without a crank
 acceleration limit the slack can be realised: near TDC dh/dtheta -> 0, so the slider does not feel the
 crank's acceleration there and the crank may slow almost to a stop at no cost in slider acceleration.
 """
@@ -36,10 +36,11 @@ import casadi as ca
 import numpy as np
 
 from planning.model.case import RPM, Case
+from planning.model.limits import limits_of
+from planning.model.limits.base import BoundGrid
 from planning.solver.ipopt import NLPSolver
-from planning.solver.optimize import crank_speed_limit, precheck
 from planning.solver.outcomes import Infeasible, NoPlanFound
-from press.dynamics import GRAVITY, forming_force
+from planning.solver.precheck import precheck
 
 DEFAULT_POINTS = 1440
 BOUND_OPTIONS = {"ipopt.max_iter": 3000}  # added to the wrapper's base options
@@ -75,23 +76,6 @@ class Bound:
         }
 
 
-def _motor_torque_bounds(case: Case, th, dth, s, s_next, alpha) -> list:  # noqa: ANN001 - CasADi MX
-    """Motor torque at both ends of every interval, as the two linear forms whose larger is the motor
-    torque: ``T_c / (i eta) + J_m i alpha`` and ``T_c eta / i + J_m i alpha``, with ``T_c`` linear in s and
-    alpha (``press.dynamics``). Both <= peak is exactly ``T_m <= peak``. The forming force is taken on
-    each interval's side of theta2 and BDC."""
-    d = case.drive_model
-    m = case.machine
-    out = []
-    for theta, speed2 in ((th[:-1] + 1e-12, s), (th[1:] - 1e-12, s_next)):
-        d1, d2, _ = m.derivatives(theta)
-        d1, d2 = d1 * 1e-3, d2 * 1e-3
-        f_env = forming_force(theta, m.height(theta), d) + d.F_cb - d.M * GRAVITY
-        tc = (d.J0 + d.M * d1**2) * alpha + d.M * d1 * d2 * speed2 - f_env * d1
-        out += [tc / (d.i * d.eta) + d.J_m * d.i * alpha, tc * d.eta / d.i + d.J_m * d.i * alpha]
-    return out
-
-
 def angle_grid(case: Case, points: int) -> np.ndarray:
     """Nodes [rad] from theta1 over one revolution, about ``points`` in all. Among them: the key angles,
     TDC, and the angles where the slide passes the die height, so that the die-height speed limit holds
@@ -121,66 +105,40 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
     n = len(th) - 1  # intervals; node n is node 0 one revolution on
     dth = np.diff(th)
     m = case.machine
-    d1, d2, _ = m.derivatives(th)
-    h = m.height(th)
+    h, d1, d2, _ = m.jets(th)
     lim = case.limits
     th1, th2, th3, th4 = case.key_angles
-    w_min = lim.min_crank_speed_rpm * RPM
+    limits = limits_of(case)
 
     draw = np.flatnonzero((th[:-1] >= th2 - 1e-12) & (th[:-1] <= th3 + 1e-12))
-    lbx_s = np.full(n, w_min**2)
-    top = crank_speed_limit(case)  # the drive's crank-speed limit and the motor's top speed through the gear
-    ubx_s = np.full(n, top**2 if top is not None else np.inf)
-    lbx_s[draw] = w2_lo**2
-    ubx_s[draw] = w2_hi**2
-    low = (h[:-1] <= lim.die_height_mm * (1 + 1e-12) + 1e-9) & (np.abs(d1[:-1]) > 0)  # the crossings count
-    ubx_s[low] = np.minimum(ubx_s[low], (lim.die_speed_mm_s / np.abs(d1[:-1][low])) ** 2)
-    if np.any(ubx_s < lbx_s):
-        raise Infeasible(
-            "the die-height speed limit leaves no crank speed above the minimum", limit="limits.die_speed_mm_s"
-        )
+    window = th[:-1] >= th4 - 1e-12  # the grid starts at theta1: the robot window is [theta4, theta1 + 2 pi)
+    grid = BoundGrid(case, th, h, d1, d2, dth, window)
+    lbx_s, ubx_s = _speed_bounds(grid, limits, draw, w2_lo, w2_hi)
     # scales: each node's speed^2 near the speed the slider-acceleration limit allows at constant speed,
     # within the node's bounds; each interval's time accordingly. A draw at 0.001 rpm and a stroke at
     # 30 rpm then both solve with variables of order one.
-    w_acc2 = lim.slider_accel_mm_s2 / (m.crank_radius + m.crank_radius**2 / m.rod_length)
+    w_acc2 = lim.slider_accel_mm_s2 / m.peak_curvature
     s_unit = np.clip(np.full(n, w_acc2), lbx_s, ubx_s)
     tau_unit = dth / np.sqrt(s_unit)
     x_s = ca.MX.sym("s", n)  # scaled speed^2 at nodes 0..n-1; node n is node 0
     x_tau = ca.MX.sym("tau", n)
-    s = ca.DM(s_unit) * x_s
-    tau = ca.DM(tau_unit) * x_tau
-    s_next = ca.vertcat(s[1:], s[0])
-    alpha = (s_next - s) / (2 * dth)
-    a_start = d2[:-1] * s + d1[:-1] * alpha
-    a_end = d2[1:] * s_next + d1[1:] * alpha
-    g = [tau - 2 * dth / (ca.sqrt(s) + ca.sqrt(s_next)), a_start, a_end]
-    lbg = [np.zeros(n), -lim.slider_accel_mm_s2 * np.ones(n), -lim.slider_accel_mm_s2 * np.ones(n)]
-    ubg = [np.full(n, np.inf), lim.slider_accel_mm_s2 * np.ones(n), lim.slider_accel_mm_s2 * np.ones(n)]
-    if lim.crank_accel_rad_s2 is not None:  # the drive's acceleration limit, linear in s
-        g.append(alpha)
-        lbg.append(-lim.crank_accel_rad_s2 * np.ones(n))
-        ubg.append(lim.crank_accel_rad_s2 * np.ones(n))
-    if lim.crank_jerk_rad_s3 is not None:  # |alpha_{i+1} - alpha_i| <= J (tau_i + tau_{i+1}) / 2, linear
-        alpha_next = ca.vertcat(alpha[1:], alpha[0])
-        tau_next = ca.vertcat(tau[1:], tau[0])
-        jerk_room = lim.crank_jerk_rad_s3 * (tau + tau_next) / 2
-        g += [alpha_next - alpha - jerk_room, alpha_next - alpha + jerk_room]
-        lbg += [np.full(n, -np.inf), np.zeros(n)]
-        ubg += [np.zeros(n), np.full(n, np.inf)]
-    if case.drive is not None:  # the motor's peak torque, driving side (see the module docstring)
-        for expr in _motor_torque_bounds(case, th, dth, s, s_next, alpha):
+    grid.s = ca.DM(s_unit) * x_s
+    grid.tau = ca.DM(tau_unit) * x_tau
+    grid.s_next = ca.vertcat(grid.s[1:], grid.s[0])
+    grid.tau_next = ca.vertcat(grid.tau[1:], grid.tau[0])
+    grid.alpha = (grid.s_next - grid.s) / (2 * dth)
+    g = [grid.tau - 2 * dth / (ca.sqrt(grid.s) + ca.sqrt(grid.s_next))]  # each interval's time (convex)
+    lbg, ubg = [np.zeros(n)], [np.full(n, np.inf)]
+    for limit in limits:
+        for expr, lo, hi in limit.bound_rows(grid):
             g.append(expr)
-            lbg.append(np.full(n, -np.inf))
-            ubg.append(np.full(n, case.drive.motor.peak_torque_Nm))
-    window = th[:-1] >= th4 - 1e-12  # the grid starts at theta1: the robot window is [theta4, theta1 + 2 pi)
-    g.append(ca.sum1(tau[np.flatnonzero(window).tolist()]))
-    lbg.append(np.array([case.process.transfer_time_s]))
-    ubg.append(np.array([np.inf]))
+            lbg.append(np.broadcast_to(lo, (expr.shape[0],)))
+            ubg.append(np.broadcast_to(hi, (expr.shape[0],)))
     if draw.size > 1:  # one speed through the draw
-        g.append(s[draw[1:].tolist()] - s[draw[:-1].tolist()])
+        g.append(grid.s[draw[1:].tolist()] - grid.s[draw[:-1].tolist()])
         lbg.append(np.zeros(draw.size - 1))
         ubg.append(np.zeros(draw.size - 1))
-    nlp = {"x": ca.vertcat(x_s, x_tau), "f": ca.sum1(tau), "g": ca.vertcat(*g)}
+    nlp = {"x": ca.vertcat(x_s, x_tau), "f": ca.sum1(grid.tau), "g": ca.vertcat(*g)}
     solver = NLPSolver("bound", nlp, BOUND_OPTIONS, fixed_scale=np.concatenate([s_unit, tau_unit]))
     s0 = s_unit  # the scales: speeds the slider-acceleration limit allows, within every bound
     x0 = np.concatenate([s0, 2 * dth / (2 * np.sqrt(s0))])
@@ -206,3 +164,32 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
         wall_time_s=time.perf_counter() - t_start,
         crank_jerk_limit_rad_s3=lim.crank_jerk_rad_s3,
     )
+
+
+def _speed_bounds(
+    grid: BoundGrid, limits: tuple, draw: np.ndarray, w2_lo: float, w2_hi: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The bounds on the speed squared at the nodes: every limit's, the draw's range on the draw's nodes.
+    :class:`Infeasible` naming the limit that leaves no speed at some node."""
+    n = grid.dtheta.size
+    lower, upper = np.zeros(n), np.full(n, np.inf)
+    uppers = []
+    for limit in limits:
+        lo, up = limit.bound_speeds(grid)
+        if lo is not None:
+            lower = np.maximum(lower, lo)
+        if up is not None:
+            upper = np.minimum(upper, up)
+            uppers.append((limit, up))
+    lower[draw] = np.maximum(lower[draw], w2_lo**2)
+    upper[draw] = np.minimum(upper[draw], w2_hi**2)
+    empty = np.flatnonzero(upper < lower)
+    if empty.size:
+        k = int(empty[0])
+        limit = next((lim for lim, up in uppers if up[k] < lower[k]), None)
+        field = limit.field if limit is not None else "limits.min_crank_speed_rpm"
+        raise Infeasible(
+            f"{field} leaves no crank speed above the minimum at {math.degrees(grid.theta[k]) % 360:.1f} deg",
+            limit=field,
+        )
+    return lower, upper

@@ -1,11 +1,11 @@
 """IPOPT behind one interface: the options, the call, the success test, scaling and warm starts.
 
-Every NLP of the project (the cycle NLP of each motion law, the time-optimal bound) is compiled once
-into an :class:`NLPSolver` and solved through :meth:`NLPSolver.solve`, which returns an
-:class:`NLPResult` with a typed status, the values in physical units, the constraint values, the
+Every NLP of the project (the cycle NLP of each motion law, the optimal law's, the time-optimal bound)
+is compiled once into an :class:`NLPSolver` and solved through :meth:`NLPSolver.solve`, which returns
+an :class:`NLPResult` with a typed status, the values in physical units, the constraint values, the
 multipliers, the iteration count and the wall time. This module and the modules that build CasADi
-expressions for it (``planning.solver.nlp``, ``planning.solver.bound``) are the only ones that import
-CasADi.
+expressions for it (``planning.solver.nlp``, ``planning.solver.halves_nlp``, ``planning.solver.free_nlp``,
+``planning.solver.bound``) are the only ones that import CasADi (``tests/test_architecture.py`` checks).
 
 Scaling: a problem may read a per-solve scale vector from the end of its parameter vector
 (physical value = scale * decision variable). :meth:`NLPSolver.solve` then takes the physical start

@@ -1,8 +1,8 @@
 """At the line's rate: the gentlest verified plan at a target SPM, and the baseline it beats.
 
 In a press line the rate is set by the line, not by one press's maximum. At a target rate (cycle time
-``60 / target_spm``, the "cycle time" row of the rate NLP ``cycle_nlp(law, rate=True)`` held fixed) the
-planner minimises
+``60 / target_spm``, the cycle-time row of the rate NLP (``planning.solver.halves_nlp``, ``rate=True``)
+held fixed) the planner minimises
 
 - ``min-rms-torque``: the heat ``integral T_m^2 dt`` over the cycle (the RMS torque squared times the
   cycle time, which is fixed);
@@ -19,79 +19,29 @@ before), started from the fastest plan run slower (every speed divided and every
 the ratio of the cycle times, so the key angles stay put); then the objective, started from a
 neighbouring rate's plan, the slowed fastest plan and the baseline (feasible at the rate, but from it
 IPOPT often crawls for hundreds of iterations where the baseline's dwell is long). The answer
-is the verified plan with the lowest exact objective; the baseline is one candidate, so the answer
-never does worse than waiting, and ``AtRate.improved`` says whether a solve beat it.
+is the verified plan with the lowest exact objective (``planning.solver.solution.objective_value``, from
+the drive's figures every verified plan carries); the baseline is one candidate, so the answer never
+does worse than waiting, and ``AtRate.improved`` says whether a solve beat it.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 from planning.model.case import Case, Placement
-from planning.model.drive import cycle_integrals
 from planning.model.plan import Plan
-from planning.solver.nlp import DRIVE_INDEX, VARIABLE_INDEX, VARIABLES, cycle_nlp
-from planning.solver.optimize import Solution, _prepare, _Search, solve
+from planning.solver.halves_nlp import VARIABLE_INDEX, VARIABLES, halves_nlp_for
+from planning.solver.max_spm import solve_max_spm
 from planning.solver.outcomes import Infeasible, NoPlanFound
-from planning.solver.verify import CHECK_FIELDS
+from planning.solver.search import Search, prepare
+from planning.solver.solution import AtRate, Solution, objective_value
+from planning.solver.verify import field_of_check
 
 RATE_TOLERANCE = 1e-9  # relative: a target this close above the fastest rate is that rate
 SAME_PERIOD_S = 1e-9  # [s] a plan whose period is this close to the target cycle time runs at the rate
 HEAT_TIE_BREAK = 1e-3  # min-energy: the heat's weight against the energy's (both normalised by the baseline's)
 BASELINE_SCORE = 1.0  # the objective's score of the baseline (the objectives are normalised by its figures)
-
-
-@dataclass(frozen=True)
-class RateFigures:
-    """The exact figures of one plan that the objectives weigh: RMS motor torque [N m], energy drawn
-    from the supply per stroke ``E+ - r |E-|`` [kJ], and the robot's window [s]."""
-
-    rms_torque_Nm: float
-    energy_kJ: float
-    transfer_time_s: float
-    spm: float
-
-    def as_dict(self) -> dict[str, float]:
-        return dict(self.__dict__)
-
-
-@dataclass(frozen=True)
-class AtRate:
-    """What a solve at the line's rate found: the ``objective``, ``target_spm``, the fastest rate the
-    limits allow (``fastest_spm``), the plan's and the baseline's figures, the baseline itself, and
-    whether the answer is the optimiser's plan (``improved``; False when no solve beat the baseline)."""
-
-    objective: str
-    target_spm: float
-    fastest_spm: float
-    figures: RateFigures
-    baseline_figures: RateFigures
-    baseline: Solution
-    improved: bool
-
-    def saving_pct(self, key: str) -> float:
-        """How much lower the plan's ``key`` (``rms_torque_Nm`` or ``energy_kJ``) is than the baseline's [%]."""
-        base = getattr(self.baseline_figures, key)
-        return 100.0 * (base - getattr(self.figures, key)) / base if base else 0.0
-
-
-def rate_figures(plan: Plan, case: Case) -> RateFigures:
-    """The exact RMS torque and supply energy of ``plan`` (the drive's quadrature)."""
-    c = cycle_integrals(plan.profile, case)
-    regen = case.drive.regen_efficiency
-    return RateFigures(
-        rms_torque_Nm=c["rms_motor_torque_Nm"],
-        energy_kJ=c["energy_drawn_kJ"] + regen * c["energy_returned_kJ"],
-        transfer_time_s=plan.transfer_window(),
-        spm=plan.spm,
-    )
-
-
-def objective_value(figures: RateFigures, objective: str) -> float:
-    """The exact objective: RMS torque squared [N^2 m^2] (the heat over the fixed cycle time) or the
-    supply energy [kJ]."""
-    return figures.rms_torque_Nm**2 if objective == "min-rms-torque" else figures.energy_kJ
 
 
 def solve_at_rate(
@@ -113,26 +63,23 @@ def solve_at_rate(
     placement = placement or case.planner.placement
     objective, target = case.planner.objective, case.planner.target_spm
     if fastest is None:
-        fastest = solve(case.with_objective("max-spm"), placement)
+        fastest = solve_max_spm(case.with_objective("max-spm"), placement)
     _check_reachable(target, fastest, case)
     period = 60.0 / target
     baseline = _baseline(case, placement, fastest, period, neighbour_baseline, confirm)
-    base_figures = rate_figures(baseline.plan, case)
-    scale = objective_value(base_figures, objective)
+    scale = objective_value(baseline, objective)
 
     if baseline is fastest:  # at the fastest rate the limits leave (generically) that one plan
-        return replace(
-            fastest, at_rate=AtRate(objective, target, fastest.plan.spm, base_figures, base_figures, fastest, False)
-        )
+        return replace(fastest, at_rate=AtRate(objective, target, fastest.plan.spm, fastest, False))
     search = _rate_search(case, placement, period)
     # normalised by the baseline: its objective is 1 (heat [N^2 m^2 s], energy [J] in the NLP)
-    heat_weight = 1.0 / (base_figures.rms_torque_Nm**2 * period)
+    heat_weight = 1.0 / (baseline.drive.rms_motor_torque_Nm**2 * period)
     if objective == "min-rms-torque":
-        search.parameters[DRIVE_INDEX["weight_heat"]] = heat_weight
+        search.parameters[search.parameter("weight_heat")] = heat_weight
     else:  # the energy has flat directions (a plan's speeds can trade without changing it): the heat breaks ties
-        search.parameters[DRIVE_INDEX["weight_energy"]] = 1.0 / (base_figures.energy_kJ * 1e3)
-        search.parameters[DRIVE_INDEX["weight_heat"]] = HEAT_TIE_BREAK * heat_weight
-    search.score = lambda plan: objective_value(rate_figures(plan, case), objective) / scale
+        search.parameters[search.parameter("weight_energy")] = 1.0 / (baseline.drive.supply_energy_kJ * 1e3)
+        search.parameters[search.parameter("weight_heat")] = HEAT_TIE_BREAK * heat_weight
+    search.score = lambda solution: objective_value(solution, objective) / scale
     search.consider(baseline, BASELINE_SCORE)
     starts = [_slowed(fastest.plan, period / fastest.plan.period, search), baseline.plan.nlp_values]
     _run_starts(search, starts, neighbour, placement, confirm, to_beat=BASELINE_SCORE)
@@ -145,24 +92,14 @@ def solve_at_rate(
         starts=info.starts + baseline.plan.solver.starts,
     )
     answer = replace(answer, plan=replace(answer.plan, solver=totals))
-    figures = rate_figures(answer.plan, case)
-    at_rate = AtRate(
-        objective=objective,
-        target_spm=target,
-        fastest_spm=fastest.plan.spm,
-        figures=figures,
-        baseline_figures=base_figures,
-        baseline=baseline,
-        improved=improved,
-    )
-    return replace(answer, at_rate=at_rate)
+    return replace(answer, at_rate=AtRate(objective, target, fastest.plan.spm, baseline, improved))
 
 
 def _check_reachable(target: float, fastest: Solution, case: Case) -> None:
     """:class:`Infeasible` when the target rate is above what the limits allow, naming the ones that bind."""
     if target <= fastest.plan.spm * (1 + RATE_TOLERANCE):
         return
-    binding = [CHECK_FIELDS.get(c.id, c.name) for c in fastest.verification.binding()]
+    binding = [field_of_check(c.id) or c.name for c in fastest.verification.binding()]
     named = ", ".join(dict.fromkeys(binding)) or "the key points and limits together"
     raise Infeasible(
         f"planner.target_spm = {target:g} is above the {fastest.plan.spm:.3f} strokes/min the limits allow "
@@ -173,12 +110,12 @@ def _check_reachable(target: float, fastest: Solution, case: Case) -> None:
     )
 
 
-def _rate_search(case: Case, placement: Placement, period: float) -> _Search:
+def _rate_search(case: Case, placement: Placement, period: float) -> Search:
     """The rate NLP's search with the cycle time held at ``period`` [s] and every objective weight 0."""
-    search = _prepare(case, placement, cycle_nlp(case.planner.motion_law, drive=True, rate=True))
+    search = prepare(case, placement, halves_nlp_for(case, drive=True, rate=True))
     search.parameters = search.parameters.copy()
-    search.parameters[DRIVE_INDEX["target_period"]] = period
-    search.parameters[DRIVE_INDEX["weight_period"]] = 0.0
+    search.parameters[search.parameter("target_period")] = period
+    search.parameters[search.parameter("weight_period")] = 0.0
     search.fixed_period = True
     return search
 
@@ -192,8 +129,8 @@ def _baseline(
         return fastest
     search = _rate_search(case, placement, period)
     time_unit = search.scale[VARIABLE_INDEX["transfer_dwell"]]
-    search.parameters[DRIVE_INDEX["weight_dwell"]] = 1.0 / time_unit
-    search.score = lambda plan: -float(plan.parameters.transfer_dwell) / period
+    search.parameters[search.parameter("weight_dwell")] = 1.0 / time_unit
+    search.score = lambda solution: -float(solution.plan.parameters.transfer_dwell) / period
     _run_starts(search, [_slowed(fastest.plan, period / fastest.plan.period, search)], neighbour, placement, confirm)
     try:
         return search.answer()
@@ -201,7 +138,7 @@ def _baseline(
         raise NoPlanFound(f"no baseline at {60 / period:.4g} strokes/min: {exc.reason}", exc.attempts) from None
 
 
-def _slowed(plan: Plan, factor: float, search: _Search) -> dict[str, float]:
+def _slowed(plan: Plan, factor: float, search: Search) -> dict[str, float]:
     """``plan``'s NLP values run ``factor`` times slower: every angle, so every key point and the cycle's
     closure, stays where it was (a start; speeds held within their bounds, the draw's in particular)."""
     values = {}
@@ -217,7 +154,7 @@ def _slowed(plan: Plan, factor: float, search: _Search) -> dict[str, float]:
 
 
 def _run_starts(
-    search: _Search,
+    search: Search,
     starts: list[dict[str, float]],
     neighbour: Plan | None,
     placement: Placement,

@@ -9,12 +9,14 @@ its peak acceleration and jerk in closed form (for the drive limits) and its con
 =================  ====================================================  ===========================
 law                one half                                              continuous up to
 =================  ====================================================  ===========================
-improved-s-curve   paper 003 Eq. 10: four sub-segments of D/4, linear     acceleration (jerk steps)
-                   jerk; one jerk for both halves of an S-curve (Eq. 14)
-seven-segment      seeds 000/002/004: jerk phase r D/2, constant          acceleration (jerk steps)
-                   acceleration (1 - r) D, jerk phase r D/2; r optimised
-quintic            seed 001: s = 10u^3 - 15u^4 + 6u^5                     jerk
-logistic           seed 000 Eq. 4 with its end slope removed, flexible a  acceleration (small jerk steps)
+improved-s-curve   Wang, Wu & Ding Eq. 10: four sub-segments of D/4,      acceleration (jerk steps)
+                   linear jerk; one jerk for both halves (Eq. 14)
+seven-segment      Li & Chen; Wang & Zhang; Zhang, Chen & Hu: jerk       acceleration (jerk steps)
+                   phase r D/2, constant acceleration (1 - r) D, jerk
+                   phase r D/2; r optimised
+quintic            Liu & Wu: s = 10u^3 - 15u^4 + 6u^5                     jerk
+logistic           Li & Chen Eq. 4 with its end slope removed,            acceleration (small jerk steps)
+                   flexible a
 cycloidal          cam classic, acceleration 1 - cos(2 pi u)              jerk
 optimal            no halves: a piecewise-constant jerk profile from       acceleration (jerk steps)
                    theta3 round to theta2, planned whole under |jerk| <= J
@@ -41,12 +43,11 @@ LAWS: dict[str, MotionLaw] = {
     for law in (ImprovedSCurve(), SevenSegment(), QuinticLaw(), LogisticLaw(), CycloidalLaw(), OptimalLaw())
 }
 DEFAULT_LAW = ImprovedSCurve.name
-OPTIMAL_LAW = OptimalLaw.name
 SHAPED_LAWS = tuple(name for name, law in LAWS.items() if not law.free_profile)  # the laws with halves
 LawName = Literal["improved-s-curve", "seven-segment", "quintic", "logistic", "cycloidal", "optimal"]
 assert set(get_args(LawName)) == set(LAWS)
 
-__all__ = ["DEFAULT_LAW", "LAWS", "OPTIMAL_LAW", "SHAPED_LAWS", "LawName", "MotionLaw", "ShapeParameter", "get_law"]
+__all__ = ["DEFAULT_LAW", "LAWS", "SHAPED_LAWS", "LawName", "MotionLaw", "ShapeParameter", "get_law"]
 
 
 def get_law(name: str) -> MotionLaw:

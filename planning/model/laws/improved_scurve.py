@@ -1,4 +1,5 @@
-"""The improved 10-segment S-curve of Wang, Wu & Ding (paper 003, Eqs. 10-21).
+"""The improved 10-segment S-curve of Wang, Wu & Ding, "Slider movement planning based on
+improved S-curve acceleration algorithms for servo presses" (Eqs. 10-21).
 
 One S-curve takes the crank from a start speed ``v_s`` to an extreme speed ``v_max`` and on to an
 end speed ``v_e``. Between the constant-speed segments 1 and 10 lie four acceleration sub-segments of
@@ -104,7 +105,7 @@ class ImprovedSCurve(MotionLaw):
 
     name = "improved-s-curve"
     continuity = "acceleration"
-    source = "paper 003, Eqs. 10-21"
+    source = "Wang, Wu & Ding, Eqs. 10-21"
     one_jerk_per_curve = True
 
     def half(self, prefix: str, duration: Any, dv: Any, param: Any = None) -> list[Segment]:

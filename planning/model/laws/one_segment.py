@@ -37,7 +37,7 @@ class OneSegmentLaw(MotionLaw):
 class QuinticLaw(OneSegmentLaw):
     name = "quintic"
     continuity = "jerk"
-    source = "seed 001"
+    source = "Liu & Wu (LED die bonder)"
 
     def shape(self, param: Any = None) -> Quintic:
         return Quintic()
@@ -55,7 +55,7 @@ class CycloidalLaw(OneSegmentLaw):
 class LogisticLaw(OneSegmentLaw):
     name = "logistic"
     continuity = "acceleration"
-    source = "seed 000, Eq. 4"
+    source = "Li & Chen (bond-wire winder), Eq. 4"
     parameter = ShapeParameter("flexible", 4.0, 6.0, 5.0, LOGISTIC_MIN_FLEXIBLE, 30.0)
 
     def shape(self, param: Any = None) -> Logistic:

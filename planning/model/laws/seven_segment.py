@@ -1,4 +1,4 @@
-"""The classic seven-segment S-curve (seeds 000, 002, 004) as a motion law.
+"""The classic seven-segment S-curve (Li & Chen; Wang & Zhang; Zhang, Chen & Hu) as a motion law.
 
 One half of duration ``D`` changes the speed by ``dv`` in three segments: a jerk phase ``r D / 2``, a
 constant-acceleration plateau ``(1 - r) D``, a jerk phase ``r D / 2``. With plateau acceleration ``a``
@@ -17,7 +17,7 @@ from planning.model.profile import Segment
 class SevenSegment(MotionLaw):
     name = "seven-segment"
     continuity = "acceleration"
-    source = "seeds 000, 002, 004"
+    source = "Li & Chen; Wang & Zhang; Zhang, Chen & Hu"
     parameter = ShapeParameter("jerk_share", 0.2, 1.0, 0.6, 0.01, 1.0)
 
     def half(self, prefix: str, duration: Any, dv: Any, param: Any = None) -> list[Segment]:

@@ -24,7 +24,7 @@ from press.backend import math_module
 
 @dataclass(frozen=True)
 class Quintic:
-    """Fifth-order polynomial transition (seed 001): ``s = 10 u^3 - 15 u^4 + 6 u^5``.
+    """Fifth-order polynomial transition (Liu & Wu, LED die bonder): ``s = 10 u^3 - 15 u^4 + 6 u^5``.
 
     Zero speed change, acceleration and jerk at both ends, so the jerk is continuous across the
     constant-speed segments and the peak. Peaks: ``s' = 15/8`` at ``u = 1/2``; ``|s''| = 10 / sqrt(3)`` at
@@ -75,12 +75,13 @@ class Cycloidal:
 
 @dataclass(frozen=True)
 class Logistic:
-    """The logistic S-curve of seed 000, Eq. 4, ``f = f_s + (f_e - f_s) / (1 + exp(-a (x - d) / d))`` on
-    ``x in [0, 2 d]``, with ``a`` the seed's "flexible" parameter (4-6 there).
+    """The logistic S-curve of Li & Chen (bond-wire winder), Eq. 4,
+    ``f = f_s + (f_e - f_s) / (1 + exp(-a (x - d) / d))`` on ``x in [0, 2 d]``, with ``a`` the source's
+    "flexible" parameter (4-6 there).
 
     As printed the curve neither starts at ``f_s`` nor ends at ``f_e``, and its slope at the ends is
     ``2 a g(0) (1 - g(0))`` (``g`` the logistic), so joining it to constant speeds would step the speed
-    and the acceleration. Here (derived, not in the seed) the end slope is taken out and the rest
+    and the acceleration. Here (derived, not in the source) the end slope is taken out and the rest
     rescaled: with ``g(u) = 1 / (1 + exp(-a (2u - 1)))`` and ``c = g'(0)``::
 
         s(u) = (g(u) - g(0) - c u) / N,    N = g(1) - g(0) - c

@@ -171,7 +171,7 @@ function render(answer, seq) {
   $("#binding").textContent = r.binding_constraints.join(", ") || "none";
   setStatus(`${r.motion_law}, ${r.placement} placement, ${r.status}: every limit holds on the dense ${(r.verification.step_s * 1e3).toFixed(3)} ms grid`, "");
   $("#objective-line").textContent = r.baseline
-    ? `${r.objective} at ${r.target_spm} SPM: RMS ${(r.rms_torque_Nm / 1e3).toFixed(2)} kN m, energy ${r.energy_kJ.toFixed(1)} kJ/stroke; ` +
+    ? `${r.objective} at ${r.target_spm} SPM: RMS ${(r.drive.rms_motor_torque_Nm / 1e3).toFixed(2)} kN m, energy ${r.drive.supply_energy_kJ.toFixed(1)} kJ/stroke; ` +
       `saving ${r.saving_pct.rms_torque.toFixed(1)} % RMS, ${r.saving_pct.energy.toFixed(1)} % energy against waiting`
     : "";
   $("#drive-line").textContent = r.drive

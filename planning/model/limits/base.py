@@ -1,0 +1,330 @@
+"""A limit of the press cycle, stated once, and the contexts in which the algorithms ask for it.
+
+A limit owns its case field, a stable id, its display name and unit, its NLP parameters and its
+expression at the sampled states of any transcription, its dense check with a named tolerance, its
+part in the time-optimal bound, the highest constant draw speed it allows, and its precheck. The
+algorithms (the NLPs, the bound, the verification, the prechecks, ``pressplan check``) iterate over the
+list ``planning.model.limits.LIMITS`` and never name a limit; messages and reports find a limit by its
+id (toppra's constraint objects, handed to its algorithms as a list, are the model).
+
+The contexts below are the contract between the limits and the algorithms:
+
+- :class:`Transcription`: an NLP's states at its samples and the extremes it can express (symbols);
+- :class:`Dense`: the dense re-simulation of a plan (numpy arrays);
+- :class:`BoundGrid`: the time-optimal bound's grid over crank angle and its variables (symbols); a limit
+  that does not take part in the bound says why in its docstring;
+- :class:`Draw`: the draw at constant crank speed, sampled (numpy arrays), for the draw-speed bounds.
+
+Every expression works on numpy arrays and CasADi symbols alike (``press.backend``); nothing here
+imports CasADi.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from typing import Any, ClassVar, NamedTuple
+
+import numpy as np
+
+from press.backend import math_module
+
+REL_TOL = 1e-6  # relative tolerance of every dense check of a limit (the README's numerical contract)
+TIME_TOL = 1e-6  # [s] a time limit
+BINDING_SHARE = 1e-4  # relative: a check within this share of its limit binds (the reports' binding list)
+NO_LIMIT = 1e9  # stands for an absent limit in an NLP's parameters
+DRAW_GRID = 4001  # angles from theta2 to theta3 on which the draw-speed bounds are taken
+
+
+@dataclass(frozen=True)
+class Check:
+    """One verified constraint ``id`` (display ``name``): measured ``value`` against ``limit`` (``kind``
+    max|min|equal) in ``unit``."""
+
+    name: str
+    value: float
+    limit: float
+    unit: str
+    kind: str
+    passed: bool
+    id: str = field(compare=False)
+
+    @classmethod
+    def of(cls, check_id: str, name: str, value: float, limit: float, unit: str, kind: str, tol: float) -> Check:
+        """The check of ``value`` against ``limit`` within ``tol`` (same unit); NaN fails."""
+        value, limit = float(value), float(limit)
+        if not math.isfinite(value):
+            ok = False
+        elif kind == "max":
+            ok = value <= limit + tol
+        elif kind == "min":
+            ok = value >= limit - tol
+        else:
+            ok = abs(value - limit) <= tol
+        return cls(name, value, limit, unit, kind, ok, check_id)
+
+    @property
+    def margin(self) -> float:
+        """Distance to the limit, positive when satisfied (for ``equal``: minus the error)."""
+        if self.kind == "max":
+            return self.limit - self.value
+        if self.kind == "min":
+            return self.value - self.limit
+        return -abs(self.value - self.limit)
+
+    @property
+    def binds(self) -> bool:
+        """An inequality that sits at its limit, within :data:`BINDING_SHARE` of it."""
+        return self.kind in ("max", "min") and abs(self.margin) <= BINDING_SHARE * max(abs(self.limit), 1e-12)
+
+    def as_dict(self) -> dict:
+        """The check as ``result.json`` writes it (display name, value, limit, unit, kind, passed, margin)."""
+        out = asdict(self)
+        del out["id"]
+        return {**out, "margin": self.margin}
+
+
+class Row(NamedTuple):
+    """A block of NLP rows ``lo <= expr <= hi`` named ``name``; ``sampled``: the limit holds at the NLP's
+    samples only (the dense check may find it exceeded between them: the search then tightens the limit's
+    :attr:`Limit.refined` parameter)."""
+
+    name: str
+    expr: Any
+    lo: Any
+    hi: Any
+    sampled: bool = False
+
+
+class Extremes(NamedTuple):
+    """Expressions whose largest magnitude is a quantity's peak over the cycle: closed-form peaks
+    (``signed`` False: each is a magnitude) or the values at the samples (``signed``, ``sampled``)."""
+
+    values: Any
+    signed: bool = False
+    sampled: bool = False
+
+
+@dataclass
+class Transcription:
+    """What an NLP offers the limits (CasADi symbols; inside units).
+
+    ``theta`` [rad], ``omega`` [rad/s], ``alpha`` [rad/s^2], ``times`` [s]: column vectors at the samples,
+    in time order, the draw's ``draw_count`` samples last; ``height`` [mm], ``slope`` [mm/rad],
+    ``curvature`` [mm/rad^2]: the mechanism's h, dh/dtheta, d2h/dtheta2 there. ``period`` [s];
+    ``window_time`` [s]: the robot's time from theta4 to theta1. ``speeds``, ``accelerations``,
+    ``jerks``: the crank's extremes as the transcription can state them (``jerks`` None: its variable
+    bounds hold the jerk); ``lowest_speeds``: expressions whose minimum is the lowest crank speed (None:
+    its variable bounds hold it). ``crossings``: ``(omega, |dh/dtheta|)`` where the slide passes the die
+    height outside the draw; ``zone``: the crank speed may peak while the slide is below the die height
+    (rows at every sample there). ``rate``: the NLP of a target rate. ``speed_unit`` [rad/s] and
+    ``length_unit`` [mm]: scales of rows. ``motor_torque`` [N m] and ``motor_speed`` [rad/s] at the
+    samples in a drive NLP, else None. ``param(name)``: a case parameter's symbol.
+    """
+
+    theta: Any
+    omega: Any
+    alpha: Any
+    times: Any
+    height: Any
+    slope: Any
+    curvature: Any
+    draw_count: int
+    period: Any
+    window_time: Any
+    speeds: Extremes
+    accelerations: Extremes
+    jerks: Extremes | None
+    lowest_speeds: Any | None
+    crossings: list[tuple[Any, Any]]
+    zone: bool
+    rate: bool
+    speed_unit: Any
+    length_unit: Any
+    param: Callable[[str], Any]
+    motor_torque: Any = None
+    motor_speed: Any = None
+
+    def outside_draw(self, values: Any) -> Any:
+        """The entries of a sample vector before the draw's."""
+        return values[0 : values.shape[0] - self.draw_count]
+
+
+@dataclass
+class Dense:
+    """A plan re-simulated densely (numpy arrays, inside units): times ``t`` [s] from TDC and the crank's
+    ``theta``, ``omega``, ``alpha``, ``jerk``, the slide's ``h``, ``v``, ``a`` there; the key points'
+    times ``key_times`` [s]; the ``plan`` and the ``case``; with a drive, the drive's state on the grid
+    (``drive_state``, ``press.dynamics.drive_state``) and the cycle's integrals (``integrals``,
+    ``planning.model.drive.cycle_integrals``)."""
+
+    case: Any
+    plan: Any
+    t: np.ndarray
+    theta: np.ndarray
+    omega: np.ndarray
+    alpha: np.ndarray
+    jerk: np.ndarray
+    h: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    key_times: np.ndarray
+    drive_state: dict | None = None
+    integrals: dict | None = None
+
+
+@dataclass
+class BoundGrid:
+    """The time-optimal bound's grid (``planning.solver.bound``): ``theta`` [rad], ``h`` [mm], ``d1``
+    [mm/rad], ``d2`` [mm/rad^2] at the n + 1 nodes (node n is node 0 a turn on), ``dtheta`` [rad] of the n
+    intervals; the symbols ``s`` (crank speed squared at nodes 0 .. n-1 [rad^2/s^2]), ``s_next`` (at
+    1 .. n), ``alpha`` (constant crank acceleration of each interval [rad/s^2]), ``tau`` (each interval's
+    time [s]), ``tau_next``; ``window``: the intervals of the robot's window theta4 -> theta1; the
+    ``case``."""
+
+    case: Any
+    theta: np.ndarray
+    h: np.ndarray
+    d1: np.ndarray
+    d2: np.ndarray
+    dtheta: np.ndarray
+    window: np.ndarray
+    s: Any = None
+    s_next: Any = None
+    alpha: Any = None
+    tau: Any = None
+    tau_next: Any = None
+
+
+@dataclass
+class Draw:
+    """The draw at constant crank speed, theta2 -> theta3: ``theta`` [rad] on :data:`DRAW_GRID` angles and
+    the mechanism's ``h`` [mm], ``d1`` [mm/rad], ``d2`` [mm/rad^2] there; the ``case``."""
+
+    case: Any
+    theta: np.ndarray
+    h: np.ndarray
+    d1: np.ndarray
+    d2: np.ndarray
+
+    @classmethod
+    def of(cls, case: Any) -> Draw:
+        _, th2, th3, _ = case.key_angles
+        theta = np.linspace(th2, th3, DRAW_GRID)
+        h, d1, d2, _ = case.machine.jets(theta)
+        return cls(case, theta, h, d1, d2)
+
+
+class Impossible(NamedTuple):
+    """A limit that provably cannot be met, found before solving: ``reason`` (one line), the case
+    ``field`` (dotted), its ``value``, what it would have to be (``needed``) and where (``angle_deg``)."""
+
+    reason: str
+    field: str
+    value: float | None = None
+    needed: float | None = None
+    angle_deg: float | None = None
+
+
+class Limit:
+    """A limit of the press cycle (module docstring). Class attributes: ``id`` (stable), ``name`` (shown),
+    ``unit``, ``field`` (the dotted case field a user changes to relax it), ``order`` (its place in every
+    list), ``section_fields`` (the keys it adds to the case's ``limits:`` section: name -> (type, default;
+    ``...`` required)), ``parameters`` (its NLP parameters, set by :meth:`parameter_values`), ``refined``
+    (the parameter the search tightens when the dense check finds the limit exceeded between an NLP's
+    samples; ``refine_upward``: a lower limit, raised instead), ``backoff`` (relative: the NLP holds the
+    limit this much inside) and ``harder_backoff`` (a wider one for a second round when no start
+    verified; None: not widened), ``overestimated`` (its NLP row can
+    overstate the exact figure: where the row is active but the exact check leaves room, the search
+    loosens the parameter once by the room), ``motor`` (a limit of the motor: a plan of the NLP without
+    the drive's rows cannot be trusted to keep it), ``uses_drive`` (its rows need the drive's torque at
+    the samples: drive NLPs only). Every method has a default that does nothing."""
+
+    id: ClassVar[str]
+    name: ClassVar[str]
+    unit: ClassVar[str]
+    field: ClassVar[str]
+    order: ClassVar[int]
+    section_fields: ClassVar[dict[str, tuple[Any, Any]]] = {}
+    parameters: ClassVar[tuple[str, ...]] = ()
+    refined: ClassVar[str | None] = None
+    refine_upward: ClassVar[bool] = False
+    backoff: ClassVar[float] = 0.0
+    harder_backoff: ClassVar[float | None] = None
+    overestimated: ClassVar[bool] = False
+    motor: ClassVar[bool] = False
+    uses_drive: ClassVar[bool] = False
+
+    def applies(self, case: Any) -> bool:
+        """Whether ``case`` sets this limit (an NLP of the case has its rows only then)."""
+        return True
+
+    def validate(self, case: Any) -> None:
+        """Raise :class:`~planning.model.errors.CaseError` when the limit's fields do not hold together
+        with the rest of the case (read time)."""
+
+    def refuse_draw_speed(self, draw: Draw, speed: float) -> str | None:
+        """Why a draw speed ``speed`` [rad/s] given in the case is an error in the case (exit 2), or None."""
+        return None
+
+    def draw_speed_bound(self, draw: Draw) -> float | None:
+        """The highest constant draw speed [rad/s] this limit allows (None: it sets none)."""
+        return self.top_crank_speed(draw.case)
+
+    def top_crank_speed(self, case: Any) -> float | None:
+        """The crank speed [rad/s] this limit keeps the crank below everywhere (None: it sets none)."""
+        return None
+
+    def at_draw_speed(self, draw: Draw, speed: float) -> list[Check]:
+        """``pressplan check``'s static checks at draw speed ``speed`` [rad/s] (no plan)."""
+        return []
+
+    def precheck(self, case: Any, given: float | None, lowest: float, highest: float) -> Impossible | None:
+        """A necessary condition before any NLP, at the draw speed ``given`` [rad/s] (None: free in
+        ``lowest`` .. ``highest``)."""
+        return None
+
+    def parameter_values(self, case: Any) -> dict[str, float]:
+        """The values of :attr:`parameters` for ``case`` (inside units)."""
+        return {}
+
+    def rows(self, nlp: Transcription) -> list[Row]:
+        """The limit's rows in an NLP."""
+        return []
+
+    def check(self, dense: Dense) -> list[Check]:
+        """The limit's checks on the dense re-simulation."""
+        return []
+
+    def bound_speeds(self, grid: BoundGrid) -> tuple[np.ndarray | None, np.ndarray | None]:
+        """The limit's bounds ``(lower, upper)`` on the crank speed squared [rad^2/s^2] at the bound's nodes
+        0 .. n-1 (None: none); numbers, known before the bound's variables (``grid`` without symbols)."""
+        return None, None
+
+    def bound_rows(self, grid: BoundGrid) -> list[tuple[Any, Any, Any]]:
+        """The limit's rows ``(expr, lo, hi)`` over the bound's intervals."""
+        return []
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}()"
+
+
+def sample_vector(values: list[Any]) -> Any:
+    """Expressions as one column (CasADi ``vertcat``, numpy ``concatenate``)."""
+    m = math_module(*values)
+    if m is np:
+        return np.concatenate([np.atleast_1d(v) for v in values])
+    return m.vertcat(*values)
+
+
+def total(values: Any) -> Any:
+    """The sum of a column (CasADi ``sum1``, numpy ``sum``)."""
+    m = math_module(values)
+    return np.sum(values) if m is np else m.sum1(values)
+
+
+def trapezoid(values: Any, times: Any) -> Any:
+    """The trapezoidal integral of a column of ``values`` at the sample ``times`` [s]."""
+    n = values.shape[0]
+    return total((times[1:n] - times[0 : n - 1]) * (values[1:n] + values[0 : n - 1]) / 2)

@@ -1,0 +1,58 @@
+"""The drive's top speed on the crank, ``limits.crank_speed_rpm`` (optional)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from planning.model.errors import CaseError
+from planning.model.limits.base import REL_TOL, BoundGrid, Check, Dense, Draw, Limit, Row, Transcription
+from planning.model.units import RPM, CrankSpeed
+
+
+class CrankSpeedLimit(Limit):
+    """crank speed <= the limit: at the speeds a law's halves join (its peaks), or at a free profile's
+    samples; a bound on the draw speed and on the bound's speeds."""
+
+    id = "crank_speed"
+    name = "crank speed <= crank_speed_rpm"
+    unit = "rpm"
+    field = "limits.crank_speed_rpm"
+    order = 50
+    section_fields = {"crank_speed_rpm": (CrankSpeed | None, None)}
+    parameters = ("crank_speed_max",)
+    refined = "crank_speed_max"
+
+    def applies(self, case: Any) -> bool:
+        return case.limits.crank_speed_rpm is not None
+
+    def validate(self, case: Any) -> None:
+        top, lowest = case.limits.crank_speed_rpm, case.limits.min_crank_speed_rpm
+        if top is not None and top <= lowest:
+            raise CaseError(self.field, f"must be above limits.min_crank_speed_rpm = {lowest:g}", top)
+
+    def top_crank_speed(self, case: Any) -> float | None:
+        top = case.limits.crank_speed_rpm
+        return None if top is None else top * RPM
+
+    def refuse_draw_speed(self, draw: Draw, speed: float) -> str | None:
+        top = draw.case.limits.crank_speed_rpm
+        return (
+            f"is above {self.field} = {top:g}" if top is not None and draw.case.process.draw_speed_rpm > top else None
+        )
+
+    def parameter_values(self, case: Any) -> dict[str, float]:
+        return {"crank_speed_max": case.limits.crank_speed_rpm * RPM}
+
+    def rows(self, nlp: Transcription) -> list[Row]:
+        peaks = nlp.speeds
+        return [Row("crank speed limit", peaks.values / nlp.param("crank_speed_max"), -np.inf, 1.0, peaks.sampled)]
+
+    def check(self, dense: Dense) -> list[Check]:
+        top = dense.case.limits.crank_speed_rpm
+        return [Check.of(self.id, self.name, float(np.max(dense.omega)) / RPM, top, self.unit, "max", REL_TOL * top)]
+
+    def bound_speeds(self, grid: BoundGrid) -> tuple[np.ndarray | None, np.ndarray | None]:
+        top = grid.case.limits.crank_speed_rpm * RPM
+        return None, np.full(grid.dtheta.size, top**2)

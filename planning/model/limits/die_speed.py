@@ -1,0 +1,118 @@
+"""At and below the die height the slide moves no faster than ``limits.die_speed_mm_s``."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from planning.model.errors import CaseError
+from planning.model.limits.base import (
+    REL_TOL,
+    BoundGrid,
+    Check,
+    Dense,
+    Draw,
+    Limit,
+    Row,
+    Transcription,
+    sample_vector,
+)
+from planning.model.units import RPM, Height, SliderSpeed
+from press.backend import math_module
+
+
+class DieSpeed(Limit):
+    """|slide speed| <= ``limits.die_speed_mm_s`` wherever the slide is at or below
+    ``limits.die_height_mm``: in the draw (a bound on the draw speed), where the slide passes the die
+    height outside the draw (rows at the crossings), and, where a transcription's crank speed may peak
+    inside the die zone, at every sample below the die height (``max(h - h_die, v_die - |v|) >= 0``,
+    continuous)."""
+
+    id = "die_speed"
+    name = "slider speed at or below the die height"
+    unit = "mm/s"
+    field = "limits.die_speed_mm_s"
+    order = 30
+    section_fields = {"die_height_mm": (Height, ...), "die_speed_mm_s": (SliderSpeed, ...)}
+    parameters = ("die_speed", "die_height")
+    refined = "die_speed"
+
+    def validate(self, case: Any) -> None:
+        m = case.machine
+        die = case.limits.die_height_mm
+        if die > m.stroke:
+            raise CaseError("limits.die_height_mm", f"is above the stroke {m.stroke:g} mm", die)
+        h2 = float(m.height(math.radians(case.key_points.draw_start_deg)))
+        if die >= h2:
+            raise CaseError(
+                "limits.die_height_mm", f"must be below the slider height at the draw start ({h2:.1f} mm)", die
+            )
+
+    def draw_speed_bound(self, draw: Draw) -> float:
+        """|dh/dtheta| peaks in the die zone of the draw or where the draw crosses the die height."""
+        case, m = draw.case, draw.case.machine
+        die = case.limits.die_height_mm
+        th2, th3 = draw.theta[0], draw.theta[-1]
+        inside = draw.h <= die
+        lo, hi = m.angles_at_height(min(die, m.stroke))
+        edges = [a for a in (float(lo), float(hi)) if th2 <= a <= th3]
+        slopes = (
+            np.abs(np.concatenate([draw.d1[inside], m.derivatives(np.array(edges))[0]]))
+            if (inside.any() or edges)
+            else []
+        )
+        peak = float(np.max(slopes)) if len(slopes) else 0.0
+        return case.limits.die_speed_mm_s / peak if peak > 0 else math.inf
+
+    def refuse_draw_speed(self, draw: Draw, speed: float) -> str | None:
+        bound = self.draw_speed_bound(draw)
+        if speed <= bound * (1 + 1e-12):
+            return None
+        return f"is above the {bound / RPM:.3f} rpm that {self.field} allows"
+
+    def at_draw_speed(self, draw: Draw, speed: float) -> list[Check]:
+        lim = draw.case.limits
+        bound = self.draw_speed_bound(draw)
+        value = lim.die_speed_mm_s * speed / bound if math.isfinite(bound) else 0.0
+        name = f"slider speed at or below {lim.die_height_mm:g} mm <= die_speed_mm_s"
+        return [Check.of(self.id, name, value, lim.die_speed_mm_s, self.unit, "max", 0.0)]
+
+    def parameter_values(self, case: Any) -> dict[str, float]:
+        return {"die_speed": case.limits.die_speed_mm_s, "die_height": case.limits.die_height_mm}
+
+    def rows(self, nlp: Transcription) -> list[Row]:
+        v_die = nlp.param("die_speed")
+        speeds = sample_vector([slope * omega for omega, slope in nlp.crossings])
+        out = [Row("die-height speed", speeds / v_die, -np.inf, 1.0)]
+        if nlp.zone:
+            h = nlp.outside_draw(nlp.height)
+            v = nlp.outside_draw(nlp.slope) * nlp.outside_draw(nlp.omega)
+            m = math_module(h)
+            zone = m.fmax((h - nlp.param("die_height")) / nlp.length_unit, (v_die - m.fabs(v)) / v_die)
+            out.append(Row("die-zone speed", zone, 0.0, np.inf, sampled=True))
+        return out
+
+    def check(self, dense: Dense) -> list[Check]:
+        case, plan = dense.case, dense.plan
+        m, lim = case.machine, case.limits
+        low = dense.h <= lim.die_height_mm
+        crossings = [float(x) for x in m.angles_at_height(min(lim.die_height_mm, m.stroke))]
+        at_crossings = []
+        for angle in crossings:
+            t = plan.profile.time_at_angle(angle)
+            th, om, al, je = plan.profile.at_time(np.array([t]))
+            at_crossings.append(abs(float(m.slider(th, om, al, je)[1][0])))
+        fastest = max(([float(np.max(np.abs(dense.v[low])))] if low.any() else [0.0]) + at_crossings)
+        return [
+            Check.of(self.id, self.name, fastest, lim.die_speed_mm_s, self.unit, "max", REL_TOL * lim.die_speed_mm_s)
+        ]
+
+    def bound_speeds(self, grid: BoundGrid) -> tuple[np.ndarray | None, np.ndarray | None]:
+        lim = grid.case.limits
+        d1, h = grid.d1[:-1], grid.h[:-1]
+        low = (h <= lim.die_height_mm * (1 + 1e-12) + 1e-9) & (np.abs(d1) > 0)  # the crossings count
+        upper = np.full(h.shape, np.inf)
+        upper[low] = (lim.die_speed_mm_s / np.abs(d1[low])) ** 2
+        return None, upper

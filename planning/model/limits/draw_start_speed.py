@@ -1,0 +1,44 @@
+"""The slide meets the blank no faster than ``limits.draw_start_speed_mm_s``: its speed at theta2."""
+
+from __future__ import annotations
+
+import math
+
+from planning.model.limits.base import REL_TOL, Check, Dense, Draw, Limit
+from planning.model.units import RPM, SliderSpeed
+
+
+class DrawStartSpeed(Limit):
+    """|slide speed| at theta2 <= the limit. The draw runs at constant crank speed, so this bounds the draw
+    speed alone (the NLPs hold it through the draw speed's bounds)."""
+
+    id = "draw_start_speed"
+    name = "slider speed at the draw start"
+    unit = "mm/s"
+    field = "limits.draw_start_speed_mm_s"
+    order = 20
+    section_fields = {"draw_start_speed_mm_s": (SliderSpeed, ...)}
+
+    def draw_speed_bound(self, draw: Draw) -> float:
+        slope = abs(float(draw.d1[0]))  # the draw's first angle is theta2
+        return draw.case.limits.draw_start_speed_mm_s / slope if slope > 0 else math.inf
+
+    def refuse_draw_speed(self, draw: Draw, speed: float) -> str | None:
+        bound = self.draw_speed_bound(draw)
+        if speed <= bound * (1 + 1e-12):
+            return None
+        return f"is above the {bound / RPM:.3f} rpm that {self.field} allows"
+
+    def at_draw_speed(self, draw: Draw, speed: float) -> list[Check]:
+        limit = draw.case.limits.draw_start_speed_mm_s
+        v = abs(float(draw.d1[0])) * speed
+        return [
+            Check.of(self.id, "slider speed at draw start <= draw_start_speed_mm_s", v, limit, self.unit, "max", 0.0)
+        ]
+
+    def check(self, dense: Dense) -> list[Check]:
+        plan, case = dense.plan, dense.case
+        w2 = float(plan.parameters.draw_speed)
+        v2 = abs(float(case.machine.slider(plan.key_angles[1], w2)[1]))
+        limit = case.limits.draw_start_speed_mm_s
+        return [Check.of(self.id, self.name, v2, limit, self.unit, "max", REL_TOL * limit)]

@@ -1,0 +1,47 @@
+"""The crank keeps turning forward, never slower than ``limits.min_crank_speed_rpm``."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from planning.model.limits.base import REL_TOL, BoundGrid, Check, Dense, Draw, Limit, Row, Transcription
+from planning.model.units import RPM, CrankSpeed
+
+
+class MinCrankSpeed(Limit):
+    """crank speed >= the minimum. A law's halves are monotone, so their NLP holds it by the bounds of the
+    speeds they join; a free profile holds it at its samples (refined upward, a lower limit)."""
+
+    id = "min_crank_speed"
+    name = "crank speed (forward, never stops)"
+    unit = "rpm"
+    field = "limits.min_crank_speed_rpm"
+    order = 45
+    section_fields = {"min_crank_speed_rpm": (CrankSpeed, 1.0)}
+    parameters = ("min_crank_speed",)
+    refined = "min_crank_speed"
+    refine_upward = True
+
+    def refuse_draw_speed(self, draw: Draw, speed: float) -> str | None:
+        lowest = draw.case.limits.min_crank_speed_rpm
+        return f"is below {self.field} = {lowest:g}" if draw.case.process.draw_speed_rpm < lowest else None
+
+    def parameter_values(self, case: Any) -> dict[str, float]:
+        return {"min_crank_speed": case.limits.min_crank_speed_rpm * RPM}
+
+    def rows(self, nlp: Transcription) -> list[Row]:
+        if nlp.lowest_speeds is None:
+            return []
+        margin = (nlp.lowest_speeds - nlp.param("min_crank_speed")) / nlp.speed_unit
+        return [Row("minimum crank speed", margin, 0.0, np.inf, sampled=True)]
+
+    def check(self, dense: Dense) -> list[Check]:
+        lowest = dense.case.limits.min_crank_speed_rpm
+        slowest = float(np.min(dense.omega)) / RPM
+        return [Check.of(self.id, self.name, slowest, lowest, self.unit, "min", REL_TOL * lowest)]
+
+    def bound_speeds(self, grid: BoundGrid) -> tuple[np.ndarray | None, np.ndarray | None]:
+        w_min = grid.case.limits.min_crank_speed_rpm * RPM
+        return np.full(grid.dtheta.size, w_min**2), None

@@ -1,0 +1,110 @@
+"""The robot's window: from theta4 to theta1 (through TDC) the slide stays at or above the safety height,
+for at least the transfer time. Two limits, one case field each."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from planning.model.errors import CaseError
+from planning.model.limits.base import (
+    REL_TOL,
+    TIME_TOL,
+    BoundGrid,
+    Check,
+    Dense,
+    Draw,
+    Impossible,
+    Limit,
+    Row,
+    Transcription,
+    total,
+)
+from planning.model.units import RPM
+
+
+class TransferTime(Limit):
+    """The time from theta4 to theta1 through TDC is at least ``process.transfer_time_s``."""
+
+    id = "transfer_time"
+    name = "transfer time theta4 -> theta1"
+    unit = "s"
+    field = "process.transfer_time_s"
+    order = 10
+    parameters = ("transfer_time",)
+
+    def parameter_values(self, case: Any) -> dict[str, float]:
+        return {"transfer_time": case.process.transfer_time_s}
+
+    def precheck(self, case: Any, given: float | None, lowest: float, highest: float) -> Impossible | None:
+        """The window's angle crossed at the minimum crank speed takes the longest any motion can take."""
+        th1, _, _, th4 = case.key_angles
+        window = th1 + 2 * math.pi - th4
+        w_min = case.limits.min_crank_speed_rpm * RPM
+        if window / w_min >= case.process.transfer_time_s:
+            return None
+        return Impossible(
+            f"transfer_time_s = {case.process.transfer_time_s:g} cannot be met: at min_crank_speed_rpm = "
+            f"{case.limits.min_crank_speed_rpm:g} the crank crosses the {math.degrees(window):.1f} deg from "
+            f"theta4 to theta1 in at most {window / w_min:.3f} s",
+            self.field,
+            case.process.transfer_time_s,
+            window / w_min,
+        )
+
+    def rows(self, nlp: Transcription) -> list[Row]:
+        return [Row("transfer time", nlp.window_time - nlp.param("transfer_time"), 0.0, np.inf)]
+
+    def check(self, dense: Dense) -> list[Check]:
+        t1, _, _, t4 = dense.key_times
+        window = t1 + dense.plan.period - t4
+        return [Check.of(self.id, self.name, window, dense.case.process.transfer_time_s, self.unit, "min", TIME_TOL)]
+
+    def bound_rows(self, grid: BoundGrid) -> list[tuple[Any, Any, Any]]:
+        window = np.flatnonzero(grid.window).tolist()
+        return [(total(grid.tau[window]), grid.case.process.transfer_time_s, np.inf)]
+
+
+class SafetyHeight(Limit):
+    """From theta4 to theta1 the slide is at or above ``process.safety_height_mm`` (the transfer robot's
+    safety height)."""
+
+    id = "safety_height"
+    name = "slider at or above the safety height from theta4 to theta1"
+    unit = "mm"
+    field = "process.safety_height_mm"
+    order = 11
+
+    def validate(self, case: Any) -> None:
+        m = case.machine
+        safety = case.process.safety_height_mm
+        if safety > m.stroke:
+            raise CaseError(self.field, f"is above the stroke {m.stroke:g} mm", safety)
+        for key in ("closing_deg", "opening_deg"):
+            deg = getattr(case.key_points, key)
+            h = float(m.height(math.radians(deg)))
+            if h < safety:
+                raise CaseError(
+                    f"key_points.{key}", f"slider is at {h:.1f} mm there, below {self.field} = {safety:g}", deg
+                )
+
+    def at_draw_speed(self, draw: Draw, speed: float) -> list[Check]:
+        case = draw.case
+        th1, _, _, th4 = case.key_angles
+        h = case.machine.height(np.array([th1, th4]))
+        safety = case.process.safety_height_mm
+        return [
+            Check.of(self.id, f"slider height at {where} >= safety height", height, safety, self.unit, "min", 0.0)
+            for where, height in (("closing", h[0]), ("opening", h[1]))
+        ]
+
+    def check(self, dense: Dense) -> list[Check]:
+        t1, _, _, t4 = dense.key_times
+        window = (dense.t >= t4) | (dense.t <= t1)
+        safety = dense.case.process.safety_height_mm
+        th1, _, _, th4 = dense.plan.key_angles
+        ends = dense.case.machine.height(np.array([th1, th4]))  # the window's ends, exactly (not a grid point)
+        lowest = float(min(np.min(dense.h[window], initial=np.inf), np.min(ends)))
+        return [Check.of(self.id, self.name, lowest, safety, self.unit, "min", REL_TOL * safety)]

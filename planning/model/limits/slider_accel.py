@@ -1,0 +1,85 @@
+"""The slide's acceleration stays within ``limits.slider_accel_mm_s2`` over the whole cycle."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from planning.model.limits.base import (
+    REL_TOL,
+    BoundGrid,
+    Check,
+    Dense,
+    Draw,
+    Impossible,
+    Limit,
+    Row,
+    Transcription,
+)
+from planning.model.units import SliderAccel
+
+ACCEL_BACKOFF = 5e-4  # the NLPs hold |slider acceleration| <= (1 - backoff) * limit at their samples
+HARDER_BACKOFF = 5e-3  # the back-off of a second round when no start verified
+
+
+class SliderAcceleration(Limit):
+    """|a| = |d2h/dtheta2 w^2 + dh/dtheta alpha| <= the limit: at every sample of an NLP (the dense check
+    decides between them), in the draw (a bound on the draw speed), at both ends of every interval of
+    the bound (linear in the speed squared there)."""
+
+    id = "slider_accel"
+    name = "|slider acceleration|"
+    unit = "mm/s^2"
+    field = "limits.slider_accel_mm_s2"
+    order = 40
+    section_fields = {"slider_accel_mm_s2": (SliderAccel, ...)}
+    parameters = ("accel_limit",)
+    refined = "accel_limit"
+    backoff = ACCEL_BACKOFF
+    harder_backoff = HARDER_BACKOFF
+
+    def draw_speed_bound(self, draw: Draw) -> float:
+        curvature = float(np.max(np.abs(draw.d2)))
+        return math.sqrt(draw.case.limits.slider_accel_mm_s2 / curvature) if curvature > 0 else math.inf
+
+    def at_draw_speed(self, draw: Draw, speed: float) -> list[Check]:
+        limit = draw.case.limits.slider_accel_mm_s2
+        value = limit * (speed / self.draw_speed_bound(draw)) ** 2
+        name = "|slider acceleration| during the draw <= slider_accel_mm_s2"
+        return [Check.of(self.id, name, value, limit, self.unit, "max", 0.0)]
+
+    def precheck(self, case: Any, given: float | None, lowest: float, highest: float) -> Impossible | None:
+        if given is None:
+            return None
+        bound = self.draw_speed_bound(Draw.of(case))
+        if given <= bound * (1 + 1e-12):
+            return None
+        limit = case.limits.slider_accel_mm_s2
+        a_draw = limit * (given / bound) ** 2
+        return Impossible(
+            f"at the draw speed {case.process.draw_speed_rpm:g} rpm the slider acceleration in the draw reaches "
+            f"{a_draw:.0f} mm/s^2 > slider_accel_mm_s2 = {limit:g}",
+            self.field,
+            limit,
+            a_draw,
+        )
+
+    def parameter_values(self, case: Any) -> dict[str, float]:
+        return {"accel_limit": case.limits.slider_accel_mm_s2 * (1 - ACCEL_BACKOFF)}
+
+    def rows(self, nlp: Transcription) -> list[Row]:
+        accel = nlp.outside_draw(nlp.curvature * nlp.omega**2 + nlp.slope * nlp.alpha)
+        return [Row("slider acceleration", accel / nlp.param("accel_limit"), -1.0, 1.0, sampled=True)]
+
+    def check(self, dense: Dense) -> list[Check]:
+        limit = dense.case.limits.slider_accel_mm_s2
+        return [Check.of(self.id, self.name, float(np.max(np.abs(dense.a))), limit, self.unit, "max", REL_TOL * limit)]
+
+    def bound_rows(self, grid: BoundGrid) -> list[tuple[Any, Any, Any]]:
+        A = grid.case.limits.slider_accel_mm_s2
+        start = grid.d2[:-1] * grid.s + grid.d1[:-1] * grid.alpha
+        end = grid.d2[1:] * grid.s_next + grid.d1[1:] * grid.alpha
+        n = grid.dtheta.size
+        return [(start, -A * np.ones(n), A * np.ones(n)), (end, -A * np.ones(n), A * np.ones(n))]

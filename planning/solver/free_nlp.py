@@ -1,0 +1,267 @@
+"""The NLP of the optimal law: the fastest jerk-limited cycle as a free profile (no fixed motion law).
+
+Outside the constant-speed draw the crank follows segments of constant jerk ``|j_k| <= J`` (``J`` =
+``limits.crank_jerk_rad_s3``, required for this law) in three phases
+(``planning.model.free_profile.PHASES``): the return theta3 -> theta4, the robot's window theta4 ->
+theta1 and the feed theta1 -> theta2, each of equal steps ``h`` [s] of its own. Multiple shooting: the
+state (angle, speed, acceleration) at every knot is a variable, and each segment's closed form ties
+it to the next, so the NLP is sparse and the acceleration continuous everywhere. Fixed: theta3, w2
+and zero acceleration at the start, theta4 and theta1 at the phase boundaries, theta2 + 2 pi, w2 and
+zero acceleration at the end. Minimised: the cycle time. The jerk limit is the bounds of the
+segments' jerks; the die-height crossings have times of their own (as in the laws' NLP). The limits
+(``planning.model.limits``) hold at every knot and at evenly spaced points inside each segment (the
+crank speed and the minimum crank speed there, refined against the dense verification like the slider
+acceleration), the crank acceleration at the knots (it is piecewise linear), the die zone at every
+sample below the die height; with a drive, the motor's limits as for the laws. Placement has no
+meaning: theta1 and theta4 are where the phases meet.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from functools import cache
+
+import casadi as ca
+import numpy as np
+
+from planning.model.case import Case
+from planning.model.free_profile import PHASES, FreeProfileParameters
+from planning.model.laws.optimal import OptimalLaw
+from planning.model.limits.base import Extremes, Transcription
+from planning.model.plan import Plan, SolverInfo, rotate_to_tdc
+from planning.model.profile import Segment, advance
+from planning.solver.ipopt import NLPSolver
+from planning.solver.nlp import (
+    CYCLE_OPTIONS,
+    DRIVE_OPTIONS,
+    CycleNLP,
+    Rows,
+    add_limit_rows,
+    clipped_advance,
+    draw_states,
+    drive_samples,
+    nlp_limits,
+)
+from planning.solver.parameters import DRAW_SAMPLES_DRIVE, ParameterLayout, time_limit
+from press.mechanism import Formula
+
+# the limits are held at every knot and at evenly spaced points inside each segment, this many per
+# segment (knot included) in each phase: the robot's window has the longest segments and the highest
+# speeds (around TDC, where the slider acceleration peaks), so it is sampled finer
+SAMPLES_PER_SEGMENT = {"return": 4, "transfer": 8, "feed": 4}
+DRAW_SAMPLES = 20  # the draw's samples without a drive
+STATES = ("angle", "speed", "accel")
+TOP_SPEED = 1e3  # [rad/s] upper bound of the crank speeds (far above any press)
+# a re-solve with a refined limit starts nearer the optimum than the laws' (about half the iterations
+# with this barrier parameter; the laws keep the wrapper's, which finds their optima as before)
+WARM_OPTIONS = {"ipopt.mu_init": 1e-8}
+
+
+def _variables() -> tuple[tuple[str, str], ...]:
+    # the die-height crossings outside the draw: going up in the return (time from theta3), going down in
+    # the feed (time from theta1)
+    out: list[tuple[str, str]] = [("draw_speed", "speed"), ("die_up_time", "time"), ("die_down_time", "time")]
+    for phase, n in PHASES:
+        out.append((f"{phase}_step", "step"))
+        out += [(f"{phase}_jerk_{k}", "jerk") for k in range(n)]
+        # the knots inside the phase and its end (the start is the previous phase's end, or theta3)
+        for k in range(1, n + 1):
+            out += [
+                (f"{phase}_{name}_{k}", kind) for name, kind in zip(STATES, ("angle", "speed", "accel"), strict=True)
+            ]
+    return tuple(out)
+
+
+VARIABLES = _variables()
+INDEX = {name: i for i, (name, _) in enumerate(VARIABLES)}
+
+
+def variable_scales(case: Case) -> np.ndarray:
+    """Scales from the press's characteristic time and speed (as the laws' NLP) and the jerk limit."""
+    m, A = case.machine, case.limits.slider_accel_mm_s2
+    t_star = math.sqrt(m.length_scale / A)
+    w_star = math.sqrt(A / m.peak_curvature)
+    unit = {
+        "speed": 0.42 * w_star,
+        "step": 0.05 * t_star,
+        "angle": 1.0,
+        "accel": w_star / t_star,
+        "jerk": case.limits.crank_jerk_rad_s3,
+        "time": t_star,
+    }
+    return np.array([unit[kind] for _, kind in VARIABLES])
+
+
+def variable_bounds(
+    case: Case, layout: ParameterLayout, w2_lo: float, w2_hi: float, parameters: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The segments' jerks within the jerk limit, the steps within the longest cycle, the speeds positive,
+    the draw speed within its bounds, a die crossing's time fixed where it lies in the draw."""
+    J = case.limits.crank_jerk_rad_s3
+    longest = time_limit(case)
+    lo, hi = np.full(len(VARIABLES), -np.inf), np.full(len(VARIABLES), np.inf)
+    for name, kind in VARIABLES:
+        i = INDEX[name]
+        if kind == "jerk":
+            lo[i], hi[i] = -J, J
+        elif kind == "step":
+            phase = name.removesuffix("_step")
+            lo[i], hi[i] = 0.0, longest / dict(PHASES)[phase]
+        elif kind == "speed":
+            lo[i], hi[i] = 0.0, TOP_SPEED
+    lo[INDEX["draw_speed"]], hi[INDEX["draw_speed"]] = w2_lo, w2_hi
+    for k in ("die_down", "die_up"):
+        i = INDEX[f"{k}_time"]
+        active = parameters[layout.index(f"{k}_active")] != 0.0
+        lo[i], hi[i] = (0.0, longest) if active else (0.0, 0.0)
+    return lo, hi
+
+
+def make_plan(case: Case, values: dict[str, float], placement: str, info: SolverInfo) -> Plan:
+    """The plan of the NLP's values: the profile propagated from theta3 through the segments' closed forms
+    (the NLP's knot states agree with it to its tolerance), then the draw."""
+    th1, th2, th3, th4 = (float(a) for a in case.key_angles)
+    durations, jerks = [], []
+    for phase, n in PHASES:
+        durations += [values[f"{phase}_step"]] * n
+        jerks += [values[f"{phase}_jerk_{k}"] for k in range(n)]
+    params = FreeProfileParameters(tuple(durations), tuple(jerks), values["draw_speed"], th2, th3)
+    segs = [seg for seg in params.segments() if seg.duration > 0]
+    draw = Segment("draw:constant", params.draw_time, 0.0, 0.0)
+    profile = rotate_to_tdc([*segs, draw], th3, params.draw_speed)
+    plan = Plan(params, profile, (th1, th2, th3, th4), "free", info, motion_law=OptimalLaw.name)
+    t = plan.key_times()
+    structure = {"closing": plan.segment_at(float(t[0])), "opening": plan.segment_at(float(t[3]))}
+    return replace(plan, structure=structure, nlp_values=dict(values))
+
+
+def _build(formula: Formula, limit_ids: tuple[str, ...], drive: bool) -> CycleNLP:
+    # MX with vector operations (every segment of a phase at once): CasADi derives the Jacobian and the
+    # Hessian of this graph in a fraction of the time a scalar SX graph of the same problem takes, and
+    # evaluates them about as fast
+    layout = ParameterLayout(formula, limit_ids, drive, False)
+    x = ca.MX.sym("x", len(VARIABLES))
+    p_case = ca.MX.sym("p", layout.size)
+    p_scale = ca.MX.sym("scale", len(VARIABLES))
+    physical = x * p_scale
+    v = {name: physical[i] for name, i in INDEX.items()}
+    unit = {name: p_scale[i] for name, i in INDEX.items()}
+    q = layout.symbols(p_case)
+    w2 = v["draw_speed"]
+
+    rows = Rows()
+    ends = {"return": q["theta4"], "transfer": q["theta1"] + 2 * np.pi, "feed": q["theta2"] + 2 * np.pi}
+    start = (q["theta3"], w2, ca.MX(0.0))
+    t0 = ca.MX(0.0)
+    shooting, boundary, samples, times, knot_accels = [], [], [], [], []
+    crossings = {}
+    for phase, n in PHASES:
+        h = v[f"{phase}_step"]
+        first = INDEX[f"{phase}_jerk_0"]
+        jerk = physical[first : first + n]
+        # the knots 1 .. n of the phase: n rows of (angle, speed, accel), stored row after row
+        states = ca.reshape(physical[first + n : first + 4 * n], 3, n).T
+        nxt = [states[:, i] for i in range(3)]
+        th0, om0, al0 = (ca.vertcat(start[i], nxt[i][: n - 1]) for i in range(3))
+        if phase in ("return", "feed"):  # the die-height crossing of this phase, in closed form (clip)
+            when = v["die_up_time" if phase == "return" else "die_down_time"]
+            tau = ca.fmin(ca.fmax(when - h * ca.DM(np.arange(n)), 0), h)
+            crossings[phase] = (clipped_advance(tau, start[0], start[1], om0, al0, jerk, 0.0), when, n * h)
+        th1, om1, al1, _ = advance(th0, om0, al0, jerk, 0.0, h)
+        shooting.append(
+            ca.vertcat(th1 - nxt[0], (om1 - nxt[1]) / unit["draw_speed"], (al1 - nxt[2]) / unit[f"{phase}_accel_1"])
+        )
+        end = tuple(states[n - 1, i] for i in range(3))
+        boundary.append(end[0] - ends[phase])
+        # samples in time order: every knot of the phase and the points inside each segment
+        fractions = [k / SAMPLES_PER_SEGMENT[phase] for k in range(1, SAMPLES_PER_SEGMENT[phase])]
+        parts = [advance(th0, om0, al0, jerk, 0.0, h * f) for f in fractions]
+        samples.append(tuple(_interleave([(th0, om0, al0)[i], *(part[i] for part in parts)]) for i in range(3)))
+        local = ca.DM(np.arange(n))
+        times.append(_interleave([t0 + local * h, *(t0 + (local + f) * h for f in fractions)]))
+        knot_accels.append(ca.vertcat(al0, end[2]))
+        t0 = t0 + n * h
+        start = end
+    rows.add("segments join (closed form)", ca.vertcat(*shooting), 0.0, 0.0, "planner.motion_law")
+    rows.add("key angles", ca.vertcat(*boundary[:2]), 0.0, 0.0, "key_points")
+    closes = ca.vertcat(boundary[2], (start[1] - w2) / unit["draw_speed"], start[2] / unit["feed_accel_1"])
+    rows.add("cycle closes", closes, 0.0, 0.0, "key_points")
+    (thu, omu), t_up, span_up = crossings["return"]
+    (thd, omd), t_down, span_down = crossings["feed"]
+    rows.add("key points in order", ca.vertcat(span_up - t_up, span_down - t_down), 0.0, np.inf, "key_points")
+    crossing = ca.vertcat(
+        q["die_up_active"] * (thu - q["die_up_angle"]),
+        q["die_down_active"] * (thd - (q["die_down_angle"] + 2 * np.pi)),
+    )
+    rows.add("die crossing angles", crossing, 0.0, 0.0, "limits.die_height_mm")
+
+    # the free profile's samples, then the draw's (the drive's forming force is given at them)
+    th = ca.vertcat(*[sm[0] for sm in samples])
+    om = ca.vertcat(*[sm[1] for sm in samples])
+    al = ca.vertcat(*[sm[2] for sm in samples])
+    draw_time = (q["theta3"] - q["theta2"]) / w2
+    count = DRAW_SAMPLES_DRIVE if drive else DRAW_SAMPLES
+    th_d, om_d, al_d, since = draw_states(q, w2, ca.DM(np.linspace(0.0, 1.0, count + 1)))
+    th_all, om_all, al_all = ca.vertcat(th, th_d), ca.vertcat(om, om_d), ca.vertcat(al, al_d)
+    t_all = ca.vertcat(*times, t0 + since)
+    h_all, d1, d2, _ = formula.jets(th_all, layout.geometry(q))
+    torque = drive_samples(q, p_case, layout, om_all, al_all, d1, d2) if drive else None
+    nlp = Transcription(
+        theta=th_all,
+        omega=om_all,
+        alpha=al_all,
+        times=t_all,
+        height=h_all,
+        slope=d1,
+        curvature=d2,
+        draw_count=count + 1,
+        period=t0 + draw_time,
+        window_time=PHASES[1][1] * v["transfer_step"],
+        speeds=Extremes(om, signed=False, sampled=True),
+        accelerations=Extremes(ca.vertcat(*knot_accels), signed=True),
+        jerks=None,  # the bounds of the segments' jerks
+        lowest_speeds=om,
+        crossings=[(omu, q["die_up_slope"]), (omd, q["die_down_slope"])],
+        zone=True,
+        rate=False,
+        speed_unit=unit["draw_speed"],
+        length_unit=q["length_unit"],
+        param=q.__getitem__,
+        motor_torque=None if torque is None else torque.tm,
+        motor_speed=None if torque is None else torque.speed,
+    )
+    refinable = add_limit_rows(rows, nlp, layout)
+
+    problem = {"x": x, "p": ca.vertcat(p_case, p_scale), "f": nlp.period, "g": ca.vertcat(*rows.g)}
+    options = {**CYCLE_OPTIONS, **DRIVE_OPTIONS}  # MUMPS's AMD ordering: the same iterations, 5-10 % faster here
+    program = NLPSolver("press_cycle_optimal" + ("_drive" if drive else ""), problem, options, None, WARM_OPTIONS)
+    return CycleNLP(
+        program,
+        *rows.bounds(),
+        tuple(rows.blocks),
+        layout,
+        VARIABLES,
+        variable_scales,
+        variable_bounds,
+        make_plan,
+        refinable=refinable,
+    )
+
+
+def _interleave(columns: list) -> ca.MX:
+    """``a0, b0, ..., a1, b1, ...`` of column vectors of one length."""
+    return ca.reshape(ca.horzcat(*columns).T, -1, 1)
+
+
+@cache
+def free_nlp(formula: Formula, limit_ids: tuple[str, ...], drive: bool = False) -> CycleNLP:
+    """The compiled NLP of the optimal law for a mechanism's ``formula`` and the limits ``limit_ids`` (built on
+    first use in a process, then reused)."""
+    return _build(formula, limit_ids, drive)
+
+
+def free_nlp_for(case: Case) -> CycleNLP:
+    """The optimal law's NLP of ``case``'s mechanism and limits, with the motor's rows when it has a drive."""
+    drive = case.drive is not None
+    return free_nlp(case.machine.formula, nlp_limits(case, drive), drive)

@@ -1,0 +1,328 @@
+"""The NLP of one press cycle under a motion law with halves (every law but the optimal one).
+
+Built once per process and kind (``planning.solver.nlp``), then reused: every number of a case, and the
+scale of every decision variable (:func:`variable_scales`, applied by the solver wrapper
+``planning.solver.ipopt``), enters as a parameter and the placement structure is a pair of constraint rows
+whose bounds are set per solve, so a sweep, a multi-start or the other placement only calls the compiled
+solver again. Decision variables are scaled to O(1): the four speeds w1, w2, wm1, wm2, the durations of
+the four halves, the transfer dwell, the law's shape parameter and the times of the key points.
+
+Time 0 of the NLP is the end of the draw (theta3); the stages follow as in ``planning.model.cycle``. The
+crank angle at any time t before the draw is evaluated in closed form as
+``theta(t) = theta3 + sum_k D_k(clip(t - s_k, 0, T_k))``, with ``D_k`` the angle swept ``tau`` into
+segment k. The clip makes theta(t) continuously differentiable in t and in every segment variable
+(the kink of one term is cancelled by the next), so a key point may move across knots inside one
+smooth NLP: that is the ``free`` placement. The ``published`` placement fixes the key points where
+the relations under the paper's Fig. 6 put them: t1 = x1 + T1 (a quarter, one sub-segment, into the
+feed acceleration), t4 = x3 + 3 T14 (three quarters into the return deceleration).
+
+The cycle's own rows: the peaks lie above the speeds they join (each half is then monotone: the crank
+speed is smallest at w1 or w2, which the variable bounds keep above the minimum crank speed), one jerk
+per S-curve (Eq. 14, improved S-curve only), the cycle closes at 2 pi, the key angles theta1 and theta4
+are met, the key points in order, the die-height crossings outside the draw at their angles. Then the
+rows of every limit the case sets (``planning.model.limits``), from the states at sample points of every
+segment (the slider acceleration, the drive's torque, a target rate's die zone; the orchestrator lowers
+a sampled limit until the dense verification holds between samples), the die-height crossings, the
+robot's window t1 - t4, and the closed-form extremes of the halves: the peak speeds, the peak
+acceleration and jerk of every half. The draw speed's bounds (every limit's draw-speed bound) are
+variable bounds.
+
+The drive NLPs (motor torque rows, the RMS integral) sample the draw at its fixed angles theta2 ...
+theta3 at the constant speed w2 instead of following the cycle's closed form there: the two agree
+wherever the cycle closes (a constraint every solution meets), and the draw's rows then depend on w2
+alone (sparse rows; on the side-panel drive a quarter fewer iterations and about half the time per
+iteration, same optima). The kinematic NLP keeps the closed form: there the change saved nothing
+(more iterations). The rate NLP (``planning.solver.objectives``) adds the objectives' terms, the rows of
+the die zone at every sample (a plan at a target rate may peak in speed there) and the cycle time.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from functools import cache, partial
+
+import casadi as ca
+import numpy as np
+
+from planning.model.case import RPM, Case, Placement
+from planning.model.cycle import HALVES, CycleParameters, cycle_segments
+from planning.model.laws import get_law
+from planning.model.limits.base import Extremes, Transcription
+from planning.model.plan import Plan, SolverInfo, params_from_numbers, profile_from_tdc
+from planning.model.profile import Segment, advance_segment, knot_states, shape_part
+from planning.solver.ipopt import NLPSolver
+from planning.solver.nlp import (
+    CYCLE_OPTIONS,
+    DRIVE_OPTIONS,
+    RATE_OPTIONS,
+    CycleNLP,
+    Rows,
+    add_limit_rows,
+    clipped_advance,
+    draw_states,
+    drive_samples,
+    nlp_limits,
+    objective_terms,
+)
+from planning.solver.parameters import DRAW_SAMPLES_DRIVE, ParameterLayout, time_limit
+from press.mechanism import Formula
+
+# Decision variables and the kind of scale each is measured in (see :func:`variable_scales`)
+VARIABLES: tuple[tuple[str, str], ...] = (
+    ("transfer_speed", "speed"),  # w1 [rad/s]
+    ("draw_speed", "speed"),  # w2 [rad/s]
+    ("feed_peak_speed", "speed"),  # wm1 [rad/s]
+    ("return_peak_speed", "speed"),  # wm2 [rad/s]
+    ("feed_accel_duration", "half"),  # [s] each half
+    ("feed_decel_duration", "half"),
+    ("return_accel_duration", "half"),
+    ("return_decel_duration", "half"),
+    ("transfer_dwell", "time"),  # [s]
+    ("law_parameter", "shape"),  # the motion law's shape parameter (fixed at 0 when it has none)
+    ("closing_time", "time"),  # t1 from the end of the draw [s]
+    ("opening_time", "time"),  # t4
+    ("die_down_time", "time"),  # time of the descending die-height crossing
+    ("die_up_time", "time"),  # time of the ascending die-height crossing
+)
+VARIABLE_INDEX = {name: i for i, (name, _) in enumerate(VARIABLES)}
+SAMPLES_CONSTANT = 20  # slider-acceleration samples on a constant-speed segment
+MIN_HALF_S = 4e-3  # [s] lower bound on the duration of a half (1 ms per improved-S-curve sub-segment)
+TOP_SPEED = 1e3  # [rad/s] upper bound of the crank speeds (far above any press)
+
+
+def variable_scales(case: Case) -> np.ndarray:
+    """Variable scales from the press's own characteristic time ``T* = sqrt(l / A)`` [s] and speed
+    ``W* = sqrt(A / k)`` [rad/s] (A the slider-acceleration limit, l the mechanism's length unit, half the
+    stroke, k its peak curvature ``max |d2h/dtheta2|``): speeds ~ W*, durations of the halves ~ T*, stage
+    times ~ 10 T*. The factors make the variables O(1) for a press cycle of the usual proportions; they
+    span orders of magnitude from a small fast press to a heavy slow one."""
+    m, A = case.machine, case.limits.slider_accel_mm_s2
+    t_star = math.sqrt(m.length_scale / A)
+    w_star = math.sqrt(A / m.peak_curvature)
+    unit = {"speed": 0.42 * w_star, "half": 1.12 * t_star, "time": 2.8 * t_star, "shape": 1.0}
+    return np.array([unit[kind] for _, kind in VARIABLES])
+
+
+def variable_bounds(
+    case: Case, layout: ParameterLayout, w2_lo: float, w2_hi: float, parameters: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Bounds of the variables: the speeds above the minimum crank speed (the halves are monotone, so the
+    whole cycle is), the draw speed within its bounds, the halves at least :data:`MIN_HALF_S`, the law's
+    shape parameter in its range (or fixed), a die crossing's time fixed where it lies in the draw."""
+    w_min = case.limits.min_crank_speed_rpm * RPM
+    lo = np.zeros(len(VARIABLES))
+    hi = np.full(len(VARIABLES), time_limit(case))
+    i = VARIABLE_INDEX
+    lo[i["transfer_speed"]], hi[i["transfer_speed"]] = w_min, TOP_SPEED
+    lo[i["draw_speed"]], hi[i["draw_speed"]] = w2_lo, w2_hi
+    for k in ("feed_peak_speed", "return_peak_speed"):
+        lo[i[k]], hi[i[k]] = w_min, TOP_SPEED
+    for k in HALVES:
+        lo[i[f"{k}_duration"]] = MIN_HALF_S
+    law = get_law(case.planner.motion_law)
+    fixed = case.planner.law_parameter
+    if law.parameter is None:
+        lo[i["law_parameter"]] = hi[i["law_parameter"]] = 0.0
+    elif fixed is not None:
+        lo[i["law_parameter"]] = hi[i["law_parameter"]] = fixed
+    else:
+        lo[i["law_parameter"]], hi[i["law_parameter"]] = law.parameter.low, law.parameter.high
+    for k in ("die_down", "die_up"):
+        if parameters[layout.index(f"{k}_active")] == 0.0:
+            lo[i[f"{k}_time"]] = hi[i[f"{k}_time"]] = 0.0
+    return lo, hi
+
+
+def make_plan(case: Case, values: dict[str, float], placement: Placement, info: SolverInfo) -> Plan:
+    """The plan of the NLP's variable ``values``: the law's cycle rotated to start at TDC, with where theta1
+    and theta4 fall (``structure``) and the values themselves (a neighbour's warm start)."""
+    th = case.key_angles
+    law = case.planner.motion_law
+    params = params_from_numbers(values, float(th[1]), float(th[2]), law)
+    profile = profile_from_tdc(params)
+    plan = Plan(params, profile, tuple(float(a) for a in th), placement, info, motion_law=law)
+    t = plan.key_times()
+    structure = {"closing": plan.segment_at(float(t[0])), "opening": plan.segment_at(float(t[3]))}
+    return replace(plan, structure=structure, nlp_values=dict(values))
+
+
+def _angle_at(t: ca.SX, starts: list, states: list, segs: list[Segment]) -> tuple[ca.SX, ca.SX]:
+    """Closed-form crank angle and speed at time ``t`` [s] over the segments (clip formulation): the
+    linear-jerk parts as one vector, the shape terms of shaped segments added one by one."""
+    T = ca.vertcat(*[seg.duration for seg in segs])
+    omega0 = ca.vertcat(*[st[1] for st in states])
+    alpha0 = ca.vertcat(*[st[2] for st in states])
+    j0, j1 = ca.vertcat(*[seg.j0 for seg in segs]), ca.vertcat(*[seg.j1 for seg in segs])
+    tau = ca.fmin(ca.fmax(t - ca.vertcat(*starts), 0), T)
+    theta, omega = clipped_advance(tau, states[0][0], states[0][1], omega0, alpha0, j0, j1)
+    for k, seg in enumerate(segs):
+        if seg.shape is not None:
+            dth, dom, _, _ = shape_part(seg, tau[k])
+            theta, omega = theta + dth, omega + dom
+    return theta, omega
+
+
+def _build(
+    law_name: str, formula: Formula, limit_ids: tuple[str, ...], drive: bool, rate: bool, zone: bool
+) -> CycleNLP:
+    law = get_law(law_name)
+    drive = drive or rate
+    zone = zone or rate
+    layout = ParameterLayout(formula, limit_ids, drive, rate)
+    x = ca.SX.sym("x", len(VARIABLES))
+    p_case = ca.SX.sym("p", layout.size)
+    p_scale = ca.SX.sym("scale", len(VARIABLES))  # physical value = scale * x, chosen per case
+    v = {name: x[i] * p_scale[i] for i, (name, _) in enumerate(VARIABLES)}
+    unit = {name: p_scale[i] for i, (name, _) in enumerate(VARIABLES)}
+    q = layout.symbols(p_case)
+
+    fields = [f for f in CycleParameters.__dataclass_fields__ if f in v]
+    params = CycleParameters(
+        **{f: v[f] for f in fields}, draw_start=q["theta2"], draw_end=q["theta3"], motion_law=law_name
+    )
+    segs = cycle_segments(params)
+    states = knot_states(q["theta3"], params.draw_speed, 0.0, segs)
+    starts = [0.0]
+    for seg in segs[:-1]:
+        starts.append(starts[-1] + seg.duration)
+    n_before = len(segs) - 1  # the segments from theta3 to theta2 (all but the draw)
+    before = (starts[:n_before], states[:n_before], segs[:n_before])
+
+    rows = Rows()
+    w1, w2 = params.transfer_speed, params.draw_speed
+    wm1, wm2 = params.feed_peak_speed, params.return_peak_speed
+    peaks = ca.vertcat(wm1 - w1, wm1 - w2, wm2 - w2, wm2 - w1) / unit["draw_speed"]
+    rows.add("peak speeds above their ends", peaks, 0, np.inf, "planner.motion_law")
+    if law.one_jerk_per_curve:  # Eq. 14: one jerk J for both halves of each S-curve
+        d_fa, d_fd = params.feed_accel_duration, params.feed_decel_duration
+        d_ra, d_rd = params.return_accel_duration, params.return_decel_duration
+        t2 = unit["feed_accel_duration"] ** 2 * unit["draw_speed"]
+        one_jerk = ca.vertcat((wm1 - w1) * d_fd**2 - (wm1 - w2) * d_fa**2, (wm2 - w2) * d_rd**2 - (wm2 - w1) * d_ra**2)
+        rows.add("one jerk per S-curve (Eq. 14)", one_jerk / t2, 0.0, 0.0, "planner.motion_law")
+    # the cycle closes: theta at the draw start is theta2 + 2 pi
+    rows.add("cycle closes", states[n_before][0] - (q["theta2"] + 2 * np.pi), 0.0, 0.0, "key_points")
+
+    t4, t1 = v["opening_time"], v["closing_time"]
+    th4, _ = _angle_at(t4, *before)
+    th1, _ = _angle_at(t1, *before)
+    rows.add("key angles", ca.vertcat(th4 - q["theta4"], th1 - (q["theta1"] + 2 * np.pi)), 0.0, 0.0, "key_points")
+    t_end = starts[n_before]
+    order = ca.vertcat(t4, t1 - t4, t_end - t1, t_end - v["die_down_time"], t_end - v["die_up_time"])
+    rows.add("key points in order", order, 0.0, np.inf, "key_points")
+    # published structure (Fig. 6): theta4 at x3 + 3 T14 (three quarters into the return deceleration),
+    # theta1 at x1 + T1 (a quarter into the feed acceleration); bounds switched per solve
+    rd_start = params.return_accel_duration
+    fa_start = rd_start + params.return_decel_duration + params.transfer_dwell
+    published = ca.vertcat(
+        t4 - (rd_start + 0.75 * params.return_decel_duration),
+        t1 - (fa_start + 0.25 * params.feed_accel_duration),
+    )
+    published_rows = rows.add("key angles (published placement)", published, -np.inf, np.inf, "planner.placement")
+    # the die-height crossings outside the draw (a crossing inside it: its row switched off, its time fixed)
+    thd, omd = _angle_at(v["die_down_time"], *before)
+    thu, omu = _angle_at(v["die_up_time"], *before)
+    crossing = ca.vertcat(
+        q["die_down_active"] * (thd - (q["die_down_angle"] + 2 * np.pi)),
+        q["die_up_active"] * (thu - q["die_up_angle"]),
+    )
+    rows.add("die crossing angles", crossing, 0.0, 0.0, "limits.die_height_mm")
+
+    # the states at sample points of every segment, one vector per segment
+    th_s, om_s, al_s, t_s = [], [], [], []
+    draw_count = 0
+    for seg, st, t0 in zip(segs, states[:-1], starts, strict=True):
+        draw = seg.name == "draw:constant"
+        count = SAMPLES_CONSTANT if draw or seg.name == "transfer:dwell" else law.samples
+        if drive and draw:
+            count = DRAW_SAMPLES_DRIVE
+        fractions = np.linspace(0.0, 1.0, count + 1)
+        if not draw:
+            fractions = fractions[:-1]  # the end is the next segment's start
+        else:
+            draw_count = fractions.size
+        if drive and draw:  # sparse rows (see the module docstring)
+            th, om, al, since = draw_states(q, w2, ca.DM(fractions))
+            t_s.append(t0 + since)
+        else:
+            th, om, al, _ = advance_segment(seg, *st, ca.DM(fractions) * seg.duration)
+            t_s.append(t0 + ca.DM(fractions) * seg.duration)
+        th_s.append(th)
+        om_s.append(om)
+        al_s.append(al)
+    th, om, al, times = ca.vertcat(*th_s), ca.vertcat(*om_s), ca.vertcat(*al_s), ca.vertcat(*t_s)
+    h, d1, d2, _ = formula.jets(th, layout.geometry(q))
+    torque = drive_samples(q, p_case, layout, om, al, d1, d2) if drive else None
+    nlp = Transcription(
+        theta=th,
+        omega=om,
+        alpha=al,
+        times=times,
+        height=h,
+        slope=d1,
+        curvature=d2,
+        draw_count=draw_count,
+        period=params.period,
+        window_time=t1 - t4,
+        speeds=Extremes(ca.vertcat(wm1, wm2, w1, w2)),  # the halves are monotone in speed
+        accelerations=Extremes(ca.vertcat(*params.peak_accelerations())),
+        jerks=Extremes(ca.vertcat(*params.peak_jerks())),
+        lowest_speeds=None,  # the variable bounds of w1, w2 (the halves are monotone)
+        crossings=[(omd, q["die_down_slope"]), (omu, q["die_up_slope"])],
+        zone=zone,
+        rate=rate,
+        speed_unit=unit["draw_speed"],
+        length_unit=q["length_unit"],
+        param=q.__getitem__,
+        motor_torque=None if torque is None else torque.tm,
+        motor_speed=None if torque is None else torque.speed,
+    )
+    refinable = add_limit_rows(rows, nlp, layout)
+    objective = params.period
+    if rate:
+        heat, energy = objective_terms(q, torque, al, times)
+        objective = q["weight_period"] * params.period + q["weight_heat"] * heat + q["weight_energy"] * energy
+        objective -= q["weight_dwell"] * params.transfer_dwell
+
+    problem = {"x": x, "p": ca.vertcat(p_case, p_scale), "f": objective, "g": ca.vertcat(*rows.g)}
+    kind = ("_rate" if rate else "_drive" if drive else "") + ("_zone" if zone and not rate else "")
+    options = {**CYCLE_OPTIONS, **(DRIVE_OPTIONS if drive else {}), **(RATE_OPTIONS if rate else {})}
+    program = NLPSolver("press_cycle_" + law_name.replace("-", "_") + kind, problem, options)
+    return CycleNLP(
+        program,
+        *rows.bounds(),
+        tuple(rows.blocks),
+        layout,
+        VARIABLES,
+        variable_scales,
+        variable_bounds,
+        make_plan,
+        published_rows,
+        refinable,
+        None if zone else partial(halves_nlp, law_name, formula, limit_ids, drive, rate, True),
+    )
+
+
+@cache
+def halves_nlp(
+    law: str,
+    formula: Formula,
+    limit_ids: tuple[str, ...],
+    drive: bool = False,
+    rate: bool = False,
+    zone: bool = False,
+) -> CycleNLP:
+    """The compiled NLP of motion law ``law`` on a mechanism of closed form ``formula`` holding the limits
+    ``limit_ids``, with the motor's torque when ``drive``; ``rate``: the drive NLP of a target rate (see the
+    module docstring); ``zone``: the limits that hold in the die zone held at every sample there (the rate
+    NLP's always; otherwise the denser variant a search turns to when a plan's crank speed peaks inside
+    the die zone, between the crossings). Built on first use in a process, then reused for every case and
+    start."""
+    return _build(law, formula, limit_ids, drive, rate, zone)
+
+
+def halves_nlp_for(case: Case, drive: bool | None = None, rate: bool = False) -> CycleNLP:
+    """The NLP of ``case``'s law, mechanism and limits; ``drive`` None: with the motor's rows when the case
+    has a drive."""
+    drive = case.drive is not None if drive is None else drive
+    return halves_nlp(case.planner.motion_law, case.machine.formula, nlp_limits(case, drive or rate), drive, rate)

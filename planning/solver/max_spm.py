@@ -1,0 +1,137 @@
+"""The most strokes under a motion law with halves: prepare, adopt a neighbour, follow it, probe the drive,
+multi-start the published placement then the free one, try harder, answer.
+
+``free`` placement starts also from the ``published`` placement's solution, so it is never worse than
+that structure, and keeps the best plan that verifies. A case with a drive starts with one probe of the
+drive NLP (the first published start): where the motor limits that plan, the drive NLP answers; else
+the case is solved without the motor's rows, and that optimum is the answer when the motor can drive it
+(the motor's limits only take plans away), else the drive NLP runs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from planning.model.case import Case, Placement
+from planning.model.limits import BY_ID
+from planning.model.plan import Plan
+from planning.solver.halves_nlp import halves_nlp_for
+from planning.solver.search import Ran, Search, prepare
+from planning.solver.solution import Solution
+from planning.solver.starts import free_starts, published_starts
+from planning.solver.verify import assess
+
+MOTOR_LIMITS = frozenset(limit.id for limit in BY_ID.values() if limit.motor)  # the motor's limits
+
+
+def solve_max_spm(
+    case: Case, placement: Placement | None = None, neighbour: Plan | None = None, follow: bool = False
+) -> Solution:
+    """The fastest verified cycle of ``case`` under its law with halves (see ``planning.solver.optimize.solve``
+    for ``neighbour`` and ``follow``)."""
+    search = prepare(case, placement or case.planner.placement)
+    neighbour = adopt(search, neighbour)
+    if follow and _follow(search, neighbour):
+        return search.answer()
+    ran: tuple[Ran, ...] = ()
+    if case.drive is not None and search.best is None:
+        ran = _probe(search, neighbour)
+        if _kinematic_first(search, neighbour, ran):
+            return search.answer()
+    _multi_start(search, neighbour, ran)
+    if search.best is None:
+        _try_harder(search, neighbour)
+    return search.answer()
+
+
+def _probe(search: Search, neighbour: Plan | None) -> tuple[Ran, ...]:
+    """A case with a drive: the drive NLP from the first published start, to learn whether the motor
+    limits the plan (:func:`_kinematic_first`)."""
+    start = published_starts(search.case, search.draw_speed_range[1], neighbour)[0]
+    return (Ran(start, search.attempt(start, "published")),)
+
+
+def _kinematic_first(search: Search, neighbour: Plan | None, ran: tuple[Ran, ...]) -> bool:
+    """A case with a drive whose motor did not bind at the ``ran`` probe (or the probe found no plan):
+    solve it without the motor's rows (the kinematic NLP, smaller and faster), counting the probe's
+    plan. Its optimum is the drive problem's too when the motor can drive it, because the motor's
+    limits only take plans away; the dense verification (motor checks included) decides. The first
+    converged plan the motor cannot drive ends this search: the drive NLP must answer then (a verified
+    kinematic plan found before stays a candidate). Whether this answered the case."""
+    if search.best is not None and any(c.id in MOTOR_LIMITS for c in search.best.verification.binding()):
+        return False  # the motor limits the probe's plan: the drive NLP answers
+    ran = tuple(r for r in ran if r.found is not None)  # a probe that found no plan: its start runs again here
+    nlp = halves_nlp_for(search.case, drive=False)
+    kinematic = replace(search, nlp=nlp, parameters=nlp.layout.values(search.case), attempts=[], stop_on=MOTOR_LIMITS)
+    _multi_start(kinematic, neighbour, ran)
+    search.iterations, search.starts = kinematic.iterations, kinematic.starts
+    search.best, search.best_score = kinematic.best, kinematic.best_score
+    return search.best is not None and not kinematic.stopped
+
+
+def converged_plan(case: Case) -> Plan | None:
+    """The plan of the first free-placement start of ``case``'s law (max-SPM) that converges, not verified
+    and not refined: a start for another NLP (the optimal law's), far quicker than :func:`solve_max_spm`.
+    None when no start converges."""
+    search = prepare(case, "free")
+    for x0 in free_starts(case, search.draw_speed_range[1], None, None):
+        res = search.nlp.solve(x0, search.parameters, search.lbx, search.ubx, "free", search.scale)
+        search.iterations += res.iterations
+        search.starts += 1
+        if res.success:
+            return search.plan_of(search.nlp.values_of(res), "free", res.return_status)
+    return None
+
+
+def _multi_start(search: Search, neighbour: Plan | None, ran: tuple[Ran, ...] = ()) -> None:
+    """The published placement's starts (but those ``ran`` before), then (free placement) the free starts
+    from its best plan."""
+    w2 = search.draw_speed_range[1]
+    published = search.multi_start(published_starts(search.case, w2, neighbour), "published", ran=ran)
+    if search.placement == "free":
+        search.multi_start(free_starts(search.case, w2, neighbour, published), "free")
+
+
+def _try_harder(search: Search, neighbour: Plan | None) -> None:
+    """No start verified: run them all once more with a wider back-off on the limits that have one
+    (``Limit.harder_backoff``; the slider acceleration): a plan of that slightly tighter problem meets this
+    one's limits."""
+    search.parameters = search.parameters.copy()
+    for limit in search.nlp.layout.limits:
+        if limit.harder_backoff is not None:
+            search.parameters[search.parameter(limit.refined)] *= (1 - limit.harder_backoff) / (1 - limit.backoff)
+    _multi_start(search, neighbour)
+
+
+def adopt(search: Search, neighbour: Plan | None) -> Plan | None:
+    """A neighbour plan that fits and verifies here is the first answer; the neighbour when its NLP
+    values can start this case's NLP (same law), else None."""
+    if neighbour is None:
+        return None
+    if _fits(neighbour, search.case, search.placement, *search.draw_speed_range):
+        verification, drive = assess(neighbour, search.case)
+        if verification.passed:
+            solution = Solution(neighbour, verification, drive)
+            search.consider(solution, search.score_of(solution))
+    if neighbour.motion_law != search.case.planner.motion_law or not neighbour.nlp_values:
+        return None  # another law's plan neither answers this case nor starts its NLP
+    return neighbour
+
+
+def _follow(search: Search, neighbour: Plan | None) -> bool:
+    """Solve from the neighbour's values alone (same placement rule); whether that verified."""
+    if neighbour is None or not (neighbour.placement == search.placement or search.placement == "free"):
+        return False
+    return search.attempt(neighbour.nlp_values, neighbour.placement) is not None
+
+
+def _fits(plan: Plan, case: Case, placement: Placement, w2_lo: float, w2_hi: float) -> bool:
+    """Whether ``plan`` is a candidate answer for ``case``: same placement rule (a published-structure
+    plan is also a free one), same key angles, a draw speed within this case's bounds."""
+    same_angles = np.allclose(plan.key_angles, case.key_angles, rtol=0, atol=1e-12)
+    w2 = float(plan.parameters.draw_speed)
+    fits_placement = placement == "free" or plan.placement == "published"
+    same_law = plan.motion_law == case.planner.motion_law
+    return bool(same_angles and same_law and fits_placement and w2_lo - 1e-12 <= w2 <= w2_hi + 1e-12)

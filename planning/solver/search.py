@@ -1,0 +1,239 @@
+"""The search over starts of one compiled NLP, shared by every solve: :class:`Search` and :func:`prepare`.
+
+A search holds one case, its compiled NLP (``planning.solver.nlp``; either transcription), the case's
+parameters and the variables' bounds and scales, and the best verified plan so far. Each start
+(:meth:`Search.attempt`) is solved, made a plan, verified densely (``planning.solver.verify``); where only
+limits the NLP holds at samples fail between them, their sampled limits are tightened by the measured
+overshoot and the start re-solved warm; where an NLP row that can overstate its figure is active while
+the exact figure leaves room, that row is loosened once by the room. Starts run until two agree on the
+optimum (:meth:`Search.multi_start`). Without a verified plan the answer is a typed outcome
+(``planning.solver.outcomes``). The max-SPM solve of the laws (``planning.solver.max_spm``), the
+optimal law (``planning.solver.optimal``) and the objectives at a rate (``planning.solver.objectives``)
+all run on it.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from planning.model.case import Case, Placement
+from planning.model.limits.base import BINDING_SHARE
+from planning.model.plan import Plan, SolverInfo
+from planning.solver.halves_nlp import halves_nlp_for
+from planning.solver.ipopt import NLPResult, NLPStatus
+from planning.solver.nlp import CycleNLP
+from planning.solver.outcomes import Attempt, NoPlanFound, Unverified
+from planning.solver.precheck import precheck
+from planning.solver.solution import Solution
+from planning.solver.verify import Verification, assess, field_of_check
+
+REFINEMENTS = 8  # re-solves with a lowered sampled limit
+REFINE_MARGIN = 1e-5  # relative: a refined sampled limit is tightened this much beyond the measured overshoot
+ROW_ACTIVE = 1e-6  # a row scaled to 1 at its limit (the RMS row: heat over the rating's) is active above 1 - this
+AGREE_S = 1e-6  # [s] two starts whose best periods agree this closely have found the same optimum
+
+
+@dataclass
+class Search:
+    """The state of one solve: the ``case`` and its compiled ``nlp``, the case's ``parameters`` (the NLP's
+    layout), the variable bounds ``lbx``/``ubx`` and ``scale``, the draw speed's range [rad/s], the best
+    verified solution so far (``best``, ``best_score``), how the starts ended (``attempts``) and the totals
+    the answer reports. ``fixed_period``: the cycle time held at the parameter ``target_period`` (a target
+    rate); ``score``: what "better" means, lower is better (None: the period); ``stop_on``: check ids of
+    which a failure ends the search (``stopped``)."""
+
+    case: Case
+    placement: Placement
+    nlp: CycleNLP
+    parameters: np.ndarray
+    lbx: np.ndarray
+    ubx: np.ndarray
+    scale: np.ndarray
+    draw_speed_range: tuple[float, float]
+    t_start: float
+    best: Solution | None = None
+    attempts: list[Attempt] = field(default_factory=list)
+    iterations: int = 0
+    starts: int = 0
+    fixed_period: bool = False
+    score: Callable[[Solution], float] | None = None
+    best_score: float = math.inf
+    stop_on: frozenset[str] = frozenset()
+    stopped: bool = False
+
+    def parameter(self, name: str) -> int:
+        """The position of the NLP parameter ``name`` in :attr:`parameters`."""
+        return self.nlp.layout.index(name)
+
+    def score_of(self, solution: Solution) -> float:
+        """The solution's score: :attr:`score`, or its period [s]."""
+        return solution.plan.period if self.score is None else self.score(solution)
+
+    def plan_of(self, values: dict[str, float], placement: Placement, status: str) -> Plan:
+        """The plan of the NLP's variable ``values`` (the transcription's own ``make_plan``)."""
+        info = SolverInfo(self.iterations, time.perf_counter() - self.t_start, self.starts, status)
+        return self.nlp.make_plan(self.case, values, placement, info)
+
+    def attempt(self, x0: dict[str, float], placement: Placement) -> tuple[dict[str, float], float] | None:
+        """Solve from ``x0``; refine sampled limits and loosen overstated rows as the module docstring says
+        (at most :data:`REFINEMENTS` re-solves, warm). Returns the best verified values and score, or None."""
+        q = self.parameters.copy()
+        values = x0
+        multipliers = None
+        found: tuple[dict[str, float], float] | None = None
+        loosened = False
+        self.starts += 1
+        for _ in range(REFINEMENTS + 2):
+            res = self.nlp.solve(values, q, self.lbx, self.ubx, placement, self.scale, multipliers, self.fixed_period)
+            self.iterations += res.iterations
+            if self.fixed_period and res.status == NLPStatus.STOPPED_AT_LIMIT:
+                # at a target rate the optimum may sit where a half of the law degenerates (a monotone speed
+                # change: peak = end speed); IPOPT then crawls, and a fresh start from its last iterate ends it
+                res = self.nlp.solve(self.nlp.values_of(res), q, self.lbx, self.ubx, placement, self.scale, None, True)
+                self.iterations += res.iterations
+            if not res.success and multipliers is not None:
+                # a warm re-solve (a refined limit) that failed: once more without the old multipliers, from
+                # the same values (IPOPT's warm start can misjudge a slightly tighter problem as infeasible)
+                res = self.nlp.solve(values, q, self.lbx, self.ubx, placement, self.scale, None, self.fixed_period)
+                self.iterations += res.iterations
+            values, multipliers = self.nlp.values_of(res), res.multipliers
+            if not res.success:
+                block, amount = self.nlp.worst_block(placement, res.g, self.fixed_period)
+                self.attempts.append(Attempt(res.return_status, block.name, amount, case_field=block.field))
+                return found
+            plan = self.plan_of(values, placement, res.return_status)
+            verification, drive = assess(plan, self.case)
+            if verification.passed:
+                solution = Solution(plan, verification, drive)
+                score = self.score_of(solution)
+                self.consider(solution, score)
+                if found is None or score < found[1]:
+                    found = (values, score)
+                room = None if loosened else self._room(res, verification)
+                if room is None:
+                    return found
+                index, factor = room
+                q[index] *= factor * (1 - REFINE_MARGIN)
+                loosened = True
+                continue
+            bad = verification.failures()
+            self.attempts.append(Attempt(check=bad[0], case_field=field_of_check(bad[0].id)))
+            if any(c.id in self.stop_on for c in bad):
+                self.stopped = True
+                return found
+            if any(c.id not in self.nlp.refinable for c in bad):
+                if not self._densify(bad):
+                    return found
+                multipliers = None  # the denser NLP from the same values, its sampled limits as they were
+                continue
+            for c in bad:  # tighten the NLP's sampled limit by the measured overshoot
+                refine = self.nlp.refinable[c.id]
+                if refine.upward:  # a lower limit (the optimal law's minimum crank speed) goes up
+                    q[refine.index] *= (c.limit / max(c.value, 0.5 * c.limit)) * (1 + REFINE_MARGIN)
+                else:
+                    q[refine.index] *= (c.limit / c.value) * (1 - REFINE_MARGIN)
+        return found
+
+    def _densify(self, bad: list) -> bool:
+        """Turn to the NLP's denser variant (``CycleNLP.denser``) when it holds every failed check at its
+        samples; the search keeps it from here on. Whether it did."""
+        if self.nlp.denser is None:
+            return False
+        denser = self.nlp.denser()
+        if any(c.id not in denser.refinable for c in bad):
+            return False
+        self.nlp = denser
+        return True
+
+    def _room(self, res: NLPResult, verification: Verification) -> tuple[int, float] | None:
+        """``(parameter index, limit / exact value)`` of the first limit whose NLP row can overstate its
+        figure (``Limit.overestimated``; the RMS torque's trapezoid) where that row is active at ``res`` and
+        the exact figure of the verified plan stays more than :data:`BINDING_SHARE` below the limit."""
+        for limit in self.nlp.layout.limits:
+            block = self.nlp.block_of(limit.id)
+            if not limit.overestimated or limit.id not in self.nlp.refinable or block is None:
+                continue
+            check = verification.check(limit.id)
+            if res.g[block.start] < 1 - ROW_ACTIVE or check is None:
+                continue
+            if check.margin > BINDING_SHARE * check.limit:
+                return self.nlp.refinable[limit.id].index, check.limit / check.value
+        return None
+
+    def key(self, values: dict[str, float]) -> np.ndarray:
+        """``values`` as the NLP's variable vector (to compare starts)."""
+        return np.array([values[k] for k, _ in self.nlp.variables])
+
+    def consider(self, solution: Solution, score: float) -> None:
+        """Keep ``solution`` (verified) when its ``score`` beats the best so far."""
+        if self.best is None or score < self.best_score - 1e-9:
+            self.best, self.best_score = solution, score
+
+    def multi_start(
+        self, x0s: list[dict[str, float]], placement: Placement, confirm: bool = True, ran: tuple[Ran, ...] = ()
+    ) -> dict[str, float] | None:
+        """Run the starts in order until the two best verified ones agree on the score (the optimum
+        is confirmed; ``confirm`` False: until one verifies) or the starts run out; the values of the
+        best verified start. ``ran``: starts of this placement already solved (the drive's probe): they
+        are not run again, and what they found counts."""
+        found = sorted((r.found for r in ran if r.found is not None), key=lambda item: item[1])
+        tried = [self.key(r.start) for r in ran]
+        for x0 in x0s:
+            if self.stopped:
+                break
+            key = self.key(x0)
+            if any(np.allclose(key, other, rtol=1e-9, atol=1e-12) for other in tried):
+                continue  # the same start again would only repeat its answer
+            tried.append(key)
+            out = self.attempt(x0, placement)
+            if out is None:
+                continue
+            found.append(out)
+            found.sort(key=lambda item: item[1])
+            if not confirm or (len(found) >= 2 and found[1][1] - found[0][1] <= AGREE_S):
+                break
+        return found[0][0] if found else None
+
+    def answer(self) -> Solution:
+        """The best verified plan with the solver's totals; else the typed error: a converged plan
+        that failed the dense check is the finding (:class:`Unverified`), otherwise :class:`NoPlanFound`."""
+        if self.best is None:
+            found = [a for a in self.attempts if a.check is not None]
+            if found:
+                raise Unverified("no plan meets the limits: " + found[0].describe(), found[0].check)
+            last = self.attempts[-1].describe() if self.attempts else "no start"
+            raise NoPlanFound(
+                f"the solver found none from {self.starts} starts, which does not prove the limits "
+                f"cannot be met; last: {last}",
+                tuple(self.attempts),
+            )
+        plan = self.best.plan
+        if self.placement == "free" and plan.placement == "published":
+            # the published structure is one of the free structures: report it as the free answer
+            plan = replace(plan, placement="free")
+        info = SolverInfo(self.iterations, time.perf_counter() - self.t_start, self.starts, plan.solver.status)
+        return replace(self.best, plan=replace(plan, solver=info))
+
+
+@dataclass(frozen=True)
+class Ran:
+    """A start already solved: its ``start`` values and what it ``found`` (verified values and score), or None."""
+
+    start: dict[str, float]
+    found: tuple[dict[str, float], float] | None
+
+
+def prepare(case: Case, placement: Placement, nlp: CycleNLP | None = None) -> Search:
+    """Prechecks, the case's parameters, the variable bounds and scales of the compiled NLP: ``nlp``, or by
+    default the case's law's halves NLP (with the motor's rows when it has a drive)."""
+    t_start = time.perf_counter()
+    w2_lo, w2_hi = precheck(case)
+    nlp = nlp or halves_nlp_for(case)
+    p = nlp.layout.values(case)
+    lbx, ubx = nlp.variable_bounds(case, nlp.layout, w2_lo, w2_hi, p)
+    return Search(case, placement, nlp, p, lbx, ubx, nlp.variable_scales(case), (w2_lo, w2_hi), t_start)
