@@ -1,0 +1,89 @@
+"""The slide moves no faster than ``limits.slider_speed_mm_s`` anywhere in the cycle (optional): a press
+whose guides, lubrication or die set cap the slide's speed."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from planning.model.limits.base import (
+    REL_TOL,
+    BoundGrid,
+    Check,
+    Dense,
+    Draw,
+    Impossible,
+    Limit,
+    Row,
+    Transcription,
+)
+from planning.model.units import SliderSpeed
+
+SPEED_BACKOFF = 5e-4  # the NLPs hold |slider speed| <= (1 - backoff) * limit at their samples (refined if exceeded)
+
+
+class SliderSpeedLimit(Limit):
+    """|v| = |dh/dtheta w| <= the limit: at every sample of an NLP outside the draw (refined against the
+    dense check), in the draw at constant speed (a bound on the draw speed: the largest |dh/dtheta| there),
+    at every node of the bound (a bound on the speed squared, ``(v / |dh/dtheta|)^2``)."""
+
+    id = "slider_speed"
+    name = "|slider speed|"
+    unit = "mm/s"
+    field = "limits.slider_speed_mm_s"
+    order = 47
+    section_fields = {"slider_speed_mm_s": (SliderSpeed | None, None)}
+    parameters = ("slider_speed_max",)
+    refined = "slider_speed_max"
+    backoff = SPEED_BACKOFF
+
+    def applies(self, case: Any) -> bool:
+        return case.limits.slider_speed_mm_s is not None
+
+    def draw_speed_bound(self, draw: Draw) -> float:
+        slope = float(np.max(np.abs(draw.d1)))
+        return draw.case.limits.slider_speed_mm_s / slope if slope > 0 else np.inf
+
+    def at_draw_speed(self, draw: Draw, speed: float) -> list[Check]:
+        limit = draw.case.limits.slider_speed_mm_s
+        fastest = float(np.max(np.abs(draw.d1))) * speed
+        return [
+            Check.of(
+                self.id, "|slider speed| during the draw <= slider_speed_mm_s", fastest, limit, self.unit, "max", 0.0
+            )
+        ]
+
+    def precheck(self, case: Any, given: float | None, lowest: float, highest: float) -> Impossible | None:
+        if given is None:
+            return None
+        bound = self.draw_speed_bound(Draw.of(case))
+        if given <= bound * (1 + 1e-12):
+            return None
+        limit = case.limits.slider_speed_mm_s
+        return Impossible(
+            f"at the draw speed {case.process.draw_speed_rpm:g} rpm the slider moves at up to "
+            f"{limit * given / bound:.1f} mm/s in the draw > slider_speed_mm_s = {limit:g}",
+            self.field,
+            limit,
+            limit * given / bound,
+        )
+
+    def parameter_values(self, case: Any) -> dict[str, float]:
+        return {"slider_speed_max": case.limits.slider_speed_mm_s * (1 - SPEED_BACKOFF)}
+
+    def rows(self, nlp: Transcription) -> list[Row]:
+        speed = nlp.outside_draw(nlp.slope * nlp.omega)
+        return [Row("slider speed", speed / nlp.param("slider_speed_max"), -1.0, 1.0, sampled=True)]
+
+    def check(self, dense: Dense) -> list[Check]:
+        limit = dense.case.limits.slider_speed_mm_s
+        fastest = float(np.max(np.abs(dense.v)))
+        return [Check.of(self.id, self.name, fastest, limit, self.unit, "max", REL_TOL * limit)]
+
+    def bound_speeds(self, grid: BoundGrid) -> tuple[np.ndarray | None, np.ndarray | None]:
+        d1 = np.abs(grid.d1[:-1])
+        upper = np.full(d1.shape, np.inf)
+        moving = d1 > 0
+        upper[moving] = (grid.case.limits.slider_speed_mm_s / d1[moving]) ** 2
+        return None, upper
