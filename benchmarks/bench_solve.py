@@ -41,12 +41,12 @@ def main() -> None:
     import casadi
 
     from planning.model.case_file import read_case
-    from planning.solver.halves_nlp import halves_nlp_for
+    from planning.solver.halves_nlp import fresh_build
     from planning.solver.optimize import solve
 
     case = read_case(CASE)
     t = time.perf_counter()
-    halves_nlp_for(case)
+    fresh_build(case)
     build = time.perf_counter() - t
     first = solve(case)  # warm-up: builds the cached NLP
     drive_case = read_case(DRIVE_CASE)
@@ -219,7 +219,7 @@ def _laws(case) -> list[dict]:
     """(c): every law's SPM, share of the bound, NLP build time and (warm) solve time."""
     from planning.model.laws import SHAPED_LAWS
     from planning.solver.bound import time_optimal_bound
-    from planning.solver.halves_nlp import halves_nlp_for
+    from planning.solver.halves_nlp import fresh_build
     from planning.solver.optimize import solve
 
     t = time.perf_counter()
@@ -229,7 +229,7 @@ def _laws(case) -> list[dict]:
     for law in SHAPED_LAWS:  # the optimal law has rows of its own (it needs a jerk limit)
         variant = case.with_law(law)
         t = time.perf_counter()
-        halves_nlp_for(variant)
+        fresh_build(variant)
         build = time.perf_counter() - t
         t = time.perf_counter()
         sol = solve(variant)

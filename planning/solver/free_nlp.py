@@ -40,8 +40,8 @@ from planning.solver.nlp import (
     add_limit_rows,
     clipped_advance,
     draw_states,
-    drive_samples,
     nlp_limits,
+    sample_states,
 )
 from planning.solver.parameters import DRAW_SAMPLES_DRIVE, ParameterLayout, time_limit
 from press.mechanism import Formula
@@ -203,19 +203,10 @@ def _build(formula: Formula, limit_ids: tuple[str, ...], drive: bool) -> CycleNL
     draw_time = (q["theta3"] - q["theta2"]) / w2
     count = DRAW_SAMPLES_DRIVE if drive else DRAW_SAMPLES
     th_d, om_d, al_d, since = draw_states(q, w2, ca.DM(np.linspace(0.0, 1.0, count + 1)))
-    th_all, om_all, al_all = ca.vertcat(th, th_d), ca.vertcat(om, om_d), ca.vertcat(al, al_d)
-    t_all = ca.vertcat(*times, t0 + since)
-    h_all, d1, d2, _ = formula.jets(th_all, layout.geometry(q))
-    torque = drive_samples(q, p_case, layout, om_all, al_all, d1, d2) if drive else None
+    states = (ca.vertcat(th, th_d), ca.vertcat(om, om_d), ca.vertcat(al, al_d))
+    samples, _ = sample_states(formula, layout, q, p_case, states, ca.vertcat(*times, t0 + since), count + 1)
     nlp = Transcription(
-        theta=th_all,
-        omega=om_all,
-        alpha=al_all,
-        times=t_all,
-        height=h_all,
-        slope=d1,
-        curvature=d2,
-        draw_count=count + 1,
+        **samples,
         period=t0 + draw_time,
         window_time=PHASES[1][1] * v["transfer_step"],
         speeds=Extremes(om, signed=False, sampled=True),
@@ -226,10 +217,6 @@ def _build(formula: Formula, limit_ids: tuple[str, ...], drive: bool) -> CycleNL
         zone=True,
         rate=False,
         speed_unit=unit["draw_speed"],
-        length_unit=q["length_unit"],
-        param=q.__getitem__,
-        motor_torque=None if torque is None else torque.tm,
-        motor_speed=None if torque is None else torque.speed,
     )
     refinable = add_limit_rows(rows, nlp, layout)
 

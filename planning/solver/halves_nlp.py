@@ -61,9 +61,9 @@ from planning.solver.nlp import (
     add_limit_rows,
     clipped_advance,
     draw_states,
-    drive_samples,
     nlp_limits,
     objective_terms,
+    sample_states,
 )
 from planning.solver.parameters import DRAW_SAMPLES_DRIVE, ParameterLayout, time_limit
 from press.mechanism import Formula
@@ -250,18 +250,11 @@ def _build(
         th_s.append(th)
         om_s.append(om)
         al_s.append(al)
-    th, om, al, times = ca.vertcat(*th_s), ca.vertcat(*om_s), ca.vertcat(*al_s), ca.vertcat(*t_s)
-    h, d1, d2, _ = formula.jets(th, layout.geometry(q))
-    torque = drive_samples(q, p_case, layout, om, al, d1, d2) if drive else None
+    states = (ca.vertcat(*th_s), ca.vertcat(*om_s), ca.vertcat(*al_s))
+    times = ca.vertcat(*t_s)
+    samples, torque = sample_states(formula, layout, q, p_case, states, times, draw_count)
     nlp = Transcription(
-        theta=th,
-        omega=om,
-        alpha=al,
-        times=times,
-        height=h,
-        slope=d1,
-        curvature=d2,
-        draw_count=draw_count,
+        **samples,
         period=params.period,
         window_time=t1 - t4,
         speeds=Extremes(ca.vertcat(wm1, wm2, w1, w2)),  # the halves are monotone in speed
@@ -272,15 +265,11 @@ def _build(
         zone=zone,
         rate=rate,
         speed_unit=unit["draw_speed"],
-        length_unit=q["length_unit"],
-        param=q.__getitem__,
-        motor_torque=None if torque is None else torque.tm,
-        motor_speed=None if torque is None else torque.speed,
     )
     refinable = add_limit_rows(rows, nlp, layout)
     objective = params.period
     if rate:
-        heat, energy = objective_terms(q, torque, al, times)
+        heat, energy = objective_terms(q, torque, states[2], times)
         objective = q["weight_period"] * params.period + q["weight_heat"] * heat + q["weight_energy"] * energy
         objective -= q["weight_dwell"] * params.transfer_dwell
 
@@ -326,3 +315,9 @@ def halves_nlp_for(case: Case, drive: bool | None = None, rate: bool = False) ->
     has a drive."""
     drive = case.drive is not None if drive is None else drive
     return halves_nlp(case.planner.motion_law, case.machine.formula, nlp_limits(case, drive or rate), drive, rate)
+
+
+def fresh_build(case: Case) -> CycleNLP:
+    """The NLP :func:`halves_nlp_for` gives ``case``, built anew (not from the cache): what a build costs."""
+    drive = case.drive is not None
+    return _build(case.planner.motion_law, case.machine.formula, nlp_limits(case, drive), drive, False, False)

@@ -29,6 +29,7 @@ from planning.model.profile import advance
 from planning.solver.ipopt import NLPResult, NLPSolver
 from planning.solver.parameters import FORMING_SAMPLES, ParameterLayout
 from press.dynamics import DriveModel, crank_torque, motor_speed, motor_torque
+from press.mechanism import Formula
 
 CYCLE_OPTIONS = {  # added to the wrapper's base options
     "ipopt.constr_viol_tol": 1e-10,
@@ -220,6 +221,33 @@ def drive_samples(q: dict, p_case: Any, layout: ParameterLayout, om: Any, al: An
     tc = crank_torque(om, al, d1, d2, forming, model)
     tm = motor_torque(tc, al, model)
     return DriveSamples(model, tc, tm, motor_speed(om, model))
+
+
+def sample_states(
+    formula: Formula, layout: ParameterLayout, q: dict, p_case: Any, states: tuple, times: Any, draw_count: int
+) -> tuple[dict[str, Any], DriveSamples | None]:
+    """What every transcription hands the limits of its samples (the crank's ``states`` ``(theta, omega,
+    alpha)`` and their ``times``, the draw's ``draw_count`` last): with the mechanism's height and its first
+    two derivatives there, the case's parameters, and in a drive NLP the motor's torque and speed; the
+    :class:`~planning.model.limits.base.Transcription` fields, and the drive's samples (None without)."""
+    theta, omega, alpha = states
+    h, d1, d2, _ = formula.jets(theta, layout.geometry(q))
+    torque = drive_samples(q, p_case, layout, omega, alpha, d1, d2) if layout.drive else None
+    fields = {
+        "theta": theta,
+        "omega": omega,
+        "alpha": alpha,
+        "times": times,
+        "height": h,
+        "slope": d1,
+        "curvature": d2,
+        "draw_count": draw_count,
+        "length_unit": q["length_unit"],
+        "param": q.__getitem__,
+        "motor_torque": None if torque is None else torque.tm,
+        "motor_speed": None if torque is None else torque.speed,
+    }
+    return fields, torque
 
 
 def objective_terms(q: dict, drive: DriveSamples, al: Any, times: Any) -> tuple[Any, Any]:

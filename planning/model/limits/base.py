@@ -28,12 +28,12 @@ from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 
+from planning.model.units import RPM
 from press.backend import math_module
 
 REL_TOL = 1e-6  # relative tolerance of every dense check of a limit (the README's numerical contract)
 TIME_TOL = 1e-6  # [s] a time limit
 BINDING_SHARE = 1e-4  # relative: a check within this share of its limit binds (the reports' binding list)
-NO_LIMIT = 1e9  # stands for an absent limit in an NLP's parameters
 DRAW_GRID = 4001  # angles from theta2 to theta3 on which the draw-speed bounds are taken
 
 
@@ -239,7 +239,9 @@ class Limit:
     overstate the exact figure: where the row is active but the exact check leaves room, the search
     loosens the parameter once by the room), ``motor`` (a limit of the motor: a plan of the NLP without
     the drive's rows cannot be trusted to keep it), ``uses_drive`` (its rows need the drive's torque at
-    the samples: drive NLPs only). Every method has a default that does nothing."""
+    the samples: drive NLPs only), ``refuses_draw_speed_above_bound`` (a draw speed given in the case above
+    the limit's bound is an error in the case, exit 2, rather than an infeasible plan). Every method has a
+    default that does nothing."""
 
     id: ClassVar[str]
     name: ClassVar[str]
@@ -255,6 +257,7 @@ class Limit:
     overestimated: ClassVar[bool] = False
     motor: ClassVar[bool] = False
     uses_drive: ClassVar[bool] = False
+    refuses_draw_speed_above_bound: ClassVar[bool] = False
 
     def applies(self, case: Any) -> bool:
         """Whether ``case`` sets this limit (an NLP of the case has its rows only then)."""
@@ -265,8 +268,14 @@ class Limit:
         with the rest of the case (read time)."""
 
     def refuse_draw_speed(self, draw: Draw, speed: float) -> str | None:
-        """Why a draw speed ``speed`` [rad/s] given in the case is an error in the case (exit 2), or None."""
-        return None
+        """Why a draw speed ``speed`` [rad/s] given in the case is an error in the case (exit 2), or None.
+        ``refuses_draw_speed_above_bound``: above the limit's draw-speed bound."""
+        if not self.refuses_draw_speed_above_bound:
+            return None
+        bound = self.draw_speed_bound(draw)
+        if bound is None or speed <= bound * (1 + 1e-12):
+            return None
+        return f"is above the {bound / RPM:.3f} rpm that {self.field} allows"
 
     def draw_speed_bound(self, draw: Draw) -> float | None:
         """The highest constant draw speed [rad/s] this limit allows (None: it sets none)."""

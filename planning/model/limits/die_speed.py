@@ -19,7 +19,7 @@ from planning.model.limits.base import (
     Transcription,
     sample_vector,
 )
-from planning.model.units import RPM, Height, SliderSpeed
+from planning.model.units import Height, SliderSpeed
 from press.backend import math_module
 
 
@@ -38,6 +38,7 @@ class DieSpeed(Limit):
     section_fields = {"die_height_mm": (Height, ...), "die_speed_mm_s": (SliderSpeed, ...)}
     parameters = ("die_speed", "die_height")
     refined = "die_speed"
+    refuses_draw_speed_above_bound = True
 
     def validate(self, case: Any) -> None:
         m = case.machine
@@ -65,12 +66,6 @@ class DieSpeed(Limit):
         )
         peak = float(np.max(slopes)) if len(slopes) else 0.0
         return case.limits.die_speed_mm_s / peak if peak > 0 else math.inf
-
-    def refuse_draw_speed(self, draw: Draw, speed: float) -> str | None:
-        bound = self.draw_speed_bound(draw)
-        if speed <= bound * (1 + 1e-12):
-            return None
-        return f"is above the {bound / RPM:.3f} rpm that {self.field} allows"
 
     def at_draw_speed(self, draw: Draw, speed: float) -> list[Check]:
         lim = draw.case.limits

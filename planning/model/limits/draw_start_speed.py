@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 from planning.model.limits.base import REL_TOL, Check, Dense, Draw, Limit
-from planning.model.units import RPM, SliderSpeed
+from planning.model.units import SliderSpeed
 
 
 class DrawStartSpeed(Limit):
@@ -18,16 +18,11 @@ class DrawStartSpeed(Limit):
     field = "limits.draw_start_speed_mm_s"
     order = 20
     section_fields = {"draw_start_speed_mm_s": (SliderSpeed, ...)}
+    refuses_draw_speed_above_bound = True
 
     def draw_speed_bound(self, draw: Draw) -> float:
         slope = abs(float(draw.d1[0]))  # the draw's first angle is theta2
         return draw.case.limits.draw_start_speed_mm_s / slope if slope > 0 else math.inf
-
-    def refuse_draw_speed(self, draw: Draw, speed: float) -> str | None:
-        bound = self.draw_speed_bound(draw)
-        if speed <= bound * (1 + 1e-12):
-            return None
-        return f"is above the {bound / RPM:.3f} rpm that {self.field} allows"
 
     def at_draw_speed(self, draw: Draw, speed: float) -> list[Check]:
         limit = draw.case.limits.draw_start_speed_mm_s
