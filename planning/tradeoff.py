@@ -134,14 +134,14 @@ class TradeoffResult:
 
     def thermal_statement(self, case: Case) -> str:
         """What the motor's thermal limit allows: whether it sets the fastest rate, and the RMS there."""
-        from planning.model.limits.motor import MotorRMSTorque
+        from planning.model.limits.motor import MotorRMSTorqueLimit
         from planning.reports.report import binding
 
         fast = self.fastest.plan
         rms = self.fastest.drive.rms_motor_torque_Nm
         rated = case.drive.motor.rated_torque_Nm
         names = binding(self.fastest)
-        if any(c.id == MotorRMSTorque.id for c in self.fastest.verification.binding()):
+        if any(c.id == MotorRMSTorqueLimit.id for c in self.fastest.verification.binding()):
             return (
                 f"the motor's thermal limit sets the highest rate: {fast.spm:.3f} strokes/min "
                 f"(RMS torque {rms:.0f} N m = rated {rated:g} N m)"

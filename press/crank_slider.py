@@ -41,6 +41,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -153,7 +154,7 @@ class CrankSlider(Mechanism):
             return 2.0 * R
         return math.sqrt((L + R) ** 2 - e**2) - math.sqrt((L - R) ** 2 - e**2)
 
-    @property
+    @cached_property
     def peak_curvature(self) -> float:
         """Largest ``|d2h/dtheta2|`` [mm/rad^2]: ``R + R^2/L`` at BDC in line; with an offset the generic
         search (:attr:`Mechanism.peak_curvature`)."""

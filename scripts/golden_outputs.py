@@ -68,7 +68,10 @@ def write(folder: Path, names: list[str]) -> None:
 
 SOLVER_KEYS = {"iterations", "starts"}  # how a solve got there, not what it found
 KNOT_IN_TEXT = re.compile(r"\S+ \((?:0|100)% in\)")
-KNOT = re.compile(r"^(\S+) \((0|100)% in\)$")  # a point at a knot: the end of one segment is the next one's start
+# a point at a knot: the end of one segment is the next one's start. Two such labels are taken as the same
+# point; the key points' times are compared as numbers (result.json, the summary's table), so a label can
+# differ only in which side of the knot names the same instant
+KNOT = re.compile(r"^(\S+) \((0|100)% in\)$")
 
 
 def _strip(obj, renames: dict[str, str], path: str = ""):  # noqa: ANN001, ANN202 - JSON data
@@ -83,8 +86,9 @@ def _strip(obj, renames: dict[str, str], path: str = ""):  # noqa: ANN001, ANN20
             out[renames.get(here, k)] = _strip(v, renames, here)
         return out
     if isinstance(obj, list):
-        if obj and all(isinstance(v, dict) and "name" in v for v in obj):  # a list of named things: by name
-            return {str(v["name"]): _strip(v, renames, f"{path}[]") for v in obj}
+        names = [v.get("name") for v in obj if isinstance(v, dict)]
+        if obj and len(names) == len(obj) and None not in names and len(set(names)) == len(names):
+            return {str(v["name"]): _strip(v, renames, f"{path}[]") for v in obj}  # named things: by name
         return [_strip(v, renames, f"{path}[]") for v in obj]
     return obj
 

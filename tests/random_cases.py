@@ -19,12 +19,14 @@ from hypothesis import strategies as st
 from press.crank_slider import CrankSlider
 
 
-def build_case(u: list[float], name: str = "random") -> dict[str, Any]:
-    """A case mapping from 14 numbers in [0, 1) (a hypothesis draw or a seeded generator)."""
+def build_case(u: list[float], name: str = "random", offset_share: float = 0.0) -> dict[str, Any]:
+    """A case mapping from 14 numbers in [0, 1) (a hypothesis draw or a seeded generator); ``offset_share``:
+    the slide's offset as a share of the crank radius (an offset crank-slider; 0: in line)."""
     lerp = lambda a, b, x: a + (b - a) * x  # noqa: E731
     R = round(lerp(100, 800, u[0]), 1)
     L = round(R * lerp(2, 6, u[1]), 1)
-    m = CrankSlider(R, L)
+    e = float(round(offset_share * R, 1))
+    m = CrankSlider(R, L, e)
     th1 = round(lerp(40, 80, u[2]), 2)
     th2 = round(lerp(th1 + 35, 165, u[3]), 2)
     th3 = round(lerp(175, 200, u[4]), 2)
@@ -43,7 +45,7 @@ def build_case(u: list[float], name: str = "random") -> dict[str, Any]:
     slope = max(slope, abs(float(m.derivatives(hi)[0])) if hi > math.radians(th3) else 0.0)
     case: dict[str, Any] = {
         "name": name,
-        "press": {"crank_radius_mm": R, "rod_length_mm": L},
+        "press": {"crank_radius_mm": R, "rod_length_mm": L, **({"offset_mm": e} if e else {})},
         "key_points": {"closing_deg": th1, "draw_start_deg": th2, "draw_end_deg": th3, "opening_deg": th4},
         "process": {"safety_height_mm": safety, "transfer_time_s": round(lerp(0.3, 4.0, u[10]), 2)},
         "limits": {
@@ -65,3 +67,9 @@ CASES = st.lists(UNIT, min_size=14, max_size=14).map(build_case)
 def seeded_case(seed: int) -> dict[str, Any]:
     """The same kind of case from a seed (for surveys and the slow run)."""
     return build_case(list(np.random.default_rng(seed).random(14)), name=f"random-{seed}")
+
+
+def seeded_offset_case(seed: int) -> dict[str, Any]:
+    """An offset crank-slider from a seed: the slide's line 0 ... 12 % of the crank radius to either side."""
+    u = np.random.default_rng(seed).random(15)
+    return build_case(list(u[:14]), name=f"random-offset-{seed}", offset_share=round(0.24 * u[14] - 0.12, 3))

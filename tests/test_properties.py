@@ -20,10 +20,11 @@ from planning.reports.report import result_dict, trajectory
 from planning.solver.optimize import solve
 from planning.solver.outcomes import PlanningError
 
-from .random_cases import CASES, build_case, seeded_case
+from .random_cases import CASES, build_case, seeded_case, seeded_offset_case
 
 RANDOM_SET = 100  # presses of each kind (draw speed given, or left to the planner) in the normal run
 VERIFIED_SHARE = 0.9  # of them at least this share end in a verified plan
+OFFSET_SET = 40  # offset crank-sliders in the normal run
 SLOW_CASES = 2000
 SLOW_CHUNK = 100
 RELAXATION_EXAMPLES = 16
@@ -78,6 +79,13 @@ def test_random_presses_end_verified(draw_speed_given):
     outcomes = [outcome(data) for data in random_set(draw_speed_given)]
     verified = outcomes.count("verified")
     assert verified >= VERIFIED_SHARE * len(outcomes), sorted(set(outcomes))
+
+
+def test_random_offset_presses_end_verified():
+    """Offset crank-sliders (the slide's line up to 12 % of the crank radius to either side) through the same
+    properties: the offset formula in the NLPs, the verification and the asymmetric inverse height."""
+    outcomes = [outcome(seeded_offset_case(seed)) for seed in range(OFFSET_SET)]
+    assert outcomes.count("verified") >= VERIFIED_SHARE * len(outcomes), sorted(set(outcomes))
 
 
 @pytest.mark.slow

@@ -38,7 +38,7 @@ def test_it_binds_below_the_free_plans_peak(limit):
     check = sol.verification.check("slider_speed")
     assert sol.verification.passed and check is not None and check.binds
     assert np.max(np.abs(trajectory(sol, case)[:, 6])) <= limit * (1 + 1e-6)  # the 1 ms trajectory
-    assert "|slider speed|" in [c.name for c in sol.verification.binding()]
+    assert "slider_speed" in [c.id for c in sol.verification.binding()]
     assert sol.plan.spm < free.plan.spm
     bound = time_optimal_bound(case).spm
     assert sol.plan.spm <= bound < time_optimal_bound(case_from_data(with_slider_speed(None))).spm

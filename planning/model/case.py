@@ -88,9 +88,10 @@ def _limits_model() -> type[_Model]:
 
 
 LimitsModel = _limits_model()
-LimitsModel.__doc__ = """Process and machine limits [units in the names]: one key or two per limit class
-(``planning.model.limits``); ``min_crank_speed_rpm`` keeps the crank turning forward; ``crank_speed_rpm``,
-``crank_accel_rad_s2``, ``crank_jerk_rad_s3`` are the drive's limits (optional)."""
+LimitsModel.__doc__ = """Process and machine limits [units in the names]: the keys of the limit classes
+(``planning.model.limits``; a limit on a field elsewhere, as the motor's, adds none here);
+``min_crank_speed_rpm`` keeps the crank turning forward; ``crank_speed_rpm``, ``crank_accel_rad_s2``,
+``crank_jerk_rad_s3`` are the drive's limits (optional)."""
 
 
 class MotorModel(_Model):

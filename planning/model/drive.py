@@ -117,7 +117,7 @@ def cycle_integrals(profile: Profile, case: Case) -> dict[str, float]:
 def dense_drive_state(profile: Profile, case: Case) -> tuple[np.ndarray, dict]:
     """The crank angle [rad] and the drive's state (``press.dynamics.drive_state``) on the verification's
     dense grid (uniform, knots included)."""
-    t = dense_times(profile.duration, profile.knot_times)
+    t = dense_times(profile.duration, profile.knot_times - profile.t0)
     th, om, al, _ = profile.at_time(profile.t0 + t)
     return th, drive_state(th, om, al, case.machine, case.drive_model)
 

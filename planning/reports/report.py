@@ -14,7 +14,7 @@ import numpy as np
 from planning.model.case import KEY_POINT_NAMES, RPM, Case
 from planning.model.cycle import HALVES
 from planning.model.laws.improved_scurve import ImprovedSCurve
-from planning.model.limits.slider_accel import SliderAcceleration
+from planning.model.limits.slider_accel import SliderAccelLimit
 from planning.model.profile import MAX_STEP_S, Profile
 from planning.solver.solution import Solution
 from press.dynamics import drive_state
@@ -119,7 +119,7 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
     plan = solution.plan
     p = plan.parameters
     ver = solution.verification
-    accel = ver.check(SliderAcceleration.id)
+    accel = ver.check(SliderAccelLimit.id)
     return {
         "case": case.name,
         "spm": plan.spm,

@@ -1,6 +1,6 @@
-"""Solving: the cycle NLP of each motion law and the time-optimal bound (CasADi expressions), the
-IPOPT wrapper, the orchestrator of named steps, the independent dense verification and the typed
-outcomes.
+"""Solving: the NLPs of the motion laws and the time-optimal bound (CasADi expressions), the IPOPT
+wrapper, the search over starts, the solves (``optimize.solve`` dispatches), the independent dense
+verification and the typed outcomes.
 
 IPOPT's linear solver calls the OpenBLAS that CasADi ships, which starts a thread per core. The
 systems here are small (at most a few thousand rows), so the threads only contend: a solve is 10-25 %

@@ -50,7 +50,6 @@ from press.mechanism import Formula
 # segment (knot included) in each phase: the robot's window has the longest segments and the highest
 # speeds (around TDC, where the slider acceleration peaks), so it is sampled finer
 SAMPLES_PER_SEGMENT = {"return": 4, "transfer": 8, "feed": 4}
-DRAW_SAMPLES = 20  # the draw's samples without a drive
 STATES = ("angle", "speed", "accel")
 TOP_SPEED = 1e3  # [rad/s] upper bound of the crank speeds (far above any press)
 # a re-solve with a refined limit starts nearer the optimum than the laws' (about half the iterations
@@ -196,15 +195,19 @@ def _build(formula: Formula, limit_ids: tuple[str, ...], drive: bool) -> CycleNL
     )
     rows.add("die crossing angles", crossing, 0.0, 0.0, "limits.die_height_mm")
 
-    # the free profile's samples, then the draw's (the drive's forming force is given at them)
+    # the free profile's samples, then, with a drive, the draw's (the forming force is given at them; every
+    # limit holds in the draw by the draw speed's bounds)
     th = ca.vertcat(*[sm[0] for sm in samples])
     om = ca.vertcat(*[sm[1] for sm in samples])
     al = ca.vertcat(*[sm[2] for sm in samples])
     draw_time = (q["theta3"] - q["theta2"]) / w2
-    count = DRAW_SAMPLES_DRIVE if drive else DRAW_SAMPLES
-    th_d, om_d, al_d, since = draw_states(q, w2, ca.DM(np.linspace(0.0, 1.0, count + 1)))
-    states = (ca.vertcat(th, th_d), ca.vertcat(om, om_d), ca.vertcat(al, al_d))
-    samples, _ = sample_states(formula, layout, q, p_case, states, ca.vertcat(*times, t0 + since), count + 1)
+    states, t_all, count = (th, om, al), ca.vertcat(*times), 0
+    if drive:
+        count = DRAW_SAMPLES_DRIVE + 1
+        th_d, om_d, al_d, since = draw_states(q, w2, ca.DM(np.linspace(0.0, 1.0, count)))
+        states = (ca.vertcat(th, th_d), ca.vertcat(om, om_d), ca.vertcat(al, al_d))
+        t_all = ca.vertcat(t_all, t0 + since)
+    samples, _ = sample_states(formula, layout, q, p_case, states, t_all, count)
     nlp = Transcription(
         **samples,
         period=t0 + draw_time,

@@ -21,18 +21,18 @@ speed is smallest at w1 or w2, which the variable bounds keep above the minimum 
 per S-curve (Eq. 14, improved S-curve only), the cycle closes at 2 pi, the key angles theta1 and theta4
 are met, the key points in order, the die-height crossings outside the draw at their angles. Then the
 rows of every limit the case sets (``planning.model.limits``), from the states at sample points of every
-segment (the slider acceleration, the drive's torque, a target rate's die zone; the orchestrator lowers
-a sampled limit until the dense verification holds between samples), the die-height crossings, the
-robot's window t1 - t4, and the closed-form extremes of the halves: the peak speeds, the peak
-acceleration and jerk of every half. The draw speed's bounds (every limit's draw-speed bound) are
-variable bounds.
+segment before the draw (the slider acceleration, a target rate's die zone; the search lowers a sampled
+limit until the dense verification holds between samples), the drive's torque at those and the draw's
+samples, the die-height crossings, the robot's window t1 - t4, and the closed-form extremes of the
+halves: the peak speeds, the peak acceleration and jerk of every half. In the draw the crank turns at
+the constant w2, so each limit there is a bound on w2 (every limit's draw-speed bound), a variable
+bound: the kinematic NLP has no samples in the draw.
 
 The drive NLPs (motor torque rows, the RMS integral) sample the draw at its fixed angles theta2 ...
 theta3 at the constant speed w2 instead of following the cycle's closed form there: the two agree
 wherever the cycle closes (a constraint every solution meets), and the draw's rows then depend on w2
 alone (sparse rows; on the side-panel drive a quarter fewer iterations and about half the time per
-iteration, same optima). The kinematic NLP keeps the closed form: there the change saved nothing
-(more iterations). The rate NLP (``planning.solver.objectives``) adds the objectives' terms, the rows of
+iteration, same optima). The rate NLP (``planning.solver.objectives``) adds the objectives' terms, the rows of
 the die zone at every sample (a plan at a target rate may peak in speed there) and the cycle time.
 """
 
@@ -86,7 +86,7 @@ VARIABLES: tuple[tuple[str, str], ...] = (
     ("die_up_time", "time"),  # time of the ascending die-height crossing
 )
 VARIABLE_INDEX = {name: i for i, (name, _) in enumerate(VARIABLES)}
-SAMPLES_CONSTANT = 20  # slider-acceleration samples on a constant-speed segment
+SAMPLES_CONSTANT = 20  # samples on the constant-speed transfer dwell
 MIN_HALF_S = 4e-3  # [s] lower bound on the duration of a half (1 ms per improved-S-curve sub-segment)
 TOP_SPEED = 1e3  # [rad/s] upper bound of the crank speeds (far above any press)
 
@@ -233,15 +233,15 @@ def _build(
     draw_count = 0
     for seg, st, t0 in zip(segs, states[:-1], starts, strict=True):
         draw = seg.name == "draw:constant"
-        count = SAMPLES_CONSTANT if draw or seg.name == "transfer:dwell" else law.samples
-        if drive and draw:
-            count = DRAW_SAMPLES_DRIVE
+        if draw and not drive:
+            continue  # every limit holds in the draw by the draw speed's bounds
+        count = DRAW_SAMPLES_DRIVE if draw else SAMPLES_CONSTANT if seg.name == "transfer:dwell" else law.samples
         fractions = np.linspace(0.0, 1.0, count + 1)
         if not draw:
             fractions = fractions[:-1]  # the end is the next segment's start
         else:
             draw_count = fractions.size
-        if drive and draw:  # sparse rows (see the module docstring)
+        if draw:  # sparse rows (see the module docstring)
             th, om, al, since = draw_states(q, w2, ca.DM(fractions))
             t_s.append(t0 + since)
         else:

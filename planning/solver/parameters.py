@@ -29,7 +29,7 @@ STRUCTURE = (
     "theta2",  # draw start
     "theta3",  # draw end
     "theta4",  # opening
-    "die_down_angle",  # the descending die-height crossing [rad] (theta2 when it lies in the draw)
+    "die_down_angle",  # the descending die-height crossing [rad] (its row is off when it lies in the draw)
     "die_down_slope",  # |dh/dtheta| there [mm/rad], 0 when the crossing lies in the draw
     "die_down_active",  # 1 when the crossing lies outside the draw, else 0 (its time is then fixed)
     "die_up_angle",

@@ -21,7 +21,7 @@ def precheck(case: Case) -> tuple[float, float]:
     given = case.process.draw_speed_rpm * RPM if case.process.draw_speed_rpm is not None else None
     highest = min(bounds.values())
     for limit in limits_of(case):
-        impossible = limit.precheck(case, given, w_min, highest)
+        impossible = limit.precheck(case, given, w_min)
         if impossible is not None:
             raise Infeasible(
                 impossible.reason, impossible.field, impossible.value, impossible.needed, impossible.angle_deg
@@ -31,7 +31,7 @@ def precheck(case: Case) -> tuple[float, float]:
     if highest < w_min:
         key = min(bounds, key=bounds.get)
         raise Infeasible(
-            f"the {key.replace('_', ' ')} limit ({BY_ID[key].field}) allows a draw speed of at most "
+            f"{BY_ID[key].field} ({BY_ID[key].name}) allows a draw speed of at most "
             f"{highest / RPM:.3f} rpm, below min_crank_speed_rpm = {case.limits.min_crank_speed_rpm:g}",
             limit="limits.min_crank_speed_rpm",
             value=case.limits.min_crank_speed_rpm,

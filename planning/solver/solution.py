@@ -12,8 +12,6 @@ from planning.model.drive import DriveFigures
 from planning.model.plan import Plan
 from planning.solver.verify import Verification
 
-SAVED_FIGURES = ("rms_motor_torque_Nm", "supply_energy_kJ")  # what an objective at a rate saves
-
 
 @dataclass(frozen=True)
 class Solution:
@@ -27,8 +25,8 @@ class Solution:
     at_rate: AtRate | None = None
 
     def saving_pct(self, key: str) -> float:
-        """How much lower this plan's drive figure ``key`` (one of :data:`SAVED_FIGURES`) is than the
-        baseline's at the same rate [%] (needs ``at_rate``)."""
+        """How much lower this plan's drive figure ``key`` (``rms_motor_torque_Nm`` or ``supply_energy_kJ``,
+        what an objective at a rate saves) is than the baseline's at the same rate [%] (needs ``at_rate``)."""
         base = getattr(self.at_rate.baseline.drive, key)
         return 100.0 * (base - getattr(self.drive, key)) / base if base else 0.0
 

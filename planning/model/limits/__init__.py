@@ -49,4 +49,4 @@ def draw_speed_bounds(case: Any) -> dict[str, float]:
     return {key: value for key, value in bounds.items() if value is not None}
 
 
-__all__ = ["BY_ID", "LIMITS", "Check", "Limit", "draw_speed_bounds", "field_of", "limits_of"]
+__all__ = ["BY_ID", "LIMITS", "Check", "Draw", "Limit", "draw_speed_bounds", "field_of", "limits_of"]

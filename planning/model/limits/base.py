@@ -7,12 +7,15 @@ algorithms (the NLPs, the bound, the verification, the prechecks, ``pressplan ch
 list ``planning.model.limits.LIMITS`` and never name a limit; messages and reports find a limit by its
 id (toppra's constraint objects, handed to its algorithms as a list, are the model).
 
-The contexts below are the contract between the limits and the algorithms:
+The cycle's own structure is not a limit: the key points, the closing of the cycle and the die-height
+crossings (events the transcriptions place, like the key points, so that the die-speed limit can hold
+the speed there) are the transcriptions'; so are their variables' scales, which read the slider
+acceleration limit every case has. The contexts below are the contract between the limits and the
+algorithms:
 
 - :class:`Transcription`: an NLP's states at its samples and the extremes it can express (symbols);
 - :class:`Dense`: the dense re-simulation of a plan (numpy arrays);
-- :class:`BoundGrid`: the time-optimal bound's grid over crank angle and its variables (symbols); a limit
-  that does not take part in the bound says why in its docstring;
+- :class:`BoundGrid`: the time-optimal bound's grid over crank angle and its variables (symbols);
 - :class:`Draw`: the draw at constant crank speed, sampled (numpy arrays), for the draw-speed bounds.
 
 Every expression works on numpy arrays and CasADi symbols alike (``press.backend``); nothing here
@@ -268,8 +271,12 @@ class Limit:
         with the rest of the case (read time)."""
 
     def refuse_draw_speed(self, draw: Draw, speed: float) -> str | None:
-        """Why a draw speed ``speed`` [rad/s] given in the case is an error in the case (exit 2), or None.
-        ``refuses_draw_speed_above_bound``: above the limit's draw-speed bound."""
+        """Why a draw speed ``speed`` [rad/s] given in the case is an error in the case (exit 2), or None:
+        above the top crank speed the limit sets (:meth:`top_crank_speed`), or, with
+        ``refuses_draw_speed_above_bound``, above its draw-speed bound."""
+        top = self.top_crank_speed(draw.case)
+        if top is not None and speed > top * (1 + 1e-12):
+            return f"is above the {top / RPM:.6g} rpm on the crank that {self.field} allows"
         if not self.refuses_draw_speed_above_bound:
             return None
         bound = self.draw_speed_bound(draw)
@@ -289,9 +296,9 @@ class Limit:
         """``pressplan check``'s static checks at draw speed ``speed`` [rad/s] (no plan)."""
         return []
 
-    def precheck(self, case: Any, given: float | None, lowest: float, highest: float) -> Impossible | None:
-        """A necessary condition before any NLP, at the draw speed ``given`` [rad/s] (None: free in
-        ``lowest`` .. ``highest``)."""
+    def precheck(self, case: Any, given: float | None, lowest: float) -> Impossible | None:
+        """A necessary condition before any NLP, at the draw speed ``given`` [rad/s] (None: free, at least
+        ``lowest``)."""
         return None
 
     def parameter_values(self, case: Any) -> dict[str, float]:

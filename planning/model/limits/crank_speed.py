@@ -37,10 +37,8 @@ class CrankSpeedLimit(Limit):
         return None if top is None else top * RPM
 
     def refuse_draw_speed(self, draw: Draw, speed: float) -> str | None:
-        top = draw.case.limits.crank_speed_rpm
-        return (
-            f"is above {self.field} = {top:g}" if top is not None and draw.case.process.draw_speed_rpm > top else None
-        )
+        top = self.top_crank_speed(draw.case)
+        return f"is above {self.field} = {draw.case.limits.crank_speed_rpm:g}" if speed > top * (1 + 1e-12) else None
 
     def parameter_values(self, case: Any) -> dict[str, float]:
         return {"crank_speed_max": case.limits.crank_speed_rpm * RPM}

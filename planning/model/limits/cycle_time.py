@@ -9,7 +9,7 @@ import numpy as np
 from planning.model.limits.base import TIME_TOL, Check, Dense, Limit, Row, Transcription
 
 
-class CycleTime(Limit):
+class CycleTimeLimit(Limit):
     """The cycle time of a plan at a target rate (objectives ``min-rms-torque``, ``min-energy``): one row of
     the rate NLP, free until a solve holds it at the parameter ``target_period`` (bounds set per solve);
     checked on every plan of a case planned at a rate."""

@@ -23,7 +23,7 @@ from planning.model.units import Height, SliderSpeed
 from press.backend import math_module
 
 
-class DieSpeed(Limit):
+class DieSpeedLimit(Limit):
     """|slide speed| <= ``limits.die_speed_mm_s`` wherever the slide is at or below
     ``limits.die_height_mm``: in the draw (a bound on the draw speed), where the slide passes the die
     height outside the draw (rows at the crossings), and, where a transcription's crank speed may peak

@@ -8,7 +8,7 @@ from planning.model.limits.base import REL_TOL, Check, Dense, Draw, Limit
 from planning.model.units import SliderSpeed
 
 
-class DrawStartSpeed(Limit):
+class DrawStartSpeedLimit(Limit):
     """|slide speed| at theta2 <= the limit. The draw runs at constant crank speed, so this bounds the draw
     speed alone (the NLPs hold it through the draw speed's bounds)."""
 

@@ -10,7 +10,7 @@ from planning.model.limits.base import REL_TOL, BoundGrid, Check, Dense, Draw, L
 from planning.model.units import RPM, CrankSpeed
 
 
-class MinCrankSpeed(Limit):
+class MinCrankSpeedLimit(Limit):
     """crank speed >= the minimum. A law's halves are monotone, so their NLP holds it by the bounds of the
     speeds they join; a free profile holds it at its samples (refined upward, a lower limit)."""
 
@@ -26,7 +26,7 @@ class MinCrankSpeed(Limit):
 
     def refuse_draw_speed(self, draw: Draw, speed: float) -> str | None:
         lowest = draw.case.limits.min_crank_speed_rpm
-        return f"is below {self.field} = {lowest:g}" if draw.case.process.draw_speed_rpm < lowest else None
+        return f"is below {self.field} = {lowest:g}" if speed < lowest * RPM * (1 - 1e-12) else None
 
     def parameter_values(self, case: Any) -> dict[str, float]:
         return {"min_crank_speed": case.limits.min_crank_speed_rpm * RPM}

@@ -28,9 +28,10 @@ DRIVE_BACKOFF = 5e-5  # the NLPs hold the motor's peak and RMS torque this much 
 RMS_PROOF_MARGIN = 1e-3  # relative: the trapezoidal draw integral of the RMS precheck is far more accurate
 
 
-class MotorSpeed(Limit):
+class MotorSpeedLimit(Limit):
     """motor speed = gear ratio x crank speed <= ``drive.motor.max_speed_rpm``: a top crank speed, held like
-    ``limits.crank_speed_rpm`` (in every NLP of a drive case, the kinematic one too)."""
+    ``limits.crank_speed_rpm`` (in every NLP of a drive case, the kinematic one too; a given draw speed
+    above it is an error in the case)."""
 
     id = "motor_speed"
     name = "motor speed"
@@ -81,11 +82,11 @@ def _top_crank_speed(case: Any) -> float:
     return case.drive.motor.max_speed_rpm * RPM / case.drive.gear_ratio
 
 
-class MotorPeakTorque(Limit):
+class MotorPeakTorqueLimit(Limit):
     """|motor torque| <= the peak-torque envelope at the motor's speed (the peak up to the base speed,
     constant power above it): ``|T_m| max(1, n / n_base) <= peak`` at every sample of a drive NLP, as one
-    row (kink at the base speed); on the dense grid; in the bound, the two linear forms whose larger is
-    the motor torque, driving side."""
+    row (kink at the base speed; the base speed is the drive model's parameter ``motor_base_speed``); on
+    the dense grid; in the bound, the two linear forms whose larger is the motor torque, driving side."""
 
     id = "motor_peak_torque"
     name = "motor peak torque"
@@ -94,13 +95,14 @@ class MotorPeakTorque(Limit):
     order = 90
     parameters = ("motor_peak",)
     refined = "motor_peak"
+    backoff = DRIVE_BACKOFF
     motor = True
     uses_drive = True
 
     def applies(self, case: Any) -> bool:
         return case.drive is not None
 
-    def precheck(self, case: Any, given: float | None, lowest: float, highest: float) -> Impossible | None:
+    def precheck(self, case: Any, given: float | None, lowest: float) -> Impossible | None:
         """At constant speed the draw needs the most torque where the forming force acts on the longest
         lever: the motor cannot make the draw even at the lowest draw speed the case allows."""
         motor = case.drive.motor
@@ -124,7 +126,7 @@ class MotorPeakTorque(Limit):
 
     def parameter_values(self, case: Any) -> dict[str, float]:
         motor = case.drive.motor
-        return {"motor_peak": motor.peak_torque_Nm * (1 - DRIVE_BACKOFF)}
+        return {"motor_peak": motor.peak_torque_Nm * (1 - self.backoff)}
 
     def rows(self, nlp: Transcription) -> list[Row]:
         above_base = math_module(nlp.motor_speed).fmax(1.0, nlp.motor_speed / nlp.param("motor_base_speed"))
@@ -158,7 +160,7 @@ class MotorPeakTorque(Limit):
         return rows
 
 
-class MotorRMSTorque(Limit):
+class MotorRMSTorqueLimit(Limit):
     """The RMS motor torque over the cycle <= ``drive.motor.rated_torque_Nm`` (the motors' heat). A drive
     NLP integrates ``T_m^2`` by the trapezoidal rule over its samples, which can overstate the exact
     integral (the search then loosens its row once by the measured room); the verification integrates by
@@ -171,6 +173,7 @@ class MotorRMSTorque(Limit):
     order = 100
     parameters = ("motor_rms",)
     refined = "motor_rms"
+    backoff = DRIVE_BACKOFF
     overestimated = True
     motor = True
     uses_drive = True
@@ -178,7 +181,7 @@ class MotorRMSTorque(Limit):
     def applies(self, case: Any) -> bool:
         return case.drive is not None
 
-    def precheck(self, case: Any, given: float | None, lowest: float, highest: float) -> Impossible | None:
+    def precheck(self, case: Any, given: float | None, lowest: float) -> Impossible | None:
         """The draw alone gives ``integral T_m^2 dt = integral T_m^2 dtheta / w2``, and no cycle is longer
         than one turn at the minimum crank speed, so ``RMS^2 >=`` that integral over ``2 pi / w_min``."""
         if given is None:
@@ -201,7 +204,7 @@ class MotorRMSTorque(Limit):
         )
 
     def parameter_values(self, case: Any) -> dict[str, float]:
-        return {"motor_rms": case.drive.motor.rated_torque_Nm * (1 - DRIVE_BACKOFF)}
+        return {"motor_rms": case.drive.motor.rated_torque_Nm * (1 - self.backoff)}
 
     def rows(self, nlp: Transcription) -> list[Row]:
         heat = trapezoid(nlp.motor_torque**2, nlp.times)

@@ -25,7 +25,7 @@ from planning.model.limits.base import (
 from planning.model.units import RPM
 
 
-class TransferTime(Limit):
+class TransferTimeLimit(Limit):
     """The time from theta4 to theta1 through TDC is at least ``process.transfer_time_s``."""
 
     id = "transfer_time"
@@ -38,7 +38,7 @@ class TransferTime(Limit):
     def parameter_values(self, case: Any) -> dict[str, float]:
         return {"transfer_time": case.process.transfer_time_s}
 
-    def precheck(self, case: Any, given: float | None, lowest: float, highest: float) -> Impossible | None:
+    def precheck(self, case: Any, given: float | None, lowest: float) -> Impossible | None:
         """The window's angle crossed at the minimum crank speed takes the longest any motion can take."""
         th1, _, _, th4 = case.key_angles
         window = th1 + 2 * math.pi - th4
@@ -67,7 +67,7 @@ class TransferTime(Limit):
         return [(total(grid.tau[window]), grid.case.process.transfer_time_s, np.inf)]
 
 
-class SafetyHeight(Limit):
+class SafetyHeightLimit(Limit):
     """From theta4 to theta1 the slide is at or above ``process.safety_height_mm`` (the transfer robot's
     safety height)."""
 

@@ -24,7 +24,7 @@ ACCEL_BACKOFF = 5e-4  # the NLPs hold |slider acceleration| <= (1 - backoff) * l
 HARDER_BACKOFF = 5e-3  # the back-off of a second round when no start verified
 
 
-class SliderAcceleration(Limit):
+class SliderAccelLimit(Limit):
     """|a| = |d2h/dtheta2 w^2 + dh/dtheta alpha| <= the limit: at every sample of an NLP (the dense check
     decides between them), in the draw (a bound on the draw speed), at both ends of every interval of
     the bound (linear in the speed squared there)."""
@@ -50,7 +50,7 @@ class SliderAcceleration(Limit):
         name = "|slider acceleration| during the draw <= slider_accel_mm_s2"
         return [Check.of(self.id, name, value, limit, self.unit, "max", 0.0)]
 
-    def precheck(self, case: Any, given: float | None, lowest: float, highest: float) -> Impossible | None:
+    def precheck(self, case: Any, given: float | None, lowest: float) -> Impossible | None:
         if given is None:
             return None
         bound = self.draw_speed_bound(Draw.of(case))
@@ -67,7 +67,7 @@ class SliderAcceleration(Limit):
         )
 
     def parameter_values(self, case: Any) -> dict[str, float]:
-        return {"accel_limit": case.limits.slider_accel_mm_s2 * (1 - ACCEL_BACKOFF)}
+        return {"accel_limit": case.limits.slider_accel_mm_s2 * (1 - self.backoff)}
 
     def rows(self, nlp: Transcription) -> list[Row]:
         accel = nlp.outside_draw(nlp.curvature * nlp.omega**2 + nlp.slope * nlp.alpha)

@@ -54,7 +54,7 @@ class SliderSpeedLimit(Limit):
             )
         ]
 
-    def precheck(self, case: Any, given: float | None, lowest: float, highest: float) -> Impossible | None:
+    def precheck(self, case: Any, given: float | None, lowest: float) -> Impossible | None:
         if given is None:
             return None
         bound = self.draw_speed_bound(Draw.of(case))
@@ -70,7 +70,7 @@ class SliderSpeedLimit(Limit):
         )
 
     def parameter_values(self, case: Any) -> dict[str, float]:
-        return {"slider_speed_max": case.limits.slider_speed_mm_s * (1 - SPEED_BACKOFF)}
+        return {"slider_speed_max": case.limits.slider_speed_mm_s * (1 - self.backoff)}
 
     def rows(self, nlp: Transcription) -> list[Row]:
         speed = nlp.outside_draw(nlp.slope * nlp.omega)
