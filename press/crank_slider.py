@@ -47,6 +47,7 @@ from typing import Any
 import numpy as np
 
 from press.backend import math_module
+from press.jets import ORDER, Jet, Point
 from press.mechanism import HEIGHT_TOL, Formula, Jets, Mechanism
 
 
@@ -87,9 +88,51 @@ def in_line_jets(theta: Any, geometry: Sequence[Any]) -> Jets:
     return h, d1, d2, d3
 
 
-IN_LINE = Formula("crank-slider, in line", ("crank_radius", "rod_length"), in_line_jets)
+def in_line_series(theta: Any, geometry: Sequence[Any], order: int = ORDER) -> Jet:
+    """The in-line height above BDC as a jet of ``order`` (``press.jets``) at ``theta`` [rad from TDC] for
+    ``geometry = (R, L)`` [mm]: ``R (1 + cos theta) + L - sqrt(L^2 - R^2 sin^2 theta)``."""
+    R, L = geometry
+    t = Jet.angle(theta, order)
+    return (t.cos() + 1.0) * R + L - (L**2 - (t.sin() * R).square()).sqrt()
+
+
+def offset_series(theta: Any, geometry: Sequence[Any], order: int = ORDER) -> Jet:
+    """The offset press's height above BDC as a jet (module docstring) for ``geometry = (R, L, e, phi_TDC,
+    y_BDC)``: ``R cos phi - sqrt(L^2 - (R sin phi - e)^2) - y_BDC``, ``phi = theta + phi_TDC``."""
+    R, L, e, phi_tdc, y_bdc = geometry
+    phi = Jet.angle(theta + phi_tdc, order)
+    return phi.cos() * R - (L**2 - (phi.sin() * R - e).square()).sqrt() - y_bdc
+
+
+def in_line_evaluate(theta: Any, geometry: Sequence[Any], order: int = ORDER) -> tuple[Jet, dict]:
+    """The in-line press's height (:func:`in_line_series`) and its one link, the rod: its joints (crank
+    pin, wrist pin) and length [mm] (``press.mechanism.Formula``)."""
+    R, L = geometry
+    height = in_line_series(theta, geometry, order)
+    return height, _rod_frame(theta, R, L, 0.0, 0.0, height, -(L + R))
+
+
+def offset_evaluate(theta: Any, geometry: Sequence[Any], order: int = ORDER) -> tuple[Jet, dict]:
+    """The same for the offset press."""
+    R, L, e, phi_tdc, y_bdc = geometry
+    height = offset_series(theta, geometry, order)
+    return height, _rod_frame(theta, R, L, e, phi_tdc, height, y_bdc)
+
+
+def _rod_frame(theta: Any, R: Any, L: Any, e: Any, phi_tdc: Any, height: Jet, y_bdc: Any) -> dict:
+    phi = Jet.angle(theta + phi_tdc, height.order)
+    crank_pin = Point(phi.sin() * R, phi.cos() * R)
+    wrist_pin = Point(Jet(e), height + y_bdc)
+    return {"rod": (crank_pin, wrist_pin, L)}
+
+
+IN_LINE = Formula("crank-slider, in line", ("crank_radius", "rod_length"), in_line_evaluate, in_line_jets, ("rod",))
 OFFSET = Formula(
-    "crank-slider, offset", ("crank_radius", "rod_length", "offset", "tdc_phase", "bdc_level"), offset_jets
+    "crank-slider, offset",
+    ("crank_radius", "rod_length", "offset", "tdc_phase", "bdc_level"),
+    offset_evaluate,
+    offset_jets,
+    ("rod",),
 )
 
 
@@ -118,6 +161,12 @@ class CrankSlider(Mechanism):
     offset: float = 0.0
 
     kind = "crank-slider"
+    own_angle_origin = "the crank pin straight above the crank axis"
+
+    @property
+    def tdc_own_angle(self) -> float:
+        """The geometric angle of TDC [rad]: ``-asin(e / (L - R))`` (0 in line)."""
+        return -math.asin(self.offset / (self.rod_length - self.crank_radius))
 
     def __post_init__(self) -> None:
         R, L, e = self.crank_radius, self.rod_length, self.offset

@@ -8,18 +8,25 @@ motor draws from the supply.
 
 Model (derived from the power balance; see the README):
 
-- Masses: what moves with the slide (the slide, the upper die, the wrist-pin share of the rod) is one
-  mass ``M``; what turns with the crank (the crankshaft and gears, the crank-pin share of the rod) one
-  inertia ``J0`` about the crank axis. The mechanism says how its links split
-  (``press.crank_slider.CrankSlider.rod_split``). The crank-pin share is taken as balanced (its gravity is
-  neglected).
+- Masses: what moves with the slide (the slide, the upper die, the wrist-pin share of a crank-slider's
+  rod) is one mass ``M``; what turns with the crank (the crankshaft and gears, the crank-pin share of
+  the rod) one inertia ``J0`` about the crank axis (``press.crank_slider.CrankSlider.rod_split``; the
+  crank-pin share is taken as balanced, its gravity neglected). A linkage's links (``LinkMass``) each
+  have a mass at their centre of gravity and an inertia about it; their kinetic energy
+  ``1/2 J_links(theta) omega^2`` with ``J_links = sum m (x_G'^2 + y_G'^2) + I phi'^2`` (primes: d/dtheta
+  of the CG's position and of the link's angle, from the mechanism's closed form) and their weight's
+  generalised force ``-sum m g y_G'`` enter Lagrange's equation below.
 - Forces on the slide: ``F_env = F_form + F_cb - M g``. ``F_form`` is the forming force of the case's
   table (height above BDC -> force, linear between points, zero outside), acting only while the slide
   descends between theta2 and BDC; ``F_cb`` the counterbalance (constant, upward).
-- Kinetic energy ``K = 1/2 (J0 + M h'^2) omega^2``. The power the crank delivers, ``T_c omega``, equals
-  ``dK/dt`` minus the power of the forces on the slide, ``F_env h' omega``:
+- Kinetic energy ``K = 1/2 J(theta) omega^2`` with ``J = J0 + M h'^2 + J_links``. Lagrange's equation for
+  the one coordinate theta, ``T_c = J alpha + 1/2 J' omega^2 - Q``, with the generalised force
+  ``Q = F_env h' - sum m g y_G'`` (virtual work):
 
-      T_c = J0 alpha + M h' (h' alpha + h'' omega^2) - F_env h'
+      T_c = J0 alpha + M h' (h' alpha + h'' omega^2) - F_env h' + J_links alpha + 1/2 J_links' omega^2
+            + sum m g y_G'
+
+  (for a crank-slider, whose rod is split, the link terms are zero).
 
 - Motor (all motors together), gear ratio i, efficiency eta, motor-side inertia J_m:
   ``omega_m = i omega``; ``T_m = T_c / (i eta) + J_m i alpha`` when ``T_c >= 0`` (power flows to the
@@ -37,9 +44,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from press.backend import math_module
+from press.jets import Jet
 
 if TYPE_CHECKING:
-    from press.crank_slider import CrankSlider
     from press.mechanism import Mechanism
 
 GRAVITY = 9.80665  # [m/s^2] standard gravity
@@ -62,14 +69,13 @@ class DriveModel:
     force_values: tuple[float, ...]
     draw_start: float
     bdc: float
+    links: tuple[LinkMass, ...] = ()
 
     @classmethod
     def from_parts(
         cls,
-        mechanism: CrankSlider,
+        mechanism: Mechanism,
         slide_mass_kg: float,
-        rod_mass_kg: float,
-        rod_cg_from_crank_pin_mm: float,
         crank_inertia_kg_m2: float,
         counterbalance_kN: float,
         gear_ratio: float,
@@ -77,9 +83,13 @@ class DriveModel:
         motor_inertia_kg_m2: float,
         forming_force_kN: list[tuple[float, float]] | None,
         draw_start: float,
+        lumped: tuple[float, float] = (0.0, 0.0),
+        links: tuple[LinkMass, ...] = (),
     ) -> DriveModel:
-        """The model from the case's engineering units; the mechanism splits the rod (module docstring)."""
-        with_slide, at_crank = mechanism.rod_split(rod_mass_kg, rod_cg_from_crank_pin_mm)
+        """The model from the case's engineering units; ``lumped``: a mass moving with the slide [kg] and an
+        inertia turning with the crank [kg m^2] (a crank-slider's split rod); ``links``: a linkage's links
+        (module docstring)."""
+        with_slide, at_crank = lumped
         table = sorted(forming_force_kN or [])
         return cls(
             M=slide_mass_kg + with_slide,
@@ -92,7 +102,45 @@ class DriveModel:
             force_values=tuple(float(f) * 1e3 for _, f in table),
             draw_start=float(draw_start),
             bdc=float(mechanism.bdc_angle),
+            links=tuple(link for link in links if link.mass > 0 or link.inertia > 0),
         )
+
+
+@dataclass(frozen=True)
+class LinkMass:
+    """One link of a linkage: its ``name`` (the mechanism's), ``mass`` [kg] at its centre of gravity,
+    ``along`` [mm] from the link's first joint toward its second and ``across`` [mm] to the left of that
+    axis, and ``inertia`` [kg m^2] about its centre of gravity."""
+
+    name: str
+    mass: float
+    along: float
+    across: float = 0.0
+    inertia: float = 0.0
+
+
+def link_jets(frames: dict[str, tuple[Any, Any, Any]], links: tuple[Any, ...]) -> tuple[Jet, Jet]:
+    """``(J_links [kg m^2], sum m g y_G' [N m])`` of ``links`` (each with ``name``, ``mass``, ``along``,
+    ``across``, ``inertia``; numbers or symbols) as jets in the crank angle, one order below the
+    mechanism's ``frames`` (link name -> first joint, second joint, length [mm]; points of jets,
+    ``press.jets``): ``J_links = sum m (x_G'^2 + y_G'^2) + I phi'^2`` with ``phi' = u_x u_y' - u_y u_x'`` for
+    the link's unit vector ``u``."""
+    J = G = Jet(0.0)
+    for link in links:
+        first, second, length = frames[link.name]
+        axis = (second - first).scaled(1.0 / length)  # a unit vector along the link
+        cg = first + axis.scaled(link.along) + axis.perpendicular().scaled(link.across)
+        x1, y1 = cg.x.derivative() * 1e-3, cg.y.derivative() * 1e-3  # [m/rad]
+        turn = axis.x * axis.y.derivative() - axis.y * axis.x.derivative()  # d(angle)/dtheta of a unit vector
+        J = J + (x1.square() + y1.square()) * link.mass + turn.square() * link.inertia
+        G = G + y1 * (link.mass * GRAVITY)
+    return J, G
+
+
+def link_terms(frames: dict[str, tuple[Any, Any, Any]], links: tuple[Any, ...]) -> tuple[Any, Any, Any]:
+    """``(J_links [kg m^2], dJ_links/dtheta [kg m^2/rad], sum m g y_G' [N m])`` (:func:`link_jets`)."""
+    J, G = link_jets(frames, links)
+    return J.c[0], J.c[1], G.c[0]
 
 
 def forming_force(theta: Any, height_mm: Any, drive: DriveModel) -> Any:
@@ -113,14 +161,28 @@ def forming_force(theta: Any, height_mm: Any, drive: DriveModel) -> Any:
     return m.if_else(active * inside, value, 0)
 
 
-def crank_torque(omega: Any, alpha: Any, d1_mm: Any, d2_mm: Any, forming_N: Any, drive: DriveModel) -> Any:
-    """Crank torque [N m] from the power balance: ``J0 alpha + M h' (h' alpha + h'' omega^2) - F_env h'``.
+def crank_torque(
+    omega: Any,
+    alpha: Any,
+    d1_mm: Any,
+    d2_mm: Any,
+    forming_N: Any,
+    drive: DriveModel,
+    links: tuple[Any, Any, Any] | None = None,
+) -> Any:
+    """Crank torque [N m] from Lagrange's equation (module docstring):
+    ``J0 alpha + M h' (h' alpha + h'' omega^2) - F_env h'`` plus, with ``links`` (:func:`link_terms`),
+    ``J_links alpha + 1/2 J_links' omega^2 + sum m g y_G'``.
 
     ``omega`` [rad/s], ``alpha`` [rad/s^2], ``d1_mm = dh/dtheta`` [mm/rad], ``d2_mm = d2h/dtheta2``
     [mm/rad^2], ``forming_N`` the forming force [N] at that point (:func:`forming_force`)."""
     d1, d2 = d1_mm * 1e-3, d2_mm * 1e-3
     f_env = forming_N + drive.F_cb - drive.M * GRAVITY
-    return drive.J0 * alpha + drive.M * d1 * (d1 * alpha + d2 * omega**2) - f_env * d1
+    torque = drive.J0 * alpha + drive.M * d1 * (d1 * alpha + d2 * omega**2) - f_env * d1
+    if links is not None:
+        J, dJ, G = links
+        torque = torque + J * alpha + 0.5 * dJ * omega**2 + G
+    return torque
 
 
 def motor_torque(crank_torque_Nm: Any, alpha: Any, drive: DriveModel) -> Any:
@@ -171,7 +233,8 @@ def drive_state(theta: Any, omega: Any, alpha: Any, mechanism: Mechanism, drive:
     ``alpha`` [rad/s^2]."""
     h, d1, d2, _ = mechanism.jets(theta)
     f = forming_force(theta, h, drive)
-    tc = crank_torque(omega, alpha, d1, d2, f, drive)
+    links = link_terms(mechanism.frames(theta), drive.links) if drive.links else None
+    tc = crank_torque(omega, alpha, d1, d2, f, drive, links)
     tm = motor_torque(tc, alpha, drive)
     wm = motor_speed(omega, drive)
     return {

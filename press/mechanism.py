@@ -13,7 +13,7 @@ Everything else a planner asks of the geometry is derived here once, from that c
 motion from the crank's (chain rule), BDC, the stroke, the crank angles at which the slide passes a
 height (going down and going up), the characteristic length and curvature the NLPs scale with. A
 mechanism with closed forms for these may override them; the generic ones assume only that the slide
-goes down monotonically from TDC to BDC and up again.
+reaches BDC once going down from TDC and leaves it once going up (it may wobble in a dwell at BDC).
 
 Nothing outside ``press/`` knows a link length.
 """
@@ -29,10 +29,14 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from press.jets import ORDER
+
 TWO_PI = 2.0 * math.pi
 CURVATURE_GRID = 7200  # angles [one turn] on which the generic peak curvature is sought
 DEAD_CENTRE_TOL = 1e-13  # [rad] the generic BDC search stops at this bracket width
 HEIGHT_TOL = 1e-9  # [mm] a height this far outside the stroke still counts as its end
+ROOT_TOL = 1e-14  # [rad] the generic crossing search stops when its steps are this small
+ROOT_ITERATIONS = 100  # at most (bisection alone would need about 40 from a grid interval)
 
 
 Jets = tuple[Any, Any, Any, Any]  # h [mm], dh/dtheta [mm/rad], d2h/dtheta2 [mm/rad^2], d3h/dtheta3 [mm/rad^3]
@@ -40,14 +44,34 @@ Jets = tuple[Any, Any, Any, Any]  # h [mm], dh/dtheta [mm/rad], d2h/dtheta2 [mm/
 
 @dataclass(frozen=True)
 class Formula:
-    """A mechanism's closed form: ``jets(theta, geometry)`` gives the slide height above BDC and its first
-    three derivatives at crank angles ``theta`` [rad from TDC] (numpy arrays or CasADi symbols) for the
-    numbers ``geometry`` (numbers or symbols) named ``geometry_names``. Hashable: an NLP is built once per
-    formula."""
+    """A mechanism's closed form for the numbers ``geometry`` (numbers or symbols) named ``geometry_names``.
+
+    ``evaluate(theta, geometry, order)`` gives, at crank angles ``theta`` [rad from TDC] (numpy arrays or
+    CasADi symbols), the slide's height above BDC as a jet of the given order (``press.jets``: the height
+    and its derivatives with respect to the crank angle) and the frames: each link's two joints (points of
+    jets) and length [mm] by the link's name, the links named ``link_names`` (the drive's link masses); one
+    evaluation of the closed form for both. ``jets(theta, geometry)``: the height's first four
+    coefficients (a mechanism may give them in a shorter closed form). ``lifted``: the NLPs take the
+    derivatives of this mechanism's quantities from its series rather than differentiating its closed form
+    for every direction (``planning.solver.lifting``): worth it for a long closed form (a linkage's), not
+    for a few operations (the crank-slider's: building the lifted derivatives costs more than its solves
+    save). Hashable: an NLP is built once per formula.
+    """
 
     name: str
     geometry_names: tuple[str, ...]
+    evaluate: Callable[..., tuple[Any, dict[str, tuple[Any, Any, Any]]]]
     jets: Callable[[Any, Sequence[Any]], Jets]
+    link_names: tuple[str, ...]
+    lifted: bool = False
+
+    def series(self, theta: Any, geometry: Sequence[Any], order: int = ORDER) -> Any:
+        """The slide's height above BDC as a jet of ``order``."""
+        return self.evaluate(theta, geometry, order)[0]
+
+    def frames(self, theta: Any, geometry: Sequence[Any], order: int = ORDER) -> dict[str, tuple[Any, Any, Any]]:
+        """Each link's two joints (points of jets of ``order``) and length [mm]."""
+        return self.evaluate(theta, geometry, order)[1]
 
 
 class Mechanism(ABC):
@@ -58,6 +82,7 @@ class Mechanism(ABC):
     """
 
     kind: ClassVar[str]
+    own_angle_origin: ClassVar[str] = "TDC"  # where the mechanism's own crank angle counts from (reports)
 
     # ---- the closed form ----
     @property
@@ -74,6 +99,17 @@ class Mechanism(ABC):
         """``(h [mm], dh/dtheta [mm/rad], d2h/dtheta2 [mm/rad^2], d3h/dtheta3 [mm/rad^3])`` at crank angles
         ``theta`` [rad from TDC]."""
         return self.formula.jets(theta, self.geometry)
+
+    def frames(self, theta: Any) -> dict[str, tuple[Any, Any, Any]]:
+        """Each link's two joints (jets to the third derivative) and length [mm] at ``theta``
+        (:attr:`Formula.frames`)."""
+        return self.formula.frames(theta, self.geometry)
+
+    @property
+    def tdc_own_angle(self) -> float:
+        """TDC's crank angle [rad] counted the mechanism's own way (:attr:`own_angle_origin`, in the
+        direction of rotation): what its maker's drawings and other programs call it."""
+        return 0.0
 
     # ---- derived from it ----
     def height(self, theta: Any) -> Any:
@@ -126,13 +162,36 @@ class Mechanism(ABC):
 
     def angles_at_height(self, h: Any) -> tuple[Any, Any]:
         """Crank angles [rad] where the slide is at height ``h`` [mm above BDC]: ``(descending, ascending)``,
-        the first in ``[0, BDC]``, the second in ``[BDC, 2 pi]`` (generic: bisection on each monotone
-        branch, to round-off). Raises ``ValueError`` outside the stroke."""
-        target = self._within_stroke(h)
-        bdc = self.bdc_angle
-        down = self._bisect(target, 0.0, bdc, falling=True)
-        up = self._bisect(target, bdc, TWO_PI, falling=False)
-        return _shaped(down, h), _shaped(up, h)
+        the first time it reaches ``h`` going down from TDC and the last time it leaves it going up before
+        TDC (a slide that wobbles in a dwell near BDC passes some heights more than once). Generic: the
+        bracketing interval on a grid of :data:`CURVATURE_GRID` angles, then Newton's method kept inside it
+        (bisection where a step would leave it), to round-off; a height asked before is remembered. Raises
+        ``ValueError`` outside the stroke."""
+        if np.ndim(h) == 0 and float(h) in self._angles_memo:
+            return self._angles_memo[float(h)]
+        target = self._within_stroke(h).ravel()
+        grid, heights = self._height_grid
+        level = np.maximum(target, heights.min())[:, None]  # the grid's lowest point is BDC, up to round-off
+        first = np.argmax(heights[None, 1:] <= level, axis=1)  # the first interval ending at or below
+        at_or_below = heights[None, :-1] <= level
+        last = at_or_below.shape[1] - 1 - np.argmax(at_or_below[:, ::-1], axis=1)  # the last starting so
+        down = self._root(target, grid[first], grid[first + 1])
+        up = self._root(target, grid[last], grid[last + 1])
+        out = _shaped(down, h), _shaped(up, h)
+        if np.ndim(h) == 0:
+            self._angles_memo[float(h)] = out
+        return out
+
+    @cached_property
+    def _angles_memo(self) -> dict[float, tuple[float, float]]:
+        return {}
+
+    @cached_property
+    def _height_grid(self) -> tuple[np.ndarray, np.ndarray]:
+        """Crank angles over the turn, BDC among them, and the slide's heights there."""
+        grid = np.unique(np.concatenate([np.linspace(0.0, TWO_PI, CURVATURE_GRID + 1), [self.bdc_angle]]))
+        heights = np.asarray(self.height(grid), dtype=float)
+        return grid, heights
 
     # ---- helpers ----
     def _within_stroke(self, h: Any) -> np.ndarray:
@@ -141,20 +200,33 @@ class Mechanism(ABC):
             raise ValueError(f"height {h} mm is outside the stroke 0 ... {self.stroke:g} mm")
         return np.clip(target, 0.0, self.stroke)
 
-    def _bisect(self, target: np.ndarray, lo: float, hi: float, falling: bool) -> np.ndarray:
-        a = np.full(target.shape, lo)
-        b = np.full(target.shape, hi)
-        for _ in range(80):  # 2 pi / 2^80: far below round-off
-            mid = 0.5 * (a + b)
-            above = self.height(mid) > target
-            go_right = above if falling else ~above
-            a, b = np.where(go_right, mid, a), np.where(go_right, b, mid)
-        return 0.5 * (a + b)
+    def _root(self, target: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        """The crank angle in each bracket ``[lo, hi]`` where the height is ``target`` (the height crosses it
+        there): Newton's method on the height's jets, a step that would leave the bracket replaced by
+        bisection, the bracket narrowed at every step; until the steps fall below round-off."""
+        lo, hi = np.array(lo, dtype=float), np.array(hi, dtype=float)
+        rising = self.height(hi) > self.height(lo)
+        x = 0.5 * (lo + hi)
+        for _ in range(ROOT_ITERATIONS):
+            h, d1, _, _ = self.jets(x)
+            f = h - target
+            above = f > 0
+            right_side = above == rising  # the root lies left of x
+            hi, lo = np.where(right_side, x, hi), np.where(right_side, lo, x)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                newton = x - f / d1
+            inside = np.isfinite(newton) & (newton > lo) & (newton < hi)
+            step = np.where(inside, newton, 0.5 * (lo + hi))
+            done = np.abs(step - x) <= ROOT_TOL
+            x = step
+            if np.all(done):
+                break
+        return x
 
 
 def _shaped(values: np.ndarray, like: Any) -> Any:
-    """``values`` as a float when ``like`` is a scalar."""
-    return float(values) if np.ndim(like) == 0 else values
+    """``values`` as a float when ``like`` is a scalar, else in its shape."""
+    return float(values[0]) if np.ndim(like) == 0 else values.reshape(np.shape(like))
 
 
 def slider_motion(h: Any, d1: Any, d2: Any, d3: Any, omega: Any, alpha: Any, jerk: Any) -> tuple[Any, Any, Any, Any]:

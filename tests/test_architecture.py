@@ -165,6 +165,7 @@ def test_bdc_is_where_the_mechanism_says():
 
 CASADI_MODULES = {  # the wrapper and the modules that build expressions for it
     "planning.solver.ipopt",
+    "planning.solver.lifting",
     "planning.solver.nlp",
     "planning.solver.halves_nlp",
     "planning.solver.free_nlp",

@@ -40,7 +40,9 @@ from planning.model.units import (
     Torque,
 )
 from press.crank_slider import CrankSlider
-from press.dynamics import DriveModel
+from press.dynamics import DriveModel, LinkMass
+from press.linkage import KnuckleJoint, LinkageError, LinkDrive
+from press.mechanism import Mechanism
 
 Placement = Literal["free", "published"]  # where theta1 / theta4 may fall (the paper's Fig. 6, or anywhere)
 Objective = Literal["max-spm", "min-rms-torque", "min-energy"]  # what the planner optimises
@@ -52,13 +54,54 @@ class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False, frozen=True)
 
 
-class PressModel(_Model):
-    """The machine: a crank-slider of ``crank_radius_mm`` [mm] and ``rod_length_mm`` [mm], its slide's line
-    ``offset_mm`` [mm] to the side of the crank axis (0: in line; ``press.crank_slider``)."""
+MechanismKind = Literal["crank-slider", "link-drive", "knuckle-joint"]
+Coordinate = Annotated[float, Field(ge=-20_000, le=20_000)]  # [mm] a position either side of the crank axis
 
-    crank_radius_mm: Length
-    rod_length_mm: Length
+
+class LinkDriveModel(_Model):
+    """``press.link_drive``: the six-bar link drive (``press.linkage.LinkDrive``; the letters of
+    ``mechpress.ld.LD``): crank (eccentric) radius a, the ternary link's side b to the rocker and side m to the
+    connecting rod with the angle tht between them, the rocker c pivoting at (-d, -f) from the crank centre,
+    the connecting rod g to the slide, the slide's line h to the side; [mm], [deg]."""
+
+    crank_radius_mm: Length  # a
+    ternary_rocker_side_mm: Length  # b
+    rocker_mm: Length  # c
+    rocker_pivot_x_mm: Coordinate  # d
+    rocker_pivot_y_mm: Coordinate  # f
+    ternary_angle_deg: Annotated[float, Field(gt=-360, lt=360)]  # tht
+    ternary_rod_side_mm: Length  # m
+    rod_length_mm: Length  # g
+    slide_offset_mm: Coordinate = 0.0  # h
+
+
+class KnuckleJointModel(_Model):
+    """``press.knuckle_joint``: the knuckle joint (``press.linkage.KnuckleJoint``; the letters of presslink's
+    ``ModularKnuckleJoint``): crank radius a, the rod b from the crank pin to the knuckle, the upper link
+    (rocker) c pivoting at (d, e) from the crank centre, the main rod g from the knuckle to the slide, the
+    slide's line h to the side of the rocker's pivot; [mm]."""
+
+    crank_radius_mm: Length  # a
+    rod_length_mm: Length  # b
+    rocker_mm: Length  # c
+    rocker_pivot_x_mm: Coordinate  # d
+    rocker_pivot_y_mm: Coordinate  # e
+    main_rod_mm: Length  # g
+    slide_offset_mm: Coordinate = 0.0  # h
+
+
+class PressModel(_Model):
+    """The machine: ``mechanism`` (crank-slider by default). A crank-slider of ``crank_radius_mm`` [mm] and
+    ``rod_length_mm`` [mm], its slide's line ``offset_mm`` [mm] to the side of the crank axis (0: in line;
+    ``press.crank_slider``); a link drive's dimensions in ``link_drive``, a knuckle joint's in
+    ``knuckle_joint`` (``press.linkage``)."""
+
+    mechanism: MechanismKind = "crank-slider"
+    crank_radius_mm: Length | None = None
+    rod_length_mm: Length | None = None
     offset_mm: Offset = 0.0
+    link_drive: LinkDriveModel | None = None
+    knuckle_joint: KnuckleJointModel | None = None
 
 
 class KeyPointsModel(_Model):
@@ -104,12 +147,26 @@ class MotorModel(_Model):
     max_speed_rpm: MotorSpeed
 
 
+class LinkMassModel(_Model):
+    """A link's mass ``mass_kg`` [kg] at its centre of gravity, ``cg_along_mm`` [mm] from the link's first
+    joint toward its second and ``cg_across_mm`` [mm] to the left of that line, and its ``inertia_kg_m2``
+    [kg m^2] about the centre of gravity (``press.dynamics.LinkMass``; the links and their joints: README)."""
+
+    mass_kg: Mass
+    cg_along_mm: Coordinate = 0.0
+    cg_across_mm: Coordinate = 0.0
+    inertia_kg_m2: Inertia = 0.0
+
+
 class DriveSection(_Model):
-    """The drive (masses, gear, motor); see ``press.dynamics`` for the model and its signs."""
+    """The drive (masses, gear, motor); see ``press.dynamics`` for the model and its signs. A crank-slider's
+    rod as two point masses (``rod_mass_kg``, ``rod_cg_from_crank_pin_mm``) or as a rigid link (``links``);
+    a linkage's links in ``links`` (massless where not given)."""
 
     slide_mass_kg: Mass  # slide + upper die
-    rod_mass_kg: Mass
-    rod_cg_from_crank_pin_mm: Annotated[float, Field(ge=0, le=100_000)]
+    rod_mass_kg: Mass | None = None
+    rod_cg_from_crank_pin_mm: Annotated[float, Field(ge=0, le=100_000)] | None = None
+    links: dict[str, LinkMassModel] | None = None
     crank_inertia_kg_m2: Inertia  # crankshaft, eccentric, bull gears, about the crank axis
     counterbalance_kN: ForceKN  # constant, upward
     gear_ratio: Annotated[float, Field(ge=1e-3, le=1e4)]  # motor turns per crank turn
@@ -190,9 +247,10 @@ class Case(_Model):
 
     # ---- derived quantities in inside units ----
     @property
-    def machine(self) -> CrankSlider:
-        """The press mechanism of the case (``press.mechanism``): the crank-slider, in line or offset."""
-        return _machine(self.press.crank_radius_mm, self.press.rod_length_mm, self.press.offset_mm)
+    def machine(self) -> Mechanism:
+        """The press mechanism of the case (``press.mechanism``): the crank-slider (in line or offset), the
+        link drive or the knuckle joint."""
+        return _machine(self.press)
 
     @property
     def key_angles(self) -> np.ndarray:
@@ -206,11 +264,17 @@ class Case(_Model):
         d = self.drive
         if d is None:
             return None
+        machine = self.machine
+        lumped = (0.0, 0.0)
+        if d.rod_mass_kg is not None:  # a crank-slider's rod as two point masses
+            lumped = machine.rod_split(d.rod_mass_kg, d.rod_cg_from_crank_pin_mm)
+        links = tuple(
+            LinkMass(name, link.mass_kg, link.cg_along_mm, link.cg_across_mm, link.inertia_kg_m2)
+            for name, link in (d.links or {}).items()
+        )
         return DriveModel.from_parts(
-            self.machine,
+            machine,
             d.slide_mass_kg,
-            d.rod_mass_kg,
-            d.rod_cg_from_crank_pin_mm,
             d.crank_inertia_kg_m2,
             d.counterbalance_kN,
             d.gear_ratio,
@@ -218,6 +282,8 @@ class Case(_Model):
             d.motor_inertia_kg_m2,
             self.process.forming_force_kN,
             math.radians(self.key_points.draw_start_deg),
+            lumped,
+            links,
         )
 
     def with_objective(self, objective: str | None, target_spm: float | None = None) -> Case:
@@ -251,11 +317,7 @@ def cross_checks(case: Case) -> None:
     """Checks that need several fields; raises :class:`CaseError` naming the first bad field: the geometry
     and the key points' order, each limit's own (``Limit.validate``), the law, the drive, the objective,
     and a given draw speed against the limits that refuse it (``Limit.refuse_draw_speed``)."""
-    R, L, e = case.press.crank_radius_mm, case.press.rod_length_mm, case.press.offset_mm
-    if not L > R:
-        raise CaseError("press.rod_length_mm", f"must be longer than the crank radius {R:g} mm", L)
-    if not abs(e) < L - R:
-        raise CaseError("press.offset_mm", f"must be less than rod length - crank radius = {L - R:g} mm", e)
+    _press_checks(case.press)
     angles = [getattr(case.key_points, f) for f in KEY_POINT_FIELDS]
     for i in range(1, 4):
         if not angles[i] > angles[i - 1]:
@@ -291,6 +353,49 @@ def cross_checks(case: Case) -> None:
                 raise CaseError("process.draw_speed_rpm", problem, case.process.draw_speed_rpm)
 
 
+LINKAGES = {"link-drive": ("link_drive", LinkDrive), "knuckle-joint": ("knuckle_joint", KnuckleJoint)}
+
+
+def _press_checks(press: PressModel) -> None:
+    """The mechanism's own section and no other; its dimensions make a press (it assembles at every crank
+    angle, the slide goes down once and up once)."""
+    kind = press.mechanism
+    given = {key: getattr(press, key) for key in ("crank_radius_mm", "rod_length_mm", "link_drive", "knuckle_joint")}
+    given["offset_mm"] = press.offset_mm or None
+    wanted = ("crank_radius_mm", "rod_length_mm", "offset_mm") if kind == "crank-slider" else (LINKAGES[kind][0],)
+    for key in wanted[:2] if kind == "crank-slider" else wanted:
+        if given[key] is None:
+            raise CaseError(f"press.{key}", f"is required for a {kind} press", None, False)
+    for key, value in given.items():
+        if value is not None and key not in wanted:
+            raise CaseError(f"press.{key}", f"belongs to another mechanism than press.mechanism = {kind}", "given")
+    if kind == "crank-slider":
+        R, L, e = press.crank_radius_mm, press.rod_length_mm, press.offset_mm
+        if not L > R:
+            raise CaseError("press.rod_length_mm", f"must be longer than the crank radius {R:g} mm", L)
+        if not abs(e) < L - R:
+            raise CaseError("press.offset_mm", f"must be less than rod length - crank radius = {L - R:g} mm", e)
+        return
+    section, _ = LINKAGES[kind]
+    try:
+        _machine(press)
+    except LinkageError as error:
+        keys = [_linkage_key(section, name) for name in error.names]
+        others = f" ({', '.join(k.split('.')[-1] for k in keys[1:])} with it)" if len(keys) > 1 else ""
+        field = keys[0] if keys else f"press.{section}"
+        raise CaseError(field, f"{error}{others}", _field_value(press, field)) from None
+
+
+def _linkage_key(section: str, name: str) -> str:
+    """The case's key of a linkage's dimension ``name`` (``press.linkage``): its unit appended."""
+    return f"press.{section}.{name}_deg" if name.endswith("_angle") else f"press.{section}.{name}_mm"
+
+
+def _field_value(press: PressModel, field: str) -> Any:
+    section, key = field.split(".")[1:3]
+    return getattr(getattr(press, section), key)
+
+
 def _drive_checks(case: Case) -> None:
     """The forming-force table and the drive section against the press and each other."""
     table = case.process.forming_force_kN
@@ -309,7 +414,8 @@ def _drive_checks(case: Case) -> None:
     d = case.drive
     if d is None:
         return
-    if d.rod_cg_from_crank_pin_mm > case.press.rod_length_mm:
+    _drive_mass_checks(case)
+    if d.rod_mass_kg is not None and d.rod_cg_from_crank_pin_mm > case.press.rod_length_mm:
         raise CaseError(
             "drive.rod_cg_from_crank_pin_mm",
             f"must lie on the rod (at most press.rod_length_mm = {case.press.rod_length_mm:g})",
@@ -327,6 +433,32 @@ def _drive_checks(case: Case) -> None:
             f"must not exceed drive.motor.max_speed_rpm = {d.motor.max_speed_rpm:g}",
             d.motor.base_speed_rpm,
         )
+
+
+def _drive_mass_checks(case: Case) -> None:
+    """A crank-slider's rod as two point masses or as a link, a linkage's links by their names."""
+    d, kind = case.drive, case.press.mechanism
+    split = (d.rod_mass_kg, d.rod_cg_from_crank_pin_mm)
+    if kind == "crank-slider":
+        if d.links is None:
+            for key, value in zip(("rod_mass_kg", "rod_cg_from_crank_pin_mm"), split, strict=True):
+                if value is None:
+                    raise CaseError(
+                        f"drive.{key}", "is required for a crank-slider (or the rod in drive.links)", None, False
+                    )
+        elif d.rod_mass_kg is not None:
+            raise CaseError("drive.rod_mass_kg", "the rod is given in drive.links already", d.rod_mass_kg)
+    else:
+        for key, value in zip(("rod_mass_kg", "rod_cg_from_crank_pin_mm"), split, strict=True):
+            if value is not None:
+                raise CaseError(f"drive.{key}", f"a {kind} press gives its links' masses in drive.links", value)
+    if (d.rod_mass_kg is None) != (d.rod_cg_from_crank_pin_mm is None):
+        missing = "rod_cg_from_crank_pin_mm" if d.rod_cg_from_crank_pin_mm is None else "rod_mass_kg"
+        raise CaseError(f"drive.{missing}", "goes with the other rod key", None, False)
+    names = case.machine.formula.link_names
+    for name in d.links or {}:
+        if name not in names:
+            raise CaseError(f"drive.links.{name}", f"a {kind} press's links are {', '.join(names)}", name)
 
 
 def _law_checks(case: Case) -> None:
@@ -358,9 +490,19 @@ def _objective_checks(case: Case) -> None:
 
 
 @cache
-def _machine(crank_radius_mm: float, rod_length_mm: float, offset_mm: float) -> CrankSlider:
-    """One mechanism object per geometry (its derived figures are computed once)."""
-    return CrankSlider(crank_radius_mm, rod_length_mm, offset_mm)
+def _machine(press: PressModel) -> Mechanism:
+    """One mechanism object per geometry (its derived figures are computed once); raises
+    ``press.linkage.LinkageError`` for a linkage that cannot be a press (:func:`_press_checks` names the
+    field)."""
+    if press.mechanism == "crank-slider":
+        return CrankSlider(press.crank_radius_mm, press.rod_length_mm, press.offset_mm)
+    section, kind = LINKAGES[press.mechanism]
+    values = getattr(press, section).model_dump()
+    dimensions = {
+        key.removesuffix("_mm").removesuffix("_deg"): math.radians(v) if key.endswith("_deg") else v
+        for key, v in values.items()
+    }
+    return kind(**dimensions)
 
 
 _SLUG = re.compile(r"[^A-Za-z0-9._-]+")

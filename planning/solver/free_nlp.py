@@ -43,7 +43,7 @@ from planning.solver.nlp import (
     nlp_limits,
     sample_states,
 )
-from planning.solver.parameters import DRAW_SAMPLES_DRIVE, ParameterLayout, time_limit
+from planning.solver.parameters import DRAW_SAMPLES_DRIVE, ParameterLayout, drive_links, time_limit
 from press.mechanism import Formula
 
 # the limits are held at every knot and at evenly spaced points inside each segment, this many per
@@ -135,11 +135,11 @@ def make_plan(case: Case, values: dict[str, float], placement: str, info: Solver
     return replace(plan, structure=structure, nlp_values=dict(values))
 
 
-def _build(formula: Formula, limit_ids: tuple[str, ...], drive: bool) -> CycleNLP:
+def _build(formula: Formula, limit_ids: tuple[str, ...], drive: bool, links: tuple[str, ...] = ()) -> CycleNLP:
     # MX with vector operations (every segment of a phase at once): CasADi derives the Jacobian and the
     # Hessian of this graph in a fraction of the time a scalar SX graph of the same problem takes, and
     # evaluates them about as fast
-    layout = ParameterLayout(formula, limit_ids, drive, False)
+    layout = ParameterLayout(formula, limit_ids, drive, False, links if drive else ())
     x = ca.MX.sym("x", len(VARIABLES))
     p_case = ca.MX.sym("p", layout.size)
     p_scale = ca.MX.sym("scale", len(VARIABLES))
@@ -207,7 +207,7 @@ def _build(formula: Formula, limit_ids: tuple[str, ...], drive: bool) -> CycleNL
         th_d, om_d, al_d, since = draw_states(q, w2, ca.DM(np.linspace(0.0, 1.0, count)))
         states = (ca.vertcat(th, th_d), ca.vertcat(om, om_d), ca.vertcat(al, al_d))
         t_all = ca.vertcat(t_all, t0 + since)
-    samples, _ = sample_states(formula, layout, q, p_case, states, t_all, count)
+    samples, _, lift = sample_states(formula, layout, q, p_case, states, t_all, count)
     nlp = Transcription(
         **samples,
         period=t0 + draw_time,
@@ -225,7 +225,8 @@ def _build(formula: Formula, limit_ids: tuple[str, ...], drive: bool) -> CycleNL
 
     problem = {"x": x, "p": ca.vertcat(p_case, p_scale), "f": nlp.period, "g": ca.vertcat(*rows.g)}
     options = {**CYCLE_OPTIONS, **DRIVE_OPTIONS}  # MUMPS's AMD ordering: the same iterations, 5-10 % faster here
-    program = NLPSolver("press_cycle_optimal" + ("_drive" if drive else ""), problem, options, None, WARM_OPTIONS)
+    name = "press_cycle_optimal" + ("_drive" if drive else "")
+    program = NLPSolver(name, problem, options, None, WARM_OPTIONS, lift)
     return CycleNLP(
         program,
         *rows.bounds(),
@@ -245,13 +246,16 @@ def _interleave(columns: list) -> ca.MX:
 
 
 @cache
-def free_nlp(formula: Formula, limit_ids: tuple[str, ...], drive: bool = False) -> CycleNLP:
-    """The compiled NLP of the optimal law for a mechanism's ``formula`` and the limits ``limit_ids`` (built on
-    first use in a process, then reused)."""
-    return _build(formula, limit_ids, drive)
+def free_nlp(
+    formula: Formula, limit_ids: tuple[str, ...], drive: bool = False, links: tuple[str, ...] = ()
+) -> CycleNLP:
+    """The compiled NLP of the optimal law for a mechanism's ``formula`` and the limits ``limit_ids``, with
+    the motor's torque when ``drive`` (the mechanism's massive ``links`` in it); built on first use in a
+    process, then reused."""
+    return _build(formula, limit_ids, drive, links)
 
 
 def free_nlp_for(case: Case) -> CycleNLP:
     """The optimal law's NLP of ``case``'s mechanism and limits, with the motor's rows when it has a drive."""
     drive = case.drive is not None
-    return free_nlp(case.machine.formula, nlp_limits(case, drive), drive)
+    return free_nlp(case.machine.formula, nlp_limits(case, drive), drive, drive_links(case) if drive else ())

@@ -65,7 +65,7 @@ from planning.solver.nlp import (
     objective_terms,
     sample_states,
 )
-from planning.solver.parameters import DRAW_SAMPLES_DRIVE, ParameterLayout, time_limit
+from planning.solver.parameters import DRAW_SAMPLES_DRIVE, ParameterLayout, drive_links, time_limit
 from press.mechanism import Formula
 
 # Decision variables and the kind of scale each is measured in (see :func:`variable_scales`)
@@ -164,12 +164,18 @@ def _angle_at(t: ca.SX, starts: list, states: list, segs: list[Segment]) -> tupl
 
 
 def _build(
-    law_name: str, formula: Formula, limit_ids: tuple[str, ...], drive: bool, rate: bool, zone: bool
+    law_name: str,
+    formula: Formula,
+    limit_ids: tuple[str, ...],
+    drive: bool,
+    rate: bool,
+    zone: bool,
+    links: tuple[str, ...] = (),
 ) -> CycleNLP:
     law = get_law(law_name)
     drive = drive or rate
     zone = zone or rate
-    layout = ParameterLayout(formula, limit_ids, drive, rate)
+    layout = ParameterLayout(formula, limit_ids, drive, rate, links if drive else ())
     x = ca.SX.sym("x", len(VARIABLES))
     p_case = ca.SX.sym("p", layout.size)
     p_scale = ca.SX.sym("scale", len(VARIABLES))  # physical value = scale * x, chosen per case
@@ -252,7 +258,7 @@ def _build(
         al_s.append(al)
     states = (ca.vertcat(*th_s), ca.vertcat(*om_s), ca.vertcat(*al_s))
     times = ca.vertcat(*t_s)
-    samples, torque = sample_states(formula, layout, q, p_case, states, times, draw_count)
+    samples, torque, lift = sample_states(formula, layout, q, p_case, states, times, draw_count)
     nlp = Transcription(
         **samples,
         period=params.period,
@@ -276,7 +282,7 @@ def _build(
     problem = {"x": x, "p": ca.vertcat(p_case, p_scale), "f": objective, "g": ca.vertcat(*rows.g)}
     kind = ("_rate" if rate else "_drive" if drive else "") + ("_zone" if zone and not rate else "")
     options = {**CYCLE_OPTIONS, **(DRIVE_OPTIONS if drive else {}), **(RATE_OPTIONS if rate else {})}
-    program = NLPSolver("press_cycle_" + law_name.replace("-", "_") + kind, problem, options)
+    program = NLPSolver("press_cycle_" + law_name.replace("-", "_") + kind, problem, options, lift=lift)
     return CycleNLP(
         program,
         *rows.bounds(),
@@ -288,7 +294,7 @@ def _build(
         make_plan,
         published_rows,
         refinable,
-        None if zone else partial(halves_nlp, law_name, formula, limit_ids, drive, rate, True),
+        None if zone else partial(halves_nlp, law_name, formula, limit_ids, drive, rate, True, links),
     )
 
 
@@ -300,24 +306,29 @@ def halves_nlp(
     drive: bool = False,
     rate: bool = False,
     zone: bool = False,
+    links: tuple[str, ...] = (),
 ) -> CycleNLP:
     """The compiled NLP of motion law ``law`` on a mechanism of closed form ``formula`` holding the limits
-    ``limit_ids``, with the motor's torque when ``drive``; ``rate``: the drive NLP of a target rate (see the
-    module docstring); ``zone``: the limits that hold in the die zone held at every sample there (the rate
-    NLP's always; otherwise the denser variant a search turns to when a plan's crank speed peaks inside
-    the die zone, between the crossings). Built on first use in a process, then reused for every case and
-    start."""
-    return _build(law, formula, limit_ids, drive, rate, zone)
+    ``limit_ids``, with the motor's torque when ``drive`` (the mechanism's massive ``links`` in it);
+    ``rate``: the drive NLP of a target rate (see the module docstring); ``zone``: the limits that hold in
+    the die zone held at every sample there (the rate NLP's always; otherwise the denser variant a search
+    turns to when a plan's crank speed peaks inside the die zone, between the crossings). Built on first
+    use in a process, then reused for every case and start."""
+    return _build(law, formula, limit_ids, drive, rate, zone, links)
 
 
 def halves_nlp_for(case: Case, drive: bool | None = None, rate: bool = False) -> CycleNLP:
     """The NLP of ``case``'s law, mechanism and limits; ``drive`` None: with the motor's rows when the case
     has a drive."""
     drive = case.drive is not None if drive is None else drive
-    return halves_nlp(case.planner.motion_law, case.machine.formula, nlp_limits(case, drive or rate), drive, rate)
+    limit_ids = nlp_limits(case, drive or rate)
+    links = drive_links(case) if drive or rate else ()
+    return halves_nlp(case.planner.motion_law, case.machine.formula, limit_ids, drive, rate, False, links)
 
 
 def fresh_build(case: Case) -> CycleNLP:
     """The NLP :func:`halves_nlp_for` gives ``case``, built anew (not from the cache): what a build costs."""
     drive = case.drive is not None
-    return _build(case.planner.motion_law, case.machine.formula, nlp_limits(case, drive), drive, False, False)
+    limit_ids = nlp_limits(case, drive)
+    links = drive_links(case) if drive else ()
+    return _build(case.planner.motion_law, case.machine.formula, limit_ids, drive, False, False, links)

@@ -5,7 +5,9 @@ is compiled once into an :class:`NLPSolver` and solved through :meth:`NLPSolver.
 an :class:`NLPResult` with a typed status, the values in physical units, the constraint values, the
 multipliers, the iteration count and the wall time. This module and the modules that build CasADi
 expressions for it (``planning.solver.nlp``, ``planning.solver.halves_nlp``, ``planning.solver.free_nlp``,
-``planning.solver.bound``) are the only ones that import CasADi (``tests/test_architecture.py`` checks).
+``planning.solver.bound``, ``planning.solver.lifting``) are the only ones that import CasADi
+(``tests/test_architecture.py`` checks). A problem that samples a lifted mechanism comes with its
+:class:`~planning.solver.lifting.Lift`: its derivative functions are put together by the chain rule.
 
 Scaling: a problem may read a per-solve scale vector from the end of its parameter vector
 (physical value = scale * decision variable). :meth:`NLPSolver.solve` then takes the physical start
@@ -26,6 +28,8 @@ from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
+
+from planning.solver.lifting import Lift, lifted_problem
 
 MAX_SOLVE_WALL_S = 30.0  # [s] one IPOPT call at most (a normal one takes well under a second)
 BASE_OPTIONS = {
@@ -112,11 +116,15 @@ class NLPSolver:
         options: dict | None = None,
         fixed_scale: np.ndarray | None = None,
         warm_options: dict | None = None,
+        lift: Lift | None = None,
     ):
         self.fixed_scale = None if fixed_scale is None else np.asarray(fixed_scale, dtype=float)
         self.name = name
-        self.problem = problem
         self.options = {**BASE_OPTIONS, **(options or {})}
+        if lift is not None:  # the mechanism's quantities lifted out of the derivatives (``lifting``)
+            problem, derivatives = lifted_problem(problem, lift)
+            self.options.update(derivatives)
+        self.problem = problem
         self.warm_options = {**WARM_START_OPTIONS, **(warm_options or {})}
         self._cold = _compiled(name, problem, self.options)
         self._warm: ca.Function | None = None

@@ -27,8 +27,9 @@ from planning.model.limits.base import Transcription, trapezoid
 from planning.model.plan import Plan
 from planning.model.profile import advance
 from planning.solver.ipopt import NLPResult, NLPSolver
-from planning.solver.parameters import FORMING_SAMPLES, ParameterLayout
-from press.dynamics import DriveModel, crank_torque, motor_speed, motor_torque
+from planning.solver.lifting import SERIES_ORDER, Lift
+from planning.solver.parameters import FORMING_SAMPLES, LINK, ParameterLayout, link_parameter
+from press.dynamics import DriveModel, LinkMass, crank_torque, link_jets, link_terms, motor_speed, motor_torque
 from press.mechanism import Formula
 
 CYCLE_OPTIONS = {  # added to the wrapper's base options
@@ -210,29 +211,68 @@ class DriveSamples:
     speed: Any
 
 
-def drive_samples(q: dict, p_case: Any, layout: ParameterLayout, om: Any, al: Any, d1: Any, d2: Any) -> DriveSamples:
+def drive_samples(
+    q: dict,
+    p_case: Any,
+    layout: ParameterLayout,
+    theta: Any,
+    lift: Lift | None,
+    frames: dict | None,
+    om: Any,
+    al: Any,
+    d1: Any,
+    d2: Any,
+) -> DriveSamples:
     """The drive's torque at the samples; the forming force enters at the draw's samples, the last
-    :data:`~planning.solver.parameters.FORMING_SAMPLES`."""
+    :data:`~planning.solver.parameters.FORMING_SAMPLES`; the mechanism's massive links (``layout.links``) at
+    every sample through its ``frames`` (the lifted mechanism's, at its series' order; else computed here).
+    """
     forming = ca.vertcat(ca.DM.zeros(om.shape[0] - FORMING_SAMPLES), p_case[layout.forming])
     # the forming force enters as parameters at the draw's samples: no table, no forming window here
+    links = tuple(LinkMass(name, *(q[link_parameter(name, part)] for part in LINK)) for name in layout.links)
     model = DriveModel(
-        q["drive_M"], q["drive_J0"], q["drive_F_cb"], q["drive_i"], q["drive_eta"], q["drive_J_m"], (), (), 0.0, 0.0
+        q["drive_M"],
+        q["drive_J0"],
+        q["drive_F_cb"],
+        q["drive_i"],
+        q["drive_eta"],
+        q["drive_J_m"],
+        (),
+        (),
+        0.0,
+        0.0,
+        links,
     )
-    tc = crank_torque(om, al, d1, d2, forming, model)
+    terms = None
+    if links and lift is not None:  # the links' inertia and weight, lifted (``planning.solver.lifting``)
+        J, weight = link_jets(frames, links)
+        terms = (lift.quantity(J), lift.quantity(J.derivative()), lift.quantity(weight))
+    elif links:
+        terms = link_terms(layout.formula.frames(theta, layout.geometry(q)), links)
+    tc = crank_torque(om, al, d1, d2, forming, model, terms)
     tm = motor_torque(tc, al, model)
     return DriveSamples(model, tc, tm, motor_speed(om, model))
 
 
 def sample_states(
     formula: Formula, layout: ParameterLayout, q: dict, p_case: Any, states: tuple, times: Any, draw_count: int
-) -> tuple[dict[str, Any], DriveSamples | None]:
+) -> tuple[dict[str, Any], DriveSamples | None, Lift | None]:
     """What every transcription hands the limits of its samples (the crank's ``states`` ``(theta, omega,
     alpha)`` and their ``times``, the draw's ``draw_count`` last): with the mechanism's height and its first
     two derivatives there, the case's parameters, and in a drive NLP the motor's torque and speed; the
-    :class:`~planning.model.limits.base.Transcription` fields, and the drive's samples (None without)."""
+    :class:`~planning.model.limits.base.Transcription` fields, the drive's samples (None without) and, for a
+    mechanism whose NLPs lift it (``Formula.lifted``), its quantities as the derivative functions take
+    them (``planning.solver.lifting``: the rows read them as symbols), else None."""
     theta, omega, alpha = states
-    h, d1, d2, _ = formula.jets(theta, layout.geometry(q))
-    torque = drive_samples(q, p_case, layout, omega, alpha, d1, d2) if layout.drive else None
+    geometry = layout.geometry(q)
+    lift = Lift.at(theta) if formula.lifted else None
+    if lift is not None:
+        series, frames = formula.evaluate(lift.angles, geometry, SERIES_ORDER)
+        h, d1, d2 = (lift.quantity(j) for j in (series, series.derivative(), series.derivative().derivative()))
+    else:
+        h, d1, d2, _ = formula.jets(theta, geometry)
+        frames = None  # computed where the drive's links need them
+    torque = drive_samples(q, p_case, layout, theta, lift, frames, omega, alpha, d1, d2) if layout.drive else None
     fields = {
         "theta": theta,
         "omega": omega,
@@ -247,7 +287,7 @@ def sample_states(
         "motor_torque": None if torque is None else torque.tm,
         "motor_speed": None if torque is None else torque.speed,
     }
-    return fields, torque
+    return fields, torque, lift
 
 
 def objective_terms(q: dict, drive: DriveSamples, al: Any, times: Any) -> tuple[Any, Any]:

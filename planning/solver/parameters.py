@@ -47,6 +47,9 @@ DRIVE = (
     "drive_J_m",  # motor-side inertia [kg m^2]
     "motor_base_speed",  # [rad/s] at the motor: the envelope's kink, the scale of the objectives' smoothing
 )
+# each massive link of a linkage (``press.dynamics.LinkMass``), after the drive's: its mass [kg], where its
+# centre of gravity lies [mm] and its inertia [kg m^2]
+LINK = ("mass", "along", "across", "inertia")
 # the objective of the rate NLP (``planning.solver.objectives``): f = weight_period * period + weight_heat *
 # heat + weight_energy * supply energy - weight_dwell * transfer dwell
 OBJECTIVE = (
@@ -65,12 +68,14 @@ POWER_SMOOTHING = 1e-3  # epsilon of the rate NLP's smooth max(P, 0), as a share
 @dataclass(frozen=True)
 class ParameterLayout:
     """The parameters of one NLP: the ``formula`` of its mechanism, the ``limit_ids`` it holds, with the
-    drive's torque (``drive``) and the objectives of a target rate (``rate``)."""
+    drive's torque (``drive``; the masses of the mechanism's ``links`` named, :func:`drive_links`) and the
+    objectives of a target rate (``rate``)."""
 
     formula: Formula
     limit_ids: tuple[str, ...]
     drive: bool = False
     rate: bool = False
+    links: tuple[str, ...] = ()
 
     @property
     def limits(self) -> tuple[Limit, ...]:
@@ -84,6 +89,7 @@ class ParameterLayout:
             names += [p for p in limit.parameters if p not in names]
         if self.drive:
             names += DRIVE
+            names += [link_parameter(link, part) for link in self.links for part in LINK]
         if self.rate:
             names += OBJECTIVE
         return tuple(names)
@@ -122,6 +128,7 @@ class ParameterLayout:
             values |= limit.parameter_values(case)
         if self.drive:
             values |= drive_values(case)
+            values |= link_values(case, self.links)
         if self.rate:
             values |= objective_values(case)
         out = np.array([values[name] for name in self.names], dtype=float)
@@ -163,6 +170,25 @@ def drive_values(case: Case) -> dict[str, float]:
         "drive_J_m": d.J_m,
         "motor_base_speed": case.drive.motor.base_speed_rpm * RPM,
     }
+
+
+def drive_links(case: Case) -> tuple[str, ...]:
+    """The names of the case's links that have mass or inertia, in the mechanism's order (an NLP holds the
+    link terms of these only; a crank-slider whose rod is split holds none)."""
+    model = case.drive_model
+    massive = {link.name for link in model.links} if model is not None else set()
+    return tuple(name for name in case.machine.formula.link_names if name in massive)
+
+
+def link_parameter(link: str, part: str) -> str:
+    """The parameter name of ``part`` (:data:`LINK`) of ``link``."""
+    return f"link_{link}_{part}"
+
+
+def link_values(case: Case, links: tuple[str, ...]) -> dict[str, float]:
+    """The parameters of ``links`` (:data:`LINK`) from the case's drive model."""
+    by_name = {link.name: link for link in case.drive_model.links}
+    return {link_parameter(name, part): float(getattr(by_name[name], part)) for name in links for part in LINK}
 
 
 def objective_values(case: Case) -> dict[str, float]:

@@ -22,7 +22,7 @@ from planning.model.limits.base import (
 )
 from planning.model.units import RPM
 from press.backend import math_module
-from press.dynamics import GRAVITY, drive_state, envelope_torque, forming_force
+from press.dynamics import GRAVITY, drive_state, envelope_torque, forming_force, link_terms
 
 DRIVE_BACKOFF = 5e-5  # the NLPs hold the motor's peak and RMS torque this much inside (refined if exceeded)
 RMS_PROOF_MARGIN = 1e-3  # relative: the trapezoidal draw integral of the RMS precheck is far more accurate
@@ -142,8 +142,8 @@ class MotorPeakTorqueLimit(Limit):
     def bound_rows(self, grid: BoundGrid) -> list[tuple[Any, Any, Any]]:
         """Motor torque at both ends of every interval, as the two linear forms whose larger is the motor
         torque: ``T_c / (i eta) + J_m i alpha`` and ``T_c eta / i + J_m i alpha``, with ``T_c`` linear in s and
-        alpha (``press.dynamics``). Both <= peak is exactly ``T_m <= peak``. The forming force is taken on
-        each interval's side of theta2 and BDC."""
+        alpha (``press.dynamics``, a linkage's links included). Both <= peak is exactly ``T_m <= peak``. The
+        forming force is taken on each interval's side of theta2 and BDC."""
         case = grid.case
         d = case.drive_model
         m = case.machine
@@ -154,7 +154,8 @@ class MotorPeakTorqueLimit(Limit):
             h, d1, d2, _ = m.jets(theta)
             d1, d2 = d1 * 1e-3, d2 * 1e-3
             f_env = forming_force(theta, h, d) + d.F_cb - d.M * GRAVITY
-            tc = (d.J0 + d.M * d1**2) * grid.alpha + d.M * d1 * d2 * speed2 - f_env * d1
+            J, dJ, weight = link_terms(m.frames(theta), d.links) if d.links else (0.0, 0.0, 0.0)
+            tc = (d.J0 + d.M * d1**2 + J) * grid.alpha + (d.M * d1 * d2 + 0.5 * dJ) * speed2 - f_env * d1 + weight
             for form in (tc / (d.i * d.eta) + d.J_m * d.i * grid.alpha, tc * d.eta / d.i + d.J_m * d.i * grid.alpha):
                 rows.append((form, np.full(n, -np.inf), np.full(n, peak)))
         return rows

@@ -1,0 +1,120 @@
+"""The mechanism lifted out of an NLP's derivatives: its rows read the mechanism through symbols, and the
+derivative functions IPOPT calls are put together by the chain rule.
+
+An NLP samples the mechanism at crank angles ``theta_k(x)`` that depend on the decision variables ``x``
+through the motion law, and its rows read quantities of the mechanism there: the slide's height ``h`` and
+its derivatives ``h'``, ``h''`` with respect to the crank angle, and with a drive a linkage's inertia and
+weight terms. Differentiated as one expression, every such quantity would be differentiated again for
+every direction of the Hessian (each variable that moves a sample's angle): a linkage's closed form (a
+chain of circle intersections, some hundred operations) would dominate the cost of an iteration. But each
+quantity is a function of one number, its sample's crank angle, and its derivatives with respect to that
+angle are further coefficients of the mechanism's series (``press.jets``). So the rows are built on
+symbols ``eta`` (one per quantity and sample), and with ``E = d eta / d theta`` and
+``F = d2 eta / d theta2`` (each entry with respect to its own sample's angle; from the series),
+``J = d theta / dx`` (the motion law's closed form, by CasADi), the rows ``g(x, eta)``, the objective
+``f(x, eta)`` and the Lagrangian ``L = lam_f f + lam_g^T g``::
+
+    grad f = f_x + J^T E^T f_eta
+    jac g  = g_x + g_eta E J
+    hess L = L_xx + (L_x,eta E J + its transpose) + J^T (E^T L_eta,eta E + diag(sum_q L_eta_q F_q)) J
+             + sum_k mu_k hess theta_k,    mu = E^T L_eta
+
+(the sum over q runs over the quantities of one sample). Each piece is differentiated by CasADi where it
+is cheap (the rows in ``x`` and ``eta``, the angles in ``x``), and the mechanism's expressions enter once
+per sample. Then ``eta`` is replaced by the mechanism's expressions and the angles' symbols by
+``theta_k(x)``: the functions IPOPT calls read ``x`` and the parameters only, and equal the derivatives of
+the composed problem (``tests/test_lifting.py`` compares them with CasADi's own).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import casadi as ca
+
+from press.jets import Jet
+
+SERIES_ORDER = 4  # the mechanism's series in the NLPs: h, h', h'' and two more derivatives of each
+
+
+@dataclass
+class Lift:
+    """The mechanism's quantities at an NLP's samples, lifted: ``angles`` the symbols of the sample angles
+    [rad], ``angle_values`` their expressions in the decision variables and parameters; each quantity
+    (:meth:`quantity`) a symbol vector with its value and its first and second derivatives with respect to
+    its sample's angle, expressions in ``angles``."""
+
+    angles: Any
+    angle_values: Any
+    symbols: list[Any] = field(default_factory=list)
+    values: list[Any] = field(default_factory=list)
+    first: list[Any] = field(default_factory=list)
+    second: list[Any] = field(default_factory=list)
+
+    @classmethod
+    def at(cls, theta: Any) -> Lift:
+        """Symbols for the sample angles ``theta`` (an SX or MX column)."""
+        return cls(type(theta).sym("lifted_theta", theta.shape[0]), theta)
+
+    def quantity(self, jet: Jet) -> Any:
+        """The symbol of a quantity given as a jet in the angles (order 2 at least)."""
+        if jet.order < 2:
+            raise ValueError("a lifted quantity needs its first two derivatives")
+        symbol = type(self.angles).sym(f"lifted_{len(self.symbols)}", self.angles.shape[0])
+        self.symbols.append(symbol)
+        self.values.append(_column(jet.c[0], self.angles))
+        self.first.append(_column(jet.c[1], self.angles))
+        self.second.append(_column(jet.c[2], self.angles))
+        return symbol
+
+
+def _column(value: Any, like: Any) -> Any:
+    """``value`` as a column of ``like``'s length (a constant coefficient of a jet is a number)."""
+    if isinstance(value, (ca.SX, ca.MX, ca.DM)) and value.shape[0] == like.shape[0]:
+        return value
+    return value * type(like).ones(like.shape[0])
+
+
+def lifted_problem(problem: dict, lift: Lift) -> tuple[dict, dict]:
+    """The problem IPOPT solves (``f`` and ``g`` in ``x`` and ``p``) and its derivative functions
+    (``nlpsol``'s ``grad_f``, ``jac_g``, ``hess_lag`` options) by the chain rule of the module docstring."""
+    x, p, f, g = problem["x"], problem["p"], problem["f"], problem["g"]
+    sym = type(x)
+    eta = ca.vertcat(*lift.symbols)
+    E = ca.vertcat(*[ca.diag(first) for first in lift.first])  # (quantities x samples) x samples
+    F = ca.vertcat(*lift.second)
+    J = ca.jacobian(lift.angle_values, x)
+    n = lift.angles.shape[0]
+    lam_f, lam_g = sym.sym("lam_f"), sym.sym("lam_g", g.shape[0])
+
+    grad = ca.gradient(f, x) + ca.mtimes(J.T, ca.mtimes(E.T, ca.gradient(f, eta)))
+    jac = ca.jacobian(g, x) + ca.mtimes(ca.jacobian(g, eta), ca.mtimes(E, J))
+    lagrangian = lam_f * f + ca.dot(lam_g, g)
+    l_x, l_eta = ca.gradient(lagrangian, x), ca.gradient(lagrangian, eta)
+    cross = ca.mtimes(ca.jacobian(l_eta, x).T, ca.mtimes(E, J))
+    curvature = ca.sum2(ca.reshape(l_eta * F, n, -1))  # sum over the quantities of each sample
+    inner = ca.mtimes(E.T, ca.mtimes(ca.jacobian(l_eta, eta), E)) + ca.diag(curvature)
+    weights = sym.sym("weights", n)
+    angles_hessian = ca.hessian(ca.dot(weights, lift.angle_values), x)[0]
+    hessian = ca.jacobian(l_x, x) + cross + cross.T + ca.mtimes(J.T, ca.mtimes(inner, J)) + angles_hessian
+    # every symbol replaced at once: the weights by E^T l_eta, eta by the mechanism's quantities, the
+    # angles by their expressions (the replacements themselves in x, p and the multipliers)
+    values = ca.substitute([ca.vertcat(*lift.values), ca.vertcat(*lift.first)], [lift.angles], [lift.angle_values])
+    weights_x = ca.substitute(
+        ca.mtimes(E.T, l_eta), ca.vertcat(eta, lift.angles), ca.vertcat(values[0], lift.angle_values)
+    )
+    exprs = ca.substitute(
+        [f, g, grad, jac, ca.triu(hessian)],
+        [weights, eta, lift.angles],
+        [weights_x, values[0], lift.angle_values],
+    )
+    f, g, grad, jac, hessian = exprs
+    functions = {
+        "grad_f": ca.Function("nlp_grad_f", [x, p], [f, grad], ["x", "p"], ["f", "grad_f_x"]),
+        "jac_g": ca.Function("nlp_jac_g", [x, p], [g, jac], ["x", "p"], ["g", "jac_g_x"]),
+        "hess_lag": ca.Function(
+            "nlp_hess_l", [x, p, lam_f, lam_g], [hessian], ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"]
+        ),
+    }
+    return {**problem, "f": f, "g": g}, functions
