@@ -162,6 +162,20 @@ class CrankSlider(Mechanism):
 
     kind = "crank-slider"
     own_angle_origin = "the crank pin straight above the crank axis"
+    bars = (("crank centre", "crank pin"), ("crank pin", "slide"))
+    fixed = ("crank centre",)
+
+    def joints(self, theta: Any) -> dict[str, tuple[Any, Any]]:
+        """The crank centre, the crank pin ``(R sin phi, R cos phi)`` and the slide's wrist pin ``(e, y)``."""
+        theta = np.asarray(theta, dtype=float)
+        pin = self.crank_pin(theta)
+        y_bdc = -math.sqrt((self.rod_length + self.crank_radius) ** 2 - self.offset**2)
+        slide = (np.full_like(theta, self.offset), self.height(theta) + y_bdc)
+        return {"crank centre": (np.zeros_like(theta), np.zeros_like(theta)), "crank pin": pin, "slide": slide}
+
+    def crank_pin(self, theta: Any) -> tuple[Any, Any]:
+        phi = np.asarray(theta, dtype=float) + self.tdc_own_angle
+        return self.crank_radius * np.sin(phi), self.crank_radius * np.cos(phi)
 
     @property
     def tdc_own_angle(self) -> float:

@@ -44,8 +44,9 @@ MIN_ROOM = 1e-6  # a loop whose closing room (a squared sine of the transmission
 
 
 class LinkageError(ValueError):
-    """A geometry that cannot be a press mechanism: ``message`` (one line), the dimensions it ``names``
-    (the mechanism's attribute names) and the crank ``angle_deg`` [deg from the oracles' +x] where it fails."""
+    """A geometry that cannot be a press mechanism: ``message`` (one line), the dimensions it ``names`` (the
+    mechanism's attribute names, the likeliest culprit first; none: all of them together) and the crank
+    ``angle_deg`` [deg from the oracles' +x] where it fails."""
 
     def __init__(self, message: str, names: tuple[str, ...] = (), angle_deg: float | None = None):
         super().__init__(message)
@@ -69,7 +70,7 @@ def link_drive_chain(phi: Jet, g: Sequence[Any]) -> tuple[dict[str, Point], list
     slide = Point(h, joint.y - reach.sqrt())
     points = {"pivot": pivot, "crank_pin": crank, "rocker_joint": rocker, "rod_joint": joint, "slide": slide}
     rooms = [
-        (room, ("crank_radius", "ternary_rocker_side", "rocker", "rocker_pivot_x", "rocker_pivot_y")),
+        (room, ("rocker", "ternary_rocker_side", "rocker_pivot_x", "rocker_pivot_y", "crank_radius")),
         (reach / rod**2, ("rod_length", "slide_offset")),
     ]
     return points, rooms
@@ -86,7 +87,7 @@ def knuckle_joint_chain(phi: Jet, g: Sequence[Any]) -> tuple[dict[str, Point], l
     slide = Point(d + h, knuckle.y - reach.sqrt())
     points = {"pivot": pivot, "crank_pin": crank, "knuckle": knuckle, "slide": slide}
     rooms = [
-        (room, ("crank_radius", "rod_length", "rocker", "rocker_pivot_x", "rocker_pivot_y")),
+        (room, ("rocker", "rod_length", "rocker_pivot_x", "rocker_pivot_y", "crank_radius")),
         (reach / main**2, ("main_rod", "slide_offset")),
     ]
     return points, rooms
@@ -198,6 +199,14 @@ class Linkage(Mechanism):
         theta = np.asarray(theta, dtype=float) if not hasattr(theta, "shape") else theta
         return type(self).chain(Jet.angle(theta + phase), self.dimensions)[0]
 
+    def joints(self, theta: Any) -> dict[str, tuple[Any, Any]]:
+        theta = np.asarray(theta, dtype=float)
+        zero = np.zeros_like(theta)
+        out = {"crank centre": (zero, zero)}
+        for name, point in self.points(theta).items():
+            out[name.replace("_", " ")] = (point.x.value + zero, point.y.value + zero)
+        return out
+
     @cached_property
     def _dead_centres(self) -> tuple[float, float, float, float]:
         """``(phi_TDC, y_TDC, y_BDC, phi_BDC)``: the oracles' crank angle of the slide's highest point [rad],
@@ -207,13 +216,14 @@ class Linkage(Mechanism):
         (within :data:`DWELL_SHARE` of the stroke above it: a knuckle joint may wobble there)."""
         self._check_pivot()
         phi = np.linspace(0.0, 2 * math.pi, SCAN, endpoint=False)
-        points, rooms = type(self).chain(Jet.angle(phi), self.dimensions)
+        with np.errstate(invalid="ignore"):  # a loop that cannot close: NaN there, refused below
+            points, rooms = type(self).chain(Jet.angle(phi), self.dimensions)
         for room, names in rooms:
             k = int(np.argmin(room.value))
             if not room.value[k] > MIN_ROOM:
                 raise LinkageError(
                     f"the links cannot close at crank angle {math.degrees(phi[k]):.1f} deg (counted from +x, "
-                    f"counter-clockwise): {', '.join(names)} do not fit together there",
+                    "counter-clockwise)",
                     names,
                     math.degrees(phi[k]),
                 )
@@ -228,7 +238,7 @@ class Linkage(Mechanism):
                 raise LinkageError(
                     f"the slide turns back at crank angle {math.degrees(phi[k]):.1f} deg (counted from +x), "
                     f"{rise:.1f} mm above its lowest point: a press's slide goes down once and up once per turn",
-                    self.dimension_names,
+                    (),  # the dimensions together
                     math.degrees(phi[k]),
                 )
         phase = self._stationary(phi[top], falling_after=True)
@@ -240,7 +250,8 @@ class Linkage(Mechanism):
     def _check_pivot(self) -> None:
         """The rocker's pivot must lie outside the circle of the crank pin (else the rocker's joint meets
         the crank's path: the loop cannot close for a whole turn)."""
-        pivot = type(self).chain(Jet.angle(0.0), self.dimensions)[0]["pivot"]
+        with np.errstate(invalid="ignore"):  # only the pivot is read
+            pivot = type(self).chain(Jet.angle(0.0), self.dimensions)[0]["pivot"]
         if math.hypot(float(pivot.x.value), float(pivot.y.value)) <= self.crank_radius:
             raise LinkageError(
                 "the rocker's pivot lies inside the crank circle (its distance from the crank centre is at most "
@@ -300,6 +311,13 @@ class LinkDrive(Linkage):
     slide_offset: float = 0.0
 
     kind = "link-drive"
+    bars = (
+        ("crank centre", "crank pin"),
+        ("crank pin", "rocker joint", "rod joint"),  # the ternary link, a triangle
+        ("pivot", "rocker joint"),
+        ("rod joint", "slide"),
+    )
+    fixed = ("crank centre", "pivot")
     chain = staticmethod(link_drive_chain)
     formula_of = LINK_DRIVE
     links = LINK_DRIVE_LINKS
@@ -348,6 +366,8 @@ class KnuckleJoint(Linkage):
     slide_offset: float = 0.0
 
     kind = "knuckle-joint"
+    bars = (("crank centre", "crank pin"), ("crank pin", "knuckle"), ("pivot", "knuckle"), ("knuckle", "slide"))
+    fixed = ("crank centre", "pivot")
     chain = staticmethod(knuckle_joint_chain)
     formula_of = KNUCKLE_JOINT
     links = KNUCKLE_JOINT_LINKS

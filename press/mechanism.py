@@ -83,6 +83,8 @@ class Mechanism(ABC):
 
     kind: ClassVar[str]
     own_angle_origin: ClassVar[str] = "TDC"  # where the mechanism's own crank angle counts from (reports)
+    bars: ClassVar[tuple[tuple[str, ...], ...]] = ()  # the rigid links between joints (:meth:`joints`)
+    fixed: ClassVar[tuple[str, ...]] = ()  # the joints fixed to the frame
 
     # ---- the closed form ----
     @property
@@ -110,6 +112,12 @@ class Mechanism(ABC):
         """TDC's crank angle [rad] counted the mechanism's own way (:attr:`own_angle_origin`, in the
         direction of rotation): what its maker's drawings and other programs call it."""
         return 0.0
+
+    @abstractmethod
+    def joints(self, theta: Any) -> dict[str, tuple[Any, Any]]:
+        """Every joint's position ``(x, y)`` [mm] at crank angles ``theta`` [rad from TDC] (numpy), the crank
+        centre at the origin, y up, the slide's joint named ``slide``: what a drawing of the mechanism needs
+        (with :attr:`bars` and :attr:`fixed`)."""
 
     # ---- derived from it ----
     def height(self, theta: Any) -> Any:

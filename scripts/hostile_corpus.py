@@ -17,6 +17,15 @@ BASE = (ROOT / "cases" / "wang2023-side-panel.yaml").read_text(encoding="utf-8")
 BASE = BASE[: BASE.index("published:")]  # the case without the source's numbers
 
 
+LINK_DRIVE = (ROOT / "cases" / "link-drive-side-panel.yaml").read_text(encoding="utf-8")
+KNUCKLE_JOINT = (ROOT / "cases" / "knuckle-joint-coining.yaml").read_text(encoding="utf-8")
+
+
+def edited(text: str, old: str, new: str) -> str:
+    assert old in text, old
+    return text.replace(old, new, 1)
+
+
 def replace(old: str, new: str) -> str:
     assert old in BASE, old
     return BASE.replace(old, new, 1)
@@ -199,6 +208,56 @@ CORPUS: dict[str, tuple[str, str | bytes]] = {
     "published_height_huge": (
         "published.key_points.closing.height_mm",
         BASE + "published:\n  key_points:\n    closing: {height_mm: 1e300}\n",
+    ),
+    # linkages: links that cannot close, a pivot inside the crank circle, a slide that turns back, sections
+    "link_drive_cannot_close": ("press.link_drive.rocker_mm", edited(LINK_DRIVE, "rocker_mm: 810", "rocker_mm: 200")),
+    "link_drive_pivot_inside_crank": (
+        "press.link_drive.rocker_pivot_x_mm",
+        edited(
+            edited(LINK_DRIVE, "rocker_pivot_x_mm: 1060", "rocker_pivot_x_mm: 100"),
+            "rocker_pivot_y_mm: 340",
+            "rocker_pivot_y_mm: 100",
+        ),
+    ),
+    "link_drive_negative_length": (
+        "press.link_drive.ternary_rod_side_mm",
+        edited(LINK_DRIVE, "ternary_rod_side_mm: 1060", "ternary_rod_side_mm: -1060"),
+    ),
+    "link_drive_huge_rod": (
+        "press.link_drive.rod_length_mm",
+        edited(LINK_DRIVE, "rod_length_mm: 1060", "rod_length_mm: 1e308"),
+    ),
+    "link_drive_nan_angle": (
+        "press.link_drive.ternary_angle_deg",
+        edited(LINK_DRIVE, "ternary_angle_deg: 134", "ternary_angle_deg: .nan"),
+    ),
+    "link_drive_turns_back": (
+        "press.link_drive:",
+        edited(LINK_DRIVE, "rocker_pivot_x_mm: 1060", "rocker_pivot_x_mm: 100"),
+    ),
+    "link_drive_rod_mass": ("drive.rod_mass_kg", edited(LINK_DRIVE, "  links:", "  rod_mass_kg: 2000\n  links:")),
+    "knuckle_joint_cannot_close": (
+        "press.knuckle_joint.main_rod_mm",
+        edited(KNUCKLE_JOINT, "main_rod_mm: 910", "main_rod_mm: 300"),
+    ),
+    "knuckle_joint_turns_back": (
+        "press.knuckle_joint:",
+        edited(KNUCKLE_JOINT, "slide_offset_mm: 0 ", "slide_offset_mm: 700 "),
+    ),
+    "knuckle_joint_without_section": (
+        "press.knuckle_joint: is required",
+        KNUCKLE_JOINT[: KNUCKLE_JOINT.index("  knuckle_joint:")] + KNUCKLE_JOINT[KNUCKLE_JOINT.index("key_points:") :],
+    ),
+    "knuckle_joint_unknown_link": ("drive.links.ternary", edited(KNUCKLE_JOINT, "    rocker: {", "    ternary: {")),
+    "mechanism_unknown": ("press.mechanism", replace("press:\n", "press:\n  mechanism: toggle\n")),
+    "linkage_section_on_a_crank_slider": (
+        "press.link_drive: belongs to another mechanism",
+        replace(
+            "press:\n",
+            "press:\n  link_drive: {crank_radius_mm: 200, ternary_rocker_side_mm: 700, rocker_mm: 800, "
+            "rocker_pivot_x_mm: 1000, rocker_pivot_y_mm: 300, ternary_angle_deg: 134, ternary_rod_side_mm: 1000, "
+            "rod_length_mm: 1000}\n",
+        ),
     ),
 }
 

@@ -39,7 +39,8 @@ def test_the_case_is_offset_by_5_to_10_percent_of_the_crank():
 def test_check_prints_the_dead_centres(capsys):
     assert main(["check", str(OFFSET_CASE)]) == 0
     out = capsys.readouterr().out
-    assert "stroke 900.583 mm; TDC at 0.00 deg, BDC at 181.67 deg" in out
+    assert "stroke 900.583 mm; TDC at -3.06 deg, BDC at 178.61 deg of the crank's own angle" in out
+    assert "goes down for 181.67 deg (50.5 % of the turn), up for 178.33 deg" in out
     assert "down for 181.67 deg, up for 178.33 deg" in out
     assert main(["check", str(OFFSET_CASE), "--json"]) == 0
     press = json.loads(capsys.readouterr().out)["press"]

@@ -241,6 +241,38 @@ def test_a_drive_case_shows_its_motor(site) -> None:
     context.close()
 
 
+@browser
+def test_a_linkage_case_shows_its_mechanism_and_follows_a_geometry_edit(site) -> None:
+    """The link drive: its own fields (not the crank-slider's), a drawing of the linkage that follows the
+    crank angle, and an edit of a link's dimension solved as the CLI solves it."""
+    url, browser = site
+    context = browser.new_context(viewport={"width": 1400, "height": 1200})
+    tab = context.new_page()
+    tab.goto(url)
+    wait_rendered(tab)
+    before = int(tab.evaluate("document.body.dataset.rendered"))
+    tab.locator("#case-select").select_option("link-drive-side-panel.yaml")
+    wait_rendered(tab, before)
+    data = load_yaml((CASES / "link-drive-side-panel.yaml").read_text(encoding="utf-8"))
+    label = "cases/link-drive-side-panel.yaml"
+    assert tab.locator("#spm").inner_text() == f"{solve(case_from_data(copy.deepcopy(data), label)).plan.spm:.3f}"
+    assert tab.locator('[data-field="press.link_drive.rocker_mm"]').input_value() == "810"
+    assert tab.locator('[data-field="press.crank_radius_mm"]').count() == 0
+    assert tab.locator('[data-field="drive.rod_mass_kg"]').count() == 0
+    assert tab.locator('[data-field="press.mechanism"]').input_value() == "link-drive"
+    svg = tab.locator("#mechanism-svg")
+    assert svg.locator("line.bar").count() == 3 and svg.locator("polygon.bar").count() == 1  # the ternary link
+    assert svg.locator("circle.joint.fixed").count() == 2  # the crank centre and the rocker's pivot
+    tab.locator("#crank-angle").fill("150")
+    tab.locator("#crank-angle").dispatch_event("input")
+    assert float(svg.get_attribute("data-angle")) == 150.0
+    edit(tab, "press.link_drive.rocker_pivot_y_mm", "380")
+    data["press"]["link_drive"]["rocker_pivot_y_mm"] = 380.0
+    assert tab.locator("#spm").inner_text() == f"{solve(case_from_data(copy.deepcopy(data), label)).plan.spm:.3f}"
+    screenshot(tab, "web-link-drive")
+    context.close()
+
+
 # ---- the server without a browser (Flask's test client) ------------------------------------------------
 
 

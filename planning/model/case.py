@@ -381,19 +381,17 @@ def _press_checks(press: PressModel) -> None:
         _machine(press)
     except LinkageError as error:
         keys = [_linkage_key(section, name) for name in error.names]
-        others = f" ({', '.join(k.split('.')[-1] for k in keys[1:])} with it)" if len(keys) > 1 else ""
-        field = keys[0] if keys else f"press.{section}"
-        raise CaseError(field, f"{error}{others}", _field_value(press, field)) from None
+        if not keys:  # the dimensions together
+            raise CaseError(f"press.{section}", str(error), None, False) from None
+        names = [k.split(".")[-1] for k in keys]
+        fit = f": {names[0]} does not fit with {', '.join(names[1:])}" if len(names) > 1 else ""
+        value = getattr(getattr(press, section), names[0])
+        raise CaseError(keys[0], f"{error}{fit}", value) from None
 
 
 def _linkage_key(section: str, name: str) -> str:
     """The case's key of a linkage's dimension ``name`` (``press.linkage``): its unit appended."""
     return f"press.{section}.{name}_deg" if name.endswith("_angle") else f"press.{section}.{name}_mm"
-
-
-def _field_value(press: PressModel, field: str) -> Any:
-    section, key = field.split(".")[1:3]
-    return getattr(getattr(press, section), key)
 
 
 def _drive_checks(case: Case) -> None:

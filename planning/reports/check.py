@@ -45,6 +45,11 @@ def check_case(case: Case) -> dict[str, Any]:
             "bdc_deg": bdc,
             "down_deg": bdc,  # crank angle from TDC to BDC: the slide goes down
             "up_deg": 360.0 - bdc,
+            "down_share_pct": bdc / 3.6,
+            # the dead centres in the mechanism's own crank angle (its maker's drawings, mechpress, presslink)
+            "own_angle_origin": m.own_angle_origin,
+            "tdc_own_deg": math.degrees(m.tdc_own_angle),
+            "bdc_own_deg": math.degrees(m.tdc_own_angle + m.bdc_angle) % 360.0,
         },
         "draw_speed_rpm": w2 / RPM,
         "draw_speed_given": case.process.draw_speed_rpm is not None,
@@ -95,9 +100,10 @@ def check_text(report: dict[str, Any]) -> str:
     p = report["press"]
     lines = [
         f"{report['case']}: key points at the draw speed {report['draw_speed_rpm']:.3f} rpm ({given})",
-        f"  {p['mechanism']}: stroke {p['stroke_mm']:.3f} mm; TDC at {p['tdc_deg']:.2f} deg, BDC at "
-        f"{p['bdc_deg']:.2f} deg of crank angle (the slide goes down for {p['down_deg']:.2f} deg, up for "
-        f"{p['up_deg']:.2f} deg)",
+        f"  {p['mechanism']}: stroke {p['stroke_mm']:.3f} mm; TDC at {p['tdc_own_deg']:.2f} deg, BDC at "
+        f"{p['bdc_own_deg']:.2f} deg of the crank's own angle (from {p['own_angle_origin']})",
+        f"  key angles count from TDC: the slide goes down for {p['down_deg']:.2f} deg "
+        f"({p['down_share_pct']:.1f} % of the turn), up for {p['up_deg']:.2f} deg",
         "",
         f"  {'key point':<11} {'angle deg':>9} {'height mm':>10} {'slider speed mm/s':>18}",
     ]

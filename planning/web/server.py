@@ -37,6 +37,7 @@ STATIC = Path(__file__).resolve().parent / "static"
 MAX_REQUEST_BYTES = 2 * MAX_BYTES  # a case as JSON, with the page's own fields
 MAX_SESSIONS = 64
 CHART_POINTS = 600  # samples of a plan's curves sent to the page (the files keep the full 1 ms step)
+DRAWING_STEP_DEG = 2.0  # [deg] the mechanism's drawing is sent at every such crank angle from TDC
 BOUND_CACHE = 32
 DOWNLOADS = ("result.json", "trajectory.csv", "cam_table.csv")
 
@@ -223,7 +224,8 @@ def _plotly_js() -> Path:
 
 
 def field_specs() -> list[dict[str, Any]]:
-    """The form's fields: dotted name, kind (number | choice | table), optional or not, choices."""
+    """The form's fields: dotted name, kind (number | choice | table | label: shown, not edited), optional or
+    not, choices."""
     from planning.sweep import numeric_fields
 
     specs: list[dict[str, Any]] = []
@@ -232,6 +234,7 @@ def field_specs() -> list[dict[str, Any]]:
         info = model.model_fields[leaf]
         specs.append({"name": name, "kind": "number", "optional": not info.is_required()})
     specs += [
+        {"name": "press.mechanism", "kind": "label"},  # a case's mechanism is its file's (each has its own keys)
         {"name": "planner.motion_law", "kind": "choice", "choices": list(LAWS)},
         {"name": "planner.placement", "kind": "choice", "choices": ["free", "published"]},
         {"name": "planner.objective", "kind": "choice", "choices": list(OBJECTIVES)},
@@ -270,7 +273,22 @@ def solve_case(data: Any, label: str, session: Session) -> dict[str, Any]:
     plan = solution.plan
     table = sample_profile(plan.profile, case.machine, plan.period / CHART_POINTS, case)
     curves = {name: _rounded(col) for name, col in zip(trajectory_columns(case), table.T, strict=True)}
-    return {"status": "verified", "result": _finite(result), "curves": curves}
+    return {"status": "verified", "result": _finite(result), "curves": curves, "mechanism": mechanism_drawing(case)}
+
+
+def mechanism_drawing(case: Case) -> dict[str, Any]:
+    """The mechanism as the page draws it: every joint's position [mm] at crank angles from TDC every
+    :data:`DRAWING_STEP_DEG`, the bars between joints (a triangle for a ternary link) and the fixed joints."""
+    machine = case.machine
+    angles = np.arange(0.0, 360.0 + DRAWING_STEP_DEG / 2, DRAWING_STEP_DEG)
+    joints = machine.joints(np.radians(angles))
+    return {
+        "kind": machine.kind,
+        "angles_deg": angles.tolist(),
+        "joints": {name: [_rounded(np.round(x, 2)), _rounded(np.round(y, 2))] for name, (x, y) in joints.items()},
+        "bars": [list(bar) for bar in machine.bars],
+        "fixed": list(machine.fixed),
+    }
 
 
 class _BoundPool:

@@ -2,7 +2,9 @@
 "use strict";
 
 const SESSION = (crypto.randomUUID ? crypto.randomUUID() : String(Math.random()).slice(2)) ;
-const SECTIONS = ["press", "key_points", "process", "limits", "drive", "drive.motor", "planner"];
+const SECTIONS = ["press", "press.link_drive", "press.knuckle_joint", "key_points", "process", "limits", "drive", "drive.motor", "planner"];
+// the press section's own keys belong to the crank-slider; a linkage's dimensions are in its subsection
+const CRANK_SLIDER_KEYS = ["press.crank_radius_mm", "press.rod_length_mm", "press.offset_mm", "drive.rod_mass_kg", "drive.rod_cg_from_crank_pin_mm"];
 const STAGE_COLOURS = { transfer: "#d9ecff", feed: "#fff2cc", draw: "#e2f0d9", return: "#fde2e2" };
 const KEY_LABELS = { closing: "θ1", draw_start: "θ2", draw_end: "θ3", opening: "θ4" };
 const TYPING_REST_MS = 600;
@@ -30,9 +32,12 @@ function buildForm(data) {
   form.innerHTML = "";
   const specs = state.meta.fields;
   const hasDrive = data.drive != null;
+  const crankSlider = (getPath(data, "press.mechanism") || "crank-slider") === "crank-slider";
   for (const section of SECTIONS) {
     if (section.startsWith("drive") && !hasDrive) continue;
-    const fields = specs.filter((f) => f.name.startsWith(section + ".") && !f.name.slice(section.length + 1).includes("."));
+    if (section.includes(".") && !section.startsWith("drive") && getPath(data, section) == null) continue;
+    const fields = specs.filter((f) => f.name.startsWith(section + ".") && !f.name.slice(section.length + 1).includes("."))
+      .filter((f) => crankSlider || !CRANK_SLIDER_KEYS.includes(f.name));
     if (!fields.length) continue;
     const fs = document.createElement("fieldset");
     fs.innerHTML = `<legend>${section}</legend>`;
@@ -51,7 +56,12 @@ function fieldRow(spec, value) {
   const id = "f-" + spec.name.replaceAll(".", "-");
   const leaf = spec.name.split(".").pop();
   let input;
-  if (spec.kind === "choice") {
+  if (spec.kind === "label") {
+    input = document.createElement("input");
+    input.type = "text";
+    input.readOnly = true;
+    input.value = value ?? "";
+  } else if (spec.kind === "choice") {
     input = document.createElement("select");
     for (const c of spec.choices) input.add(new Option(c, c));
     input.value = value ?? spec.choices[0];
@@ -72,8 +82,8 @@ function fieldRow(spec, value) {
   msg.className = "msg";
   msg.dataset.for = spec.name;
   row.appendChild(msg);
-  input.addEventListener("change", onEdit);
-  if (spec.kind !== "choice") {  // typing: solve once the keys rest (a change solves at once)
+  if (spec.kind !== "label") input.addEventListener("change", onEdit);
+  if (spec.kind !== "choice" && spec.kind !== "label") {  // typing: solve once the keys rest (a change solves at once)
     input.addEventListener("input", () => { clearTimeout(editTimer); editTimer = setTimeout(onEdit, TYPING_REST_MS); });
   }
   return row;
@@ -81,7 +91,7 @@ function fieldRow(spec, value) {
 
 function formValue(input) {
   const text = input.value.trim();
-  if (input.dataset.kind === "choice") return text;
+  if (input.dataset.kind === "choice" || input.dataset.kind === "label") return text || undefined;
   if (text === "") return undefined;
   if (input.dataset.kind === "table") { try { return JSON.parse(text); } catch (e) { return text; } }
   const number = Number(text);
@@ -191,6 +201,7 @@ function render(answer, seq) {
     body.appendChild(tr);
   }
   drawCharts();
+  drawMechanism();
   window.renderedAt = performance.now(); // the edit-to-chart benchmark reads it
   document.body.dataset.state = "ready";
   document.body.dataset.rendered = String(seq);
@@ -258,6 +269,8 @@ function drawCharts() {
     shapes: stageShapes(r, axis),
   };
   Plotly.react("motion-chart", traces, layout, { responsive: true, displaylogo: false });
+  const chart = $("#motion-chart");
+  if (!chart.dataset.follows) { chart.on("plotly_hover", followChart); chart.dataset.follows = "1"; }
   drawDrive(r, c, x, axis);
 }
 
@@ -296,6 +309,49 @@ function drawDrive(r, c, x, axis) {
     shapes: stageShapes(r, axis).map((s) => ({ ...s, xref: "x" })),
   };
   Plotly.react(el, traces, layout, { responsive: true, displaylogo: false });
+}
+
+// ---- the mechanism at a crank angle -----------------------------------------------------------------
+function drawMechanism() {
+  const m = state.last && state.last.mechanism;
+  const svg = $("#mechanism-svg");
+  if (!m) { svg.innerHTML = ""; return; }
+  const angle = Number($("#crank-angle").value);
+  $("#crank-angle-value").textContent = angle.toFixed(0) + " deg";
+  const k = nearest(m.angles_deg, angle);
+  const names = Object.keys(m.joints);
+  let xs = [], ys = [];
+  for (const n of names) { xs = xs.concat(m.joints[n][0]); ys = ys.concat(m.joints[n][1]); }
+  const pad = 0.08 * Math.max(Math.max(...xs) - Math.min(...xs), Math.max(...ys) - Math.min(...ys));
+  const x0 = Math.min(...xs) - pad, x1 = Math.max(...xs) + pad, y0 = Math.min(...ys) - pad, y1 = Math.max(...ys) + pad;
+  svg.setAttribute("viewBox", `${x0} ${-y1} ${x1 - x0} ${y1 - y0}`);
+  const at = (n) => [m.joints[n][0][k], -m.joints[n][1][k]]; // SVG's y points down
+  const size = (x1 - x0) / 60;
+  const parts = [];
+  const slideX = m.joints.slide[0][k];
+  parts.push(`<line class="guide" x1="${slideX}" y1="${-y1}" x2="${slideX}" y2="${-y0}" />`);
+  for (const bar of m.bars) {
+    const pts = bar.map(at);
+    if (pts.length > 2) parts.push(`<polygon class="bar" points="${pts.map((p) => p.join(",")).join(" ")}" />`);
+    else parts.push(`<line class="bar" x1="${pts[0][0]}" y1="${pts[0][1]}" x2="${pts[1][0]}" y2="${pts[1][1]}" />`);
+  }
+  const [sx, sy] = at("slide");
+  parts.push(`<rect class="slide" x="${sx - 4 * size}" y="${sy - 1.5 * size}" width="${8 * size}" height="${3 * size}" />`);
+  for (const n of names) {
+    const [x, y] = at(n);
+    const cls = m.fixed.includes(n) ? "joint fixed" : "joint";
+    parts.push(`<circle class="${cls}" cx="${x}" cy="${y}" r="${size}"><title>${n}</title></circle>`);
+  }
+  svg.innerHTML = parts.join("");
+  svg.dataset.angle = String(m.angles_deg[k]);
+}
+
+function followChart(event) {  // the drawing follows the crank angle under the mouse
+  if (!state.last || !event.points || !event.points.length) return;
+  const c = state.last.curves, x = event.points[0].x;
+  const angle = $("#x-axis").value === "time" ? c.crank_angle_deg[nearest(c.time_s, x)] : x;
+  $("#crank-angle").value = String(Math.round(((angle % 360) + 360) % 360));
+  drawMechanism();
 }
 
 // ---- cases, uploads, downloads ----------------------------------------------------------------------
@@ -346,6 +402,7 @@ async function start() {
   select.addEventListener("change", () => loadCase(select.value));
   $("#upload").addEventListener("change", (e) => { if (e.target.files.length) upload(e.target.files[0]); });
   $("#x-axis").addEventListener("change", () => { if (state.last) drawCharts(); });
+  $("#crank-angle").addEventListener("input", drawMechanism);
   $("#pin").addEventListener("click", () => { if (state.last) { state.pinned = state.last; render(state.last, state.shownSeq); } });
   $("#unpin").addEventListener("click", () => { state.pinned = null; if (state.last) render(state.last, state.shownSeq); });
   $("#download-case").addEventListener("click", () => download("case.yaml"));
