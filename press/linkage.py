@@ -40,6 +40,8 @@ DWELL_SHARE = 5e-3  # a slide may turn back within this share of the stroke abov
 SIDE = -1.0  # the closing joint lies to the right of the line from the crank pin to the rocker pivot
 SCAN = 7200  # crank angles of the scans (dead centres, assembly, one stroke per turn)
 DEAD_CENTRE_TOL = 1e-13  # [rad] the bisection for TDC stops at this bracket width
+MEMO_SIZE = 4  # arrays of crank angles whose evaluation a linkage remembers
+MEMO_MIN_SIZE = 64  # smaller arrays are evaluated again (cheaper than a look-up)
 MIN_ROOM = 1e-6  # a loop whose closing room (a squared sine of the transmission angle) falls below this locks
 
 
@@ -187,6 +189,29 @@ class Linkage(Mechanism):
     @property
     def formula(self) -> Formula:
         return self.formula_of
+
+    def jets(self, theta: Any) -> Any:
+        return self._evaluated(theta)[0].c
+
+    def frames(self, theta: Any) -> dict[str, tuple[Any, Any, Any]]:
+        return self._evaluated(theta)[1]
+
+    def _evaluated(self, theta: Any) -> tuple[Jet, dict]:
+        """The closed form at ``theta`` (third order), remembered for the last few arrays of angles: the
+        verification, the drive's state and the reports ask for the same dense grid in turn."""
+        if not isinstance(theta, np.ndarray) or theta.size < MEMO_MIN_SIZE:
+            return self.formula.evaluate(theta, self.geometry)
+        key = (theta.shape, hash(theta.tobytes()))
+        memo = self._memo
+        if key not in memo:
+            if len(memo) >= MEMO_SIZE:
+                memo.pop(next(iter(memo)))
+            memo[key] = self.formula.evaluate(theta.copy(), self.geometry)
+        return memo[key]
+
+    @cached_property
+    def _memo(self) -> dict:
+        return {}
 
     @property
     def geometry(self) -> tuple[float, ...]:

@@ -55,7 +55,9 @@ def link_drive() -> None:
     case = read_case(ROOT / "cases" / "link-drive-side-panel.yaml")
     m = case.machine
     j = m.joints(np.array(math.radians(100.0)))
-    o, a, b, c, p, s = (point(j, n) for n in ("crank centre", "crank pin", "rocker joint", "rod joint", "pivot", "slide"))
+    o, a, b, c, p, s = (
+        point(j, n) for n in ("crank centre", "crank pin", "rocker joint", "rod joint", "pivot", "slide")
+    )
     fig, ax = plt.subplots(figsize=(7.5, 7.5))
     ax.fill(*zip(a, b, c, strict=True), fc="#aab7c4", alpha=0.4, ec="none")
     bar(ax, o, a, "a  crank_radius_mm", (70, 10))
@@ -76,10 +78,21 @@ def link_drive() -> None:
     arc = matplotlib.patches.Arc(a, 260, 260, theta1=ang_b, theta2=ang_c, color=DIM)
     ax.add_patch(arc)
     ax.annotate("tht  ternary_angle_deg", a, xytext=(-40, -40), textcoords="offset points", color=DIM, fontsize=9)
-    ax.annotate("h  slide_offset_mm: the slide's line at x = h", (s[0], s[1]), xytext=(-60, -28),
-                textcoords="offset points", color=DIM, fontsize=9)
-    for name, q, fixed in (("crank centre", o, True), ("rocker pivot (-d, -f)", p, True), ("", a, False),
-                           ("", b, False), ("", c, False)):
+    ax.annotate(
+        "h  slide_offset_mm: the slide's line at x = h",
+        (s[0], s[1]),
+        xytext=(-60, -28),
+        textcoords="offset points",
+        color=DIM,
+        fontsize=9,
+    )
+    for name, q, fixed in (
+        ("crank centre", o, True),
+        ("rocker pivot (-d, -f)", p, True),
+        ("", a, False),
+        ("", b, False),
+        ("", c, False),
+    ):
         joint(ax, q, fixed, name)
     slide(ax, s, 180)
     ax.set_title("link drive (mechpress.ld.LD): crank angle counter-clockwise from +x", fontsize=10)
@@ -101,14 +114,25 @@ def knuckle_joint() -> None:
     dimension(ax, np.array([right, o[1]]), np.array([right, p[1]]), "e  rocker_pivot_y_mm", (62, 0))
     ax.plot([o[0], right], [o[1], o[1]], color=DIM, lw=0.6, ls=":")
     ax.plot([p[0], right], [p[1], p[1]], color=DIM, lw=0.6, ls=":")
-    ax.annotate("h  slide_offset_mm: the slide's line at x = d + h", (s[0], s[1]), xytext=(-60, -28),
-                textcoords="offset points", color=DIM, fontsize=9)
-    for name, q, fixed in (("crank centre", o, True), ("rocker pivot (d, e)", p, True), ("", a, False),
-                           ("knuckle", k, False)):
+    ax.annotate(
+        "h  slide_offset_mm: the slide's line at x = d + h",
+        (s[0], s[1]),
+        xytext=(-60, -28),
+        textcoords="offset points",
+        color=DIM,
+        fontsize=9,
+    )
+    for name, q, fixed in (
+        ("crank centre", o, True),
+        ("rocker pivot (d, e)", p, True),
+        ("", a, False),
+        ("knuckle", k, False),
+    ):
         joint(ax, q, fixed, name)
     slide(ax, s, 160)
-    ax.set_title("knuckle joint (presslink ModularKnuckleJoint, f = c): crank angle counter-clockwise from +x",
-                 fontsize=10)
+    ax.set_title(
+        "knuckle joint (presslink ModularKnuckleJoint, f = c): crank angle counter-clockwise from +x", fontsize=10
+    )
     finish(fig, ax, "knuckle-joint.svg")
 
 

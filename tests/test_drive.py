@@ -22,7 +22,11 @@ from .conftest import PUBLISHED_CASE, ROOT
 
 DRIVE_CASES = [ROOT / "cases" / "wang2023-side-panel-drive.yaml", ROOT / "cases" / "cup-2000kN-drive.yaml"]
 # every mechanism's: the linkages' links carry their own masses (Lagrange's equation, ``press.dynamics``)
-EVERY_MECHANISM = [*DRIVE_CASES, ROOT / "cases" / "link-drive-side-panel.yaml", ROOT / "cases" / "knuckle-joint-coining.yaml"]
+EVERY_MECHANISM = [
+    *DRIVE_CASES,
+    ROOT / "cases" / "link-drive-side-panel.yaml",
+    ROOT / "cases" / "knuckle-joint-coining.yaml",
+]
 INTEGRATION_TOL = 1e-3  # relative: the trapezoidal rule on the 1 ms trajectory against the solver's quadrature
 
 

@@ -24,7 +24,17 @@ LINK_DRIVE_CASE = ROOT / "cases" / "link-drive-side-panel.yaml"
 KNUCKLE_JOINT_CASE = ROOT / "cases" / "knuckle-joint-coining.yaml"
 HEIGHT_TOL_MM = 1e-3  # the acceptance: 1e-6 m at every angle of the oracle's grid
 # mechpress's example link drive (its docstring's numbers) [m, rad]; presslink's knuckle joint [mm]
-MECHPRESS_EXAMPLE = {"a": 0.260, "b": 0.8, "c": 0.9, "d": 1.175, "f": 0.375, "tht": 2.33923, "g": 1.175, "h": 0.0, "m": 1.175}
+MECHPRESS_EXAMPLE = {
+    "a": 0.260,
+    "b": 0.8,
+    "c": 0.9,
+    "d": 1.175,
+    "f": 0.375,
+    "tht": 2.33923,
+    "g": 1.175,
+    "h": 0.0,
+    "m": 1.175,
+}
 PRESSLINK_EXAMPLE = {"a": 187.5, "b": 920.0, "c": 830.0, "d": 730.0, "e": 737.5, "g": 830.0, "h": 0.0}
 STILL = DriveModel(0.0, 0.0, 0.0, 1.0, 1.0, 0.0, (), (), 0.0, math.pi)  # no masses, no losses
 
@@ -141,7 +151,9 @@ def knuckle_joint_cases() -> list[tuple[str, KnuckleJoint, dict]]:
     return [("presslink example", example, x), ("shipped", read_case(KNUCKLE_JOINT_CASE).machine, letters)]
 
 
-@pytest.mark.parametrize("name, mechanism, letters", knuckle_joint_cases(), ids=lambda x: x if isinstance(x, str) else "")
+@pytest.mark.parametrize(
+    "name, mechanism, letters", knuckle_joint_cases(), ids=lambda x: x if isinstance(x, str) else ""
+)
 def test_knuckle_joint_heights_agree_with_presslink(name, mechanism, letters):
     """Every one of ModularKnuckleJoint's 360 angles (root_op 3, f = c): its slide distance counts from the
     rocker's pivot height."""
@@ -175,7 +187,9 @@ def test_the_series_derivatives_are_the_heights_derivatives(mechanism):
     the fourth coefficient of the order-4 series (the NLPs') against a difference of the third."""
     theta = np.linspace(0.1, 2 * math.pi - 0.1, 97)
     step = 1e-4
-    np.testing.assert_array_equal(np.array(mechanism.jets(theta)), np.array(mechanism.formula.series(theta, mechanism.geometry, 3).c))
+    np.testing.assert_array_equal(
+        np.array(mechanism.jets(theta)), np.array(mechanism.formula.series(theta, mechanism.geometry, 3).c)
+    )
     series = mechanism.formula.series
     g = mechanism.geometry
 

@@ -41,7 +41,6 @@ def test_check_prints_the_dead_centres(capsys):
     out = capsys.readouterr().out
     assert "stroke 900.583 mm; TDC at -3.06 deg, BDC at 178.61 deg of the crank's own angle" in out
     assert "goes down for 181.67 deg (50.5 % of the turn), up for 178.33 deg" in out
-    assert "down for 181.67 deg, up for 178.33 deg" in out
     assert main(["check", str(OFFSET_CASE), "--json"]) == 0
     press = json.loads(capsys.readouterr().out)["press"]
     assert press["bdc_deg"] == pytest.approx(181.668, abs=1e-3) and press["mechanism"] == "crank-slider"

@@ -112,7 +112,7 @@ class NLPSolver:
     def __init__(
         self,
         name: str,
-        problem: dict,
+        problem: dict | ca.Function,
         options: dict | None = None,
         fixed_scale: np.ndarray | None = None,
         warm_options: dict | None = None,
@@ -124,7 +124,7 @@ class NLPSolver:
         if lift is not None:  # the mechanism's quantities lifted out of the derivatives (``lifting``)
             problem, derivatives = lifted_problem(problem, lift)
             self.options.update(derivatives)
-        self.problem = problem
+        self.problem = problem  # a dict of expressions, or (lifted) a function of x and p
         self.warm_options = {**WARM_START_OPTIONS, **(warm_options or {})}
         self._cold = _compiled(name, problem, self.options)
         self._warm: ca.Function | None = None
@@ -194,12 +194,12 @@ class NLPSolver:
         )
 
 
-def _compiled(name: str, problem: dict, options: dict) -> ca.Function:
+def _compiled(name: str, problem: dict | ca.Function, options: dict) -> ca.Function:
     """``nlpsol`` of ``problem``. An SX problem as it is. An MX problem (vector operations, cheap to
     differentiate) is differentiated in MX; its constraint Jacobian, evaluated at every iteration, is then
     expanded to SX, which evaluates it about three times faster; the Hessian stays in MX (its SX expansion
     is larger and slower), and so do the functions (expanding them costs more to set up than it saves)."""
-    if not isinstance(problem["x"], ca.MX):
+    if isinstance(problem, ca.Function) or not isinstance(problem["x"], ca.MX):
         return ca.nlpsol(name, "ipopt", problem, options)
     derived = ca.nlpsol(f"{name}_mx", "ipopt", problem, options)
     supplied = {option: derived.get_function(function) for option, function in DERIVATIVE_FUNCTIONS.items()}

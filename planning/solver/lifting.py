@@ -42,12 +42,13 @@ SERIES_ORDER = 4  # the mechanism's series in the NLPs: h, h', h'' and two more 
 class Lift:
     """The mechanism's quantities at an NLP's samples, lifted: ``angles`` the symbols of the sample angles
     [rad], ``angle_values`` their expressions in the decision variables and parameters; each quantity
-    (:meth:`quantity`) a symbol vector with its value and its first and second derivatives with respect to
-    its sample's angle, expressions in ``angles``."""
+    (:meth:`quantity`) a slice of the symbol ``symbols`` (room for :data:`CAPACITY` quantities) with its
+    value and its first and second derivatives with respect to its sample's angle, expressions in
+    ``angles`` and the parameters."""
 
     angles: Any
     angle_values: Any
-    symbols: list[Any] = field(default_factory=list)
+    symbols: Any
     values: list[Any] = field(default_factory=list)
     first: list[Any] = field(default_factory=list)
     second: list[Any] = field(default_factory=list)
@@ -55,18 +56,29 @@ class Lift:
     @classmethod
     def at(cls, theta: Any) -> Lift:
         """Symbols for the sample angles ``theta`` (an SX or MX column)."""
-        return cls(type(theta).sym("lifted_theta", theta.shape[0]), theta)
+        sym, n = type(theta), theta.shape[0]
+        return cls(sym.sym("lifted_theta", n), theta, sym.sym("lifted", CAPACITY * n))
 
     def quantity(self, jet: Jet) -> Any:
         """The symbol of a quantity given as a jet in the angles (order 2 at least)."""
         if jet.order < 2:
             raise ValueError("a lifted quantity needs its first two derivatives")
-        symbol = type(self.angles).sym(f"lifted_{len(self.symbols)}", self.angles.shape[0])
-        self.symbols.append(symbol)
+        k, n = len(self.values), self.angles.shape[0]
+        if k == CAPACITY:
+            raise ValueError(f"at most {CAPACITY} lifted quantities")
         self.values.append(_column(jet.c[0], self.angles))
         self.first.append(_column(jet.c[1], self.angles))
         self.second.append(_column(jet.c[2], self.angles))
-        return symbol
+        return self.symbols[k * n : (k + 1) * n]
+
+    def columns(self, coefficients: list[Any]) -> Any:
+        """One coefficient of every quantity, stacked as :attr:`symbols` is (zeros where unused)."""
+        n = self.angles.shape[0]
+        unused = type(self.angles).zeros((CAPACITY - len(coefficients)) * n)
+        return ca.vertcat(*coefficients, unused)
+
+
+CAPACITY = 6  # lifted quantities per sample at most: the height and two derivatives, three link terms
 
 
 def _column(value: Any, like: Any) -> Any:
@@ -76,16 +88,18 @@ def _column(value: Any, like: Any) -> Any:
     return value * type(like).ones(like.shape[0])
 
 
-def lifted_problem(problem: dict, lift: Lift) -> tuple[dict, dict]:
-    """The problem IPOPT solves (``f`` and ``g`` in ``x`` and ``p``) and its derivative functions
-    (``nlpsol``'s ``grad_f``, ``jac_g``, ``hess_lag`` options) by the chain rule of the module docstring."""
+def lifted_problem(problem: dict, lift: Lift) -> tuple[ca.Function, dict]:
+    """The problem IPOPT solves (a function of ``x`` and ``p`` giving ``f`` and ``g``) and its derivative
+    functions (``nlpsol``'s ``grad_f``, ``jac_g``, ``hess_lag`` options) by the chain rule of the module
+    docstring. Each is the composition of three functions: the sample angles of ``x`` and ``p`` (the motion
+    law), the mechanism's quantities and their derivatives at those angles, and the rows and their
+    derivatives in ``x`` and the quantities; nothing is substituted into a large expression."""
     x, p, f, g = problem["x"], problem["p"], problem["f"], problem["g"]
     sym = type(x)
-    eta = ca.vertcat(*lift.symbols)
-    E = ca.vertcat(*[ca.diag(first) for first in lift.first])  # (quantities x samples) x samples
-    F = ca.vertcat(*lift.second)
-    J = ca.jacobian(lift.angle_values, x)
     n = lift.angles.shape[0]
+    eta, e1, e2 = lift.symbols, sym.sym("first", CAPACITY * n), sym.sym("second", CAPACITY * n)
+    E = ca.vertcat(*[ca.diag(e1[k * n : (k + 1) * n]) for k in range(CAPACITY)])  # (quantities x samples) x samples
+    J = ca.jacobian(lift.angle_values, x)
     lam_f, lam_g = sym.sym("lam_f"), sym.sym("lam_g", g.shape[0])
 
     grad = ca.gradient(f, x) + ca.mtimes(J.T, ca.mtimes(E.T, ca.gradient(f, eta)))
@@ -93,28 +107,42 @@ def lifted_problem(problem: dict, lift: Lift) -> tuple[dict, dict]:
     lagrangian = lam_f * f + ca.dot(lam_g, g)
     l_x, l_eta = ca.gradient(lagrangian, x), ca.gradient(lagrangian, eta)
     cross = ca.mtimes(ca.jacobian(l_eta, x).T, ca.mtimes(E, J))
-    curvature = ca.sum2(ca.reshape(l_eta * F, n, -1))  # sum over the quantities of each sample
+    curvature = ca.sum2(ca.reshape(l_eta * e2, n, -1))  # sum over the quantities of each sample
     inner = ca.mtimes(E.T, ca.mtimes(ca.jacobian(l_eta, eta), E)) + ca.diag(curvature)
     weights = sym.sym("weights", n)
     angles_hessian = ca.hessian(ca.dot(weights, lift.angle_values), x)[0]
+    angles_hessian = ca.substitute(angles_hessian, weights, ca.mtimes(E.T, l_eta))  # the law's part only
     hessian = ca.jacobian(l_x, x) + cross + cross.T + ca.mtimes(J.T, ca.mtimes(inner, J)) + angles_hessian
-    # every symbol replaced at once: the weights by E^T l_eta, eta by the mechanism's quantities, the
-    # angles by their expressions (the replacements themselves in x, p and the multipliers)
-    values = ca.substitute([ca.vertcat(*lift.values), ca.vertcat(*lift.first)], [lift.angles], [lift.angle_values])
-    weights_x = ca.substitute(
-        ca.mtimes(E.T, l_eta), ca.vertcat(eta, lift.angles), ca.vertcat(values[0], lift.angle_values)
-    )
-    exprs = ca.substitute(
-        [f, g, grad, jac, ca.triu(hessian)],
-        [weights, eta, lift.angles],
-        [weights_x, values[0], lift.angle_values],
-    )
-    f, g, grad, jac, hessian = exprs
+
+    angles = ca.Function("lifted_angles", [x, p], [lift.angle_values])
+    coefficients = [lift.columns(lift.values), lift.columns(lift.first), lift.columns(lift.second)]
+    # the mechanism to the order each function needs (a function computes all its outputs at every call)
+    mechanism = [ca.Function(f"lifted_mechanism_{k}", [lift.angles, p], coefficients[: k + 1]) for k in range(3)]
+    rows = ca.Function("lifted_rows", [x, p, eta], [f, g])
+    rows_jac = ca.Function("lifted_jac", [x, p, eta, e1], [g, jac])
+    rows_hess = ca.Function("lifted_hess", [x, p, eta, e1, e2, lam_f, lam_g], [ca.triu(hessian)])
+
+    X, P = ca.MX.sym("x", x.shape[0]), ca.MX.sym("p", p.shape[0])
+    LF, LG = ca.MX.sym("lam_f"), ca.MX.sym("lam_g", g.shape[0])
+    at = angles(X, P)
+    values = mechanism[0](at, P)  # one output: returned as it is
+    nlp = ca.Function("nlp", [X, P], rows(X, P, values), ["x", "p"], ["f", "g"])
+    if ca.depends_on(f, eta):
+        values_1, first_1 = mechanism[1](at, P)
+        gradient = ca.Function("lifted_grad", [x, p, eta, e1], [f, grad])(X, P, values_1, first_1)
+    else:  # the period: no mechanism in it
+        gradient = ca.Function("lifted_grad", [x, p], [f, ca.gradient(f, x)])(X, P)
+    values_1, first_1 = mechanism[1](at, P)
+    values_2, first_2, second_2 = mechanism[2](at, P)
     functions = {
-        "grad_f": ca.Function("nlp_grad_f", [x, p], [f, grad], ["x", "p"], ["f", "grad_f_x"]),
-        "jac_g": ca.Function("nlp_jac_g", [x, p], [g, jac], ["x", "p"], ["g", "jac_g_x"]),
+        "grad_f": ca.Function("nlp_grad_f", [X, P], gradient, ["x", "p"], ["f", "grad_f_x"]),
+        "jac_g": ca.Function("nlp_jac_g", [X, P], rows_jac(X, P, values_1, first_1), ["x", "p"], ["g", "jac_g_x"]),
         "hess_lag": ca.Function(
-            "nlp_hess_l", [x, p, lam_f, lam_g], [hessian], ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"]
+            "nlp_hess_l",
+            [X, P, LF, LG],
+            [rows_hess(X, P, values_2, first_2, second_2, LF, LG)],
+            ["x", "p", "lam_f", "lam_g"],
+            ["triu_hess_gamma_x_x"],
         ),
     }
-    return {**problem, "f": f, "g": g}, functions
+    return nlp, functions
