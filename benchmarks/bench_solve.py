@@ -26,6 +26,13 @@ ROOT = Path(__file__).resolve().parents[1]
 CASE = ROOT / "cases" / "wang2023-side-panel.yaml"
 DRIVE_CASE = ROOT / "cases" / "wang2023-side-panel-drive.yaml"
 CUP_DRIVE_CASE = ROOT / "cases" / "cup-2000kN-drive.yaml"
+# one drive case per mechanism, the crank-slider's first (the others' times are compared with it)
+MECHANISM_CASES = [
+    DRIVE_CASE,
+    ROOT / "cases" / "link-drive-side-panel.yaml",
+    ROOT / "cases" / "knuckle-joint-coining.yaml",
+]
+MECHANISM_COLD_RUNS = 3
 TRADEOFF_RUNS = 3
 COLD_RUNS = 5
 WARM_RUNS = 7
@@ -55,8 +62,9 @@ def main() -> None:
         strong["drive"]["motor"][key] *= 10
     from planning.model.case_file import case_from_data
 
-    (warm, sol), (drive_warm, drive_sol), (strong_warm, _) = _interleaved(
-        [case, drive_case, case_from_data(strong)], solve
+    linkages = [read_case(path) for path in MECHANISM_CASES[1:]]
+    (warm, sol), (drive_warm, drive_sol), (strong_warm, _), *linkage_warm = _interleaved(
+        [case, drive_case, case_from_data(strong), *linkages], solve
     )
     assert sol.verification.passed and abs(sol.plan.spm - first.plan.spm) < 1e-9
 
@@ -97,6 +105,7 @@ def main() -> None:
             tradeoff_rows.append((drive_path.name, start, statistics.median(walls)))
     optimal_rows = _optimal(case, exe, imports)
     law_rows = _laws(case)
+    mechanism_rows = _mechanisms(exe, [(drive_warm, drive_sol), *linkage_warm], [drive_case, *linkages])
     med = statistics.median
     rows = [
         ("NLP build (once per process)", build),
@@ -151,6 +160,17 @@ def main() -> None:
             for r in law_rows
         ],
         "",
+        "Every mechanism's drive case (improved S-curve, free placement): a cold `pressplan solve --no-plots` "
+        f"process (median of {MECHANISM_COLD_RUNS}, the cases taking turns), an in-process solve with the NLPs "
+        f"built (median of {WARM_RUNS}, taking turns with the solves above) and a re-solve from the plan before "
+        f"(a sweep's or the page's warm start; median of {WARM_RUNS}); the ratios divide by the crank-slider's "
+        "(target: at most 2):",
+        "",
+        "| mechanism | case | SPM | IPOPT iterations | cold [s] | ratio | warm [s] | ratio | from the plan before [s] "
+        "| ratio |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+        *mechanism_rows,
+        "",
     ]
     out = ROOT / "benchmarks" / "RESULTS.md"
     old = out.read_text(encoding="utf-8") if out.exists() else ""
@@ -197,6 +217,36 @@ def _optimal(case, exe: Path, imports: list[float]) -> list[tuple[str, float]]:
         (f"{label}: in-process, NLPs built (median of {WARM_RUNS}; target 0.5 s)", med(warm)),
         (f"{label}: in-process from the plan before (median of {WARM_RUNS})", med(follow)),
     ]
+
+
+def _mechanisms(exe: Path, warm: list[tuple[list[float], object]], cases: list) -> list[str]:
+    """The rows of the mechanisms' table: cold processes taking turns, the warm solves measured with the
+    others (``warm``), re-solves from the plan before taking turns."""
+    from planning.solver.optimize import solve
+
+    cold: list[list[float]] = [[] for _ in cases]
+    with tempfile.TemporaryDirectory() as tmp:
+        for _ in range(MECHANISM_COLD_RUNS):
+            for k, path in enumerate(MECHANISM_CASES):
+                cold[k].append(timed([str(exe), "solve", str(path), "--out", f"{tmp}/m{k}", "--no-plots"]))
+    follow: list[list[float]] = [[] for _ in cases]
+    for _ in range(WARM_RUNS):
+        for k, (case, (_, solution)) in enumerate(zip(cases, warm, strict=True)):
+            t = time.perf_counter()
+            solve(case, neighbour=solution.plan, follow=True)  # as a sweep's and the page's re-solves
+            follow[k].append(time.perf_counter() - t)
+    med = statistics.median
+    base = (med(cold[0]), med(warm[0][0]), med(follow[0]))
+    rows = []
+    for k, case in enumerate(cases):
+        solution = warm[k][1]
+        times = (med(cold[k]), med(warm[k][0]), med(follow[k]))
+        cells = " | ".join(f"{t:.3f} | {t / b:.2f}" for t, b in zip(times, base, strict=True))
+        rows.append(
+            f"| {case.machine.kind} | `{MECHANISM_CASES[k].name}` | {solution.plan.spm:.3f} | "
+            f"{solution.plan.solver.iterations} | {cells} |"
+        )
+    return rows
 
 
 def _interleaved(cases: list, solve) -> list[tuple[list[float], object]]:
