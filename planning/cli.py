@@ -17,6 +17,7 @@ from typing import NoReturn
 
 from planning.model.case import OBJECTIVES
 from planning.model.laws import LAWS
+from planning.reports.new_case import MECHANISMS
 
 EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = 0, 2, 3
 EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143  # Ctrl-C, SIGTERM (128 + the signal number)
@@ -31,12 +32,17 @@ class _Parser(argparse.ArgumentParser):
 
 def _parser() -> argparse.ArgumentParser:
     ap = _Parser(prog="pressplan", description="Plan the crank speed of a crank-slider servo press for maximum SPM.")
+    ap.add_argument("--version", action="version", version=f"pressplan {_version()}")
     sub = ap.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    n = sub.add_parser("new", help="write a first case file, commented field by field, to edit")
+    n.add_argument("file", help="the case file to write (YAML; not over an existing file)")
+    n.add_argument("--mechanism", choices=MECHANISMS, default="crank-slider", help="the press (default crank-slider)")
+    n.add_argument("--drive", action="store_true", help="with a drive: section (motor, masses, forming force)")
     c = sub.add_parser("check", help="key points and process checks of a case (no solve)")
-    c.add_argument("case", help="case file (YAML)")
+    _case_argument(c)
     c.add_argument("--json", action="store_true", help="print JSON instead of the table")
     s = sub.add_parser("solve", help="solve, verify and write the fastest cycle")
-    s.add_argument("case", help="case file (YAML)")
+    _case_argument(s)
     s.add_argument("--out", help="output folder (default: out/<case name>)")
     s.add_argument("--placement", choices=("free", "published"), help="where theta1/theta4 may fall (default: case)")
     s.add_argument("--law", choices=tuple(LAWS), default=None, help="motion law (default: case, improved-s-curve)")
@@ -48,8 +54,13 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument(
         "--cam-points", type=_whole(2, 1_000_000), default=3600, metavar="N", help="cam table rows (default 3600)"
     )
-    m = sub.add_parser("compare", help="the published solution beside ours, and checked against itself")
-    m.add_argument("case", help="case file (YAML) with a published: block")
+    m = sub.add_parser(
+        "compare",
+        help="the published solution beside ours, and checked against itself (needs published.solution)",
+        description="Solve the case with the published and with free placement, re-simulate the published "
+        "solution (published.solution: x1_s ... J_rpm_s2, the paper's vector X) and compare the three.",
+    )
+    m.add_argument("case", help="case file (YAML) with published.solution (the paper's X vector; see the README)")
     m.add_argument("--out", help="output folder (default: out/<case name>)")
     m.add_argument("--json", action="store_true", help="print comparison.json instead of the table")
     w = sub.add_parser("sweep", help="solve a grid over case fields (resumable, parallel, Dask)")
@@ -80,14 +91,20 @@ def _parser() -> argparse.ArgumentParser:
     t.add_argument("--workers", type=_whole(1, 256), default=2, help="local worker processes (default 2)")
     t.add_argument("--scheduler", help="address of a Dask distributed scheduler (instead of local workers)")
     t.add_argument("--out", required=True, help="output folder (tradeoff.csv, tradeoff.png)")
-    b = sub.add_parser("bound", help="the time-optimal bound: the most strokes any motion can make")
-    b.add_argument("case", help="case file (YAML)")
+    b = sub.add_parser(
+        "bound",
+        help="the time-optimal bound: the most strokes any motion can make",
+        description="The time-optimal bound: the shortest cycle any crank motion within the limits can take, "
+        "on a grid of crank angles. 'idle time in the robot's window' is the time the bound waits there: the "
+        "transfer time minus the time its crank needs to cross the window (window_slack_s in --json).",
+    )
+    _case_argument(b)
     b.add_argument(
         "--points", type=_whole(2, 1_000_000), default=1440, metavar="N", help="grid intervals (default 1440)"
     )
     b.add_argument("--json", action="store_true", help="print JSON")
     lw = sub.add_parser("laws", help="every motion law on the case, beside the time-optimal bound")
-    lw.add_argument("case", help="case file (YAML)")
+    _case_argument(lw)
     lw.add_argument("--out", help="output folder (default: out/<case name>)")
     lw.add_argument("--json", action="store_true", help="print laws.json instead of the table")
     lw.add_argument("--format", choices=PLOT_FORMATS, default="png", help="figure format (default png)")
@@ -102,6 +119,46 @@ def _parser() -> argparse.ArgumentParser:
     pl.add_argument("folder", help="output folder of `pressplan solve`")
     pl.add_argument("--format", choices=PLOT_FORMATS, default="png", help="figure format (default png)")
     return ap
+
+
+def _version() -> str:
+    """The installed package's version (a source tree not installed: unknown)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("pressplan")
+    except PackageNotFoundError:
+        return "unknown (not installed)"
+
+
+def _case_argument(parser: argparse.ArgumentParser) -> None:
+    """The case file and ``--set FIELD=VALUE`` (repeatable): a case field replaced for this run."""
+    parser.add_argument("case", help="case file (YAML)")
+    parser.add_argument(
+        "--set",
+        action="append",
+        type=_setting,
+        default=[],
+        metavar="FIELD=VALUE",
+        help="replace a dotted case field for this run, e.g. --set limits.crank_jerk_rad_s3=2000 (repeatable)",
+    )
+
+
+def _setting(text: str) -> tuple[str, object]:
+    """An argparse type: ``FIELD=VALUE`` -> (dotted field, value read as a YAML scalar: 1.8, 2e3, free)."""
+    from planning.model.case_file import CaseFileError, load_yaml
+
+    field, sep, value = text.partition("=")
+    field = field.strip()
+    if not sep or not field or any(not part for part in field.split(".")):
+        raise argparse.ArgumentTypeError(f"expected FIELD=VALUE with a dotted case field, got {text!r}")
+    try:
+        parsed = load_yaml(value, f"--set {field}")
+    except CaseFileError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    if isinstance(parsed, (dict, list)):
+        raise argparse.ArgumentTypeError(f"--set {field}: one value, not a section or a list")
+    return field, parsed
 
 
 def _rate(text: str) -> float:
@@ -172,18 +229,34 @@ def main(argv: Sequence[str] | None = None) -> int:
         "laws": _laws,
         "plot": _plot,
         "serve": _serve,
+        "new": _new,
     }[args.command]
     try:
-        if args.command in ("plot", "serve"):
+        if args.command in ("plot", "serve", "new"):
             return command(args)
-        from planning.model.case_file import read_case
-
-        return command(read_case(args.case), args)
+        return command(_read(args), args)
     except Exception as exc:
         known = _exit_code(exc, getattr(args, "case", None))
         if known is None:
             raise
         return _fail(*known)
+
+
+def _read(args: argparse.Namespace):  # noqa: ANN202 - a Case (its module loads on use)
+    """The case of ``args.case`` with the ``--set`` fields; an error in a field set there says so."""
+    from planning.model.case_file import CaseFileError, read_case
+
+    overrides = dict(getattr(args, "set", None) or [])
+    if len(overrides) != len(getattr(args, "set", None) or []):
+        raise CommandError("--set: each field at most once")
+    try:
+        return read_case(args.case, overrides)
+    except CaseFileError as exc:
+        if exc.field is not None and any(
+            exc.field == f or exc.field.startswith(f + ".") or f.startswith(exc.field + ".") for f in overrides
+        ):
+            raise CaseFileError(f"{exc} (from --set)", exc.field) from None
+        raise
 
 
 def _fail(message: str, code: int) -> int:
@@ -217,9 +290,7 @@ def _solve(case, args) -> int:
     from planning.reports.report import result_dict, summary_text
     from planning.solver.optimize import solve
 
-    if args.law:
-        case = case.with_law(args.law)
-    case = _with_objective(case, args)
+    case = _with_objective(_with_law(case, args), args)
     out = _output_folder(case, args, SOLVE_FILES)
     solution = solve(case, args.placement)
     if not solution.verification.passed:  # solve() returns only verified plans; belt and braces
@@ -230,8 +301,29 @@ def _solve(case, args) -> int:
     return _write_and_report(out, writers, result, summary_text(result), args, SOLVE_FILES)
 
 
+def _with_law(case, args):  # noqa: ANN001, ANN202 - a Case and the parsed arguments
+    """The case under ``--law``; the refusal that does not depend on the case comes first (the optimal
+    law with an objective at a rate), then what the case lacks, named with the ``--set`` that adds it."""
+    from planning.model.case import CaseError
+
+    if args.law is None:
+        return case
+    objective = getattr(args, "objective", None)
+    if LAWS[args.law].free_profile and objective not in (None, "max-spm"):
+        raise CommandError(
+            f"--law {args.law}: the {args.law} law plans for the most strokes only; it takes no --objective "
+            f"{objective} (choose a law with halves, e.g. --law improved-s-curve)"
+        )
+    try:
+        return case.with_law(args.law)
+    except CaseError as exc:
+        add = f" (add it: --set {exc.field}=VALUE)" if exc.field.startswith("limits.") else ""
+        raise CommandError(f"{args.case}: --law {args.law}: {exc.line()}{add}") from None
+
+
 def _with_objective(case, args):  # noqa: ANN001, ANN202 - a Case and the parsed arguments
-    """The case with ``--objective`` and ``--spm`` applied; a rate without an objective at a rate is an error."""
+    """The case with ``--objective`` and ``--spm`` applied; a rate without an objective at a rate is an
+    error; a problem with what the user typed names the option (``--spm``), else the case's field."""
     from planning.model.case import CaseError
 
     objective = args.objective or case.planner.objective
@@ -242,6 +334,12 @@ def _with_objective(case, args):  # noqa: ANN001, ANN202 - a Case and the parsed
     try:
         return case.with_objective(args.objective, args.spm)
     except CaseError as exc:
+        if exc.field == "planner.target_spm" and args.objective is not None:
+            raise CommandError(
+                f"--objective {args.objective}: needs the line's rate: add --spm RATE (strokes/min)"
+            ) from None
+        if exc.field == "planner.objective" and args.objective is not None:
+            raise CommandError(f"{args.case}: --objective {args.objective}: {exc.message}") from None
         raise CommandError(f"{args.case}: {exc.line()}") from None
 
 
@@ -295,7 +393,7 @@ def _sweep(case, args) -> int:
         raise CommandError("--vary: each field at most once")
     out = Path(args.out)
     ensure_writable(out)
-    base = (case.with_law(args.law) if args.law else case).model_dump(exclude_none=True)
+    base = _with_law(case, args).model_dump(exclude_none=True)
     tty = sys.stderr.isatty()
 
     def progress(done: int, total: int, failed: int) -> None:
@@ -332,8 +430,7 @@ def _tradeoff(case, args) -> int:
     rates = parse_rates(args.spm)
     if case.drive is None:
         raise CommandError(f"{args.case}: drive: the trade-off weighs the motor: the case needs a drive: section")
-    if args.law:
-        case = case.with_law(args.law)
+    case = _with_law(case, args)
     objective = args.objective or (case.planner.objective if case.planner.objective != "max-spm" else "min-rms-torque")
     try:
         case = case.with_objective(objective, rates.start)
@@ -364,11 +461,18 @@ def _bound(case, args) -> int:
     else:
         print(
             f"{case.name}: time-optimal bound {bound.spm:.3f} strokes/min, cycle {bound.cycle_time_s:.4f} s "
-            f"({bound.points} intervals; peak crank speed {data['peak_crank_speed_rpm']:.2f} rpm, "
-            f"draw {bound.draw_speed_rpm:.3f} rpm, robot-window slack {bound.window_slack_s:.3f} s"
+            f"({bound.points} intervals{_more_than_asked(bound.points, args.points)}; peak crank speed "
+            f"{data['peak_crank_speed_rpm']:.2f} rpm, draw {bound.draw_speed_rpm:.3f} rpm, "
+            f"idle time in the robot's window {bound.window_slack_s:.3f} s"
             + (f"; crank jerk <= {bound.crank_jerk_limit_rad_s3:g} rad/s^3)" if bound.crank_jerk_limit_rad_s3 else ")")
         )
     return EXIT_OK
+
+
+def _more_than_asked(used: int, asked: int) -> str:
+    from planning.solver.bound import MIN_INTERVALS_PER_ARC
+
+    return f": at least {MIN_INTERVALS_PER_ARC} between key angles, more than the {asked} asked" if used > asked else ""
 
 
 def _laws(case, args) -> int:
@@ -390,6 +494,20 @@ def _laws(case, args) -> int:
         f"laws_overlay.{args.format}": lambda p: save(laws_figure(curves, title), p),
     }
     return _write_and_report(out, writers, data, laws_text(data), args, LAWS_FILES)
+
+
+def _new(args) -> int:
+    from planning.reports.new_case import write_new_case
+
+    path = Path(args.file)
+    if path.suffix.lower() not in (".yaml", ".yml"):
+        raise CommandError(f"{path}: a case file ends in .yaml")
+    try:
+        write_new_case(path, args.mechanism, args.drive)
+    except FileExistsError:
+        raise CommandError(f"{path}: exists already (choose another name; nothing was written)") from None
+    print(f"wrote {path}: a {args.mechanism} case{' with a drive' if args.drive else ''}. Next: pressplan check {path}")
+    return EXIT_OK
 
 
 def _plot(args) -> int:

@@ -28,6 +28,7 @@ import numpy as np
 from pydantic import BaseModel
 
 from planning.model.case import Case
+from planning.model.case_file import with_fields
 
 BLOCK_POINTS = 6
 ROW_FIELDS = ("spm", "cycle_time_s", "status", "binding", "solve_time_s", "message")
@@ -109,15 +110,8 @@ def grid(varies: list[Vary]) -> list[tuple[float, ...]]:
 
 
 def point_data(base: dict[str, Any], fields: list[str], values: tuple[float, ...]) -> dict[str, Any]:
-    """The case mapping of one grid point (a deep copy of ``base`` with the fields set)."""
-    data = json.loads(json.dumps(base))
-    for field, value in zip(fields, values, strict=True):
-        node = data
-        *parents, leaf = field.split(".")
-        for key in parents:
-            node = node.setdefault(key, {})
-        node[leaf] = value
-    return data
+    """The case mapping of one grid point (a copy of ``base`` with the fields set)."""
+    return with_fields(base, dict(zip(fields, values, strict=True)))
 
 
 def solve_block(

@@ -190,6 +190,23 @@ class Mechanism(ABC):
             self._angles_memo[float(h)] = out
         return out
 
+    def lowest_on_arc(self, start: float, end: float) -> tuple[float, float]:
+        """The slide's lowest position over the crank arc from ``start`` to ``end`` [rad from TDC, ``end >=
+        start``, through TDC when ``end`` passes 2 pi]: ``(height [mm], crank angle [rad, 0 ... 2 pi))``. The
+        arc's ends and the angles of the height grid inside it (BDC among them); between grid angles a
+        local dip of the slide can lie lower by at most ``max|h''| dtheta^2 / 8`` (never above: a height
+        found here is one the slide reaches)."""
+        grid, heights = self._height_grid
+        turns = np.arange(math.floor(start / TWO_PI), math.floor(end / TWO_PI) + 1) * TWO_PI
+        unrolled = (grid[None, :] + turns[:, None]).ravel()
+        inside = (unrolled > start) & (unrolled < end)
+        angles = np.concatenate([[start, end], unrolled[inside]])
+        h = np.concatenate(
+            [np.asarray(self.height(np.array([start, end])), dtype=float), np.tile(heights, len(turns))[inside]]
+        )
+        k = int(np.argmin(h))
+        return float(h[k]), float(angles[k] % TWO_PI)
+
     @cached_property
     def _angles_memo(self) -> dict[float, tuple[float, float]]:
         return {}

@@ -67,11 +67,12 @@ def write(folder: Path, names: list[str]) -> None:
 
 
 SOLVER_KEYS = {"iterations", "starts"}  # how a solve got there, not what it found
-KNOT_IN_TEXT = re.compile(r"\S+ \((?:0|100)% in\)")
+# a knot named the old way ("feed:accel4 (100% in)") or in words ("feed, 4th acceleration sub-segment, 100 % in")
+KNOT_IN_TEXT = re.compile(r"\S+ \((?:0|100)% in\)|\w+, (?:[\w -]+, )?(?:0|100) % in")
 # a point at a knot: the end of one segment is the next one's start. Two such labels are taken as the same
 # point; the key points' times are compared as numbers (result.json, the summary's table), so a label can
 # differ only in which side of the knot names the same instant
-KNOT = re.compile(r"^(\S+) \((0|100)% in\)$")
+KNOT = re.compile(r"^(\S+) \((0|100)% in\)$|^\w+, (?:[\w -]+, )?(0|100) % in$")
 
 
 def _strip(obj, renames: dict[str, str], path: str = ""):  # noqa: ANN001, ANN202 - JSON data

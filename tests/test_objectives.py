@@ -80,9 +80,7 @@ def test_at_the_fastest_rate_the_plan_is_the_fastest() -> None:
         sol = solve_at_rate(case, fastest=fast)
         assert sol.verification.passed
         assert abs(sol.plan.spm - fast.plan.spm) <= 1e-3 * fast.plan.spm
-        assert sol.drive.rms_motor_torque_Nm <= drive_figures(fast.plan.profile, case).rms_motor_torque_Nm * (
-            1 + 1e-12
-        )
+        assert sol.drive.rms_motor_torque_Nm <= drive_figures(fast.plan.profile, case).rms_motor_torque_Nm * (1 + 1e-12)
 
 
 @pytest.mark.parametrize(

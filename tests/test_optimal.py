@@ -69,7 +69,7 @@ def test_an_optimal_plan_is_smooth_and_complete(tmp_path: Path) -> None:
     result = json.loads((tmp_path / "result.json").read_text())
     assert result["motion_law"] == "optimal" and result["segment_count"] == len(result["segments"])
     assert result["half_durations_s"] is None
-    jerk = next(c for c in result["verification"]["checks"] if c["name"] == "|crank jerk| <= crank_jerk_rad_s3")
+    jerk = next(c for c in result["verification"]["checks"] if c["id"] == "crank_jerk")
     assert jerk["passed"] and jerk["value"] <= 40.0 * (1 + 1e-9)
     case = read_case(path).with_law("optimal")
     plan = solve(case).plan
@@ -90,7 +90,7 @@ def test_the_optimal_law_needs_a_jerk_limit(tmp_path: Path, capsys: pytest.Captu
     assert main(["solve", str(published), "--law", "optimal", "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err.strip()
     assert err == (
-        f"pressplan: {published}: limits.crank_jerk_rad_s3: the optimal law needs a crank-jerk limit "
-        "(the jerk it may use)"
+        f"pressplan: {published}: --law optimal: limits.crank_jerk_rad_s3: the optimal law needs a crank-jerk "
+        "limit (the jerk it may use) (add it: --set limits.crank_jerk_rad_s3=VALUE)"
     )
     assert not (tmp_path / "o").exists()

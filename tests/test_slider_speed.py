@@ -37,7 +37,7 @@ def test_it_binds_below_the_free_plans_peak(limit):
     sol = solve(case)
     check = sol.verification.check("slider_speed")
     assert sol.verification.passed and check is not None and check.binds
-    assert np.max(np.abs(trajectory(sol, case)[:, 6])) <= limit * (1 + 1e-6)  # the 1 ms trajectory
+    assert np.max(np.abs(trajectory(sol, case)["slider_speed_mm_s"])) <= limit * (1 + 1e-6)  # the 1 ms trajectory
     assert "slider_speed" in [c.id for c in sol.verification.binding()]
     assert sol.plan.spm < free.plan.spm
     bound = time_optimal_bound(case).spm

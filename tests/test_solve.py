@@ -49,7 +49,8 @@ def test_dense_grid_meets_every_limit(which, case, request):
     """Constraint checks straight from the written trajectory (<= 1 ms grid), not via verify()."""
     sol = request.getfixturevalue(which)
     tab = trajectory(sol, case)
-    t, th_deg, w_rpm, _, _, h, v, a = tab.T
+    t, th_deg, w_rpm = tab["time_s"], tab["crank_angle_deg"], tab["crank_speed_rpm"]
+    h, v, a = tab["slider_height_mm"], tab["slider_speed_mm_s"], tab["slider_accel_mm_s2"]
     assert np.max(np.diff(t)) <= 1e-3 + 1e-12
     assert th_deg[-1] - th_deg[0] == pytest.approx(360.0, abs=1e-9)
     assert np.max(np.abs(a)) <= case.limits.slider_accel_mm_s2 * (1 + 1e-6)

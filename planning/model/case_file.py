@@ -11,6 +11,7 @@ case can overflow.
 
 from __future__ import annotations
 
+import copy
 import difflib
 import re
 from pathlib import Path
@@ -81,11 +82,33 @@ class CaseFileError(ValueError):
         self.field = field
 
 
-def read_case(path: str | Path) -> Case:
-    """Read, parse and validate a case file; raises :class:`CaseFileError` with a one-line message."""
+def read_case(path: str | Path, overrides: dict[str, Any] | None = None) -> Case:
+    """Read, parse and validate a case file; raises :class:`CaseFileError` with a one-line message.
+    ``overrides``: dotted case fields and the values that replace the file's (``process.transfer_time_s``
+    -> 1.8), set before validation, so a value is checked as if the file held it."""
     path = Path(path)
     raw = _read_text(path)
-    return case_from_data(load_yaml(raw, str(path)), str(path))
+    data = load_yaml(raw, str(path))
+    if overrides:
+        data = with_fields(data, overrides, str(path))
+    return case_from_data(data, str(path))
+
+
+def with_fields(data: Any, overrides: dict[str, Any], label: str = "<case>") -> Any:
+    """A copy of the case mapping ``data`` with each dotted field of ``overrides`` set (sections made as
+    needed); :class:`CaseFileError` when a field's parent is a value, not a section."""
+    if not isinstance(data, dict):
+        return data
+    out = copy.deepcopy(data)
+    for field, value in overrides.items():
+        node = out
+        *parents, leaf = field.split(".")
+        for i, key in enumerate(parents):
+            node = node.setdefault(key, {})
+            if not isinstance(node, dict):
+                raise CaseFileError(f"{label}: {'.'.join(parents[: i + 1])}: is a value, not a section", field)
+        node[leaf] = value
+    return out
 
 
 def load_yaml(text: str, label: str = "<case>") -> Any:

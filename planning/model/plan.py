@@ -65,13 +65,14 @@ class Plan:
         return np.array([self.profile.time_at_angle(a) for a in self.key_angles])
 
     def segment_at(self, t: float) -> str:
-        """Where time ``t`` [s] lies: ``segment name (NN% in)``; a knot counts as the end of the earlier
-        segment (``feed:accel1 (100% in)`` is the knot where the second sub-segment starts), also when ``t``
+        """Where time ``t`` [s] lies, in words: ``stage, segment, NN % in`` (:func:`segment_in_words`); a knot
+        counts as the end of the earlier segment (``feed, 1st acceleration sub-segment, 100 % in`` is the
+        knot where the second sub-segment starts), also when ``t``
         lies within :data:`KNOT_TOL_S` after it (round-off)."""
         tk = self.profile.knot_times
         k = int(np.clip(np.searchsorted(tk, t - KNOT_TOL_S, side="left") - 1, 0, len(self.profile.segments) - 1))
         share = (t - tk[k]) / max(tk[k + 1] - tk[k], 1e-300)
-        return f"{self.profile.segments[k].name} ({100 * share:.0f}% in)"
+        return f"{segment_in_words(self.profile.segments[k].name)}, {100 * share:.0f} % in"
 
     def transfer_window(self) -> float:
         """Achieved time [s] from theta4 to theta1 through TDC."""
@@ -159,3 +160,27 @@ def params_from_numbers(values: dict[str, float], theta2: float, theta3: float, 
     """A numeric :class:`CycleParameters` of motion law ``law`` from the NLP variable values (inside units)."""
     keys = [f for f in CycleParameters.__dataclass_fields__ if f not in ("draw_start", "draw_end", "motion_law")]
     return CycleParameters(**{k: float(values[k]) for k in keys}, draw_start=theta2, draw_end=theta3, motion_law=law)
+
+
+SUB_SEGMENTS = {"accel": "acceleration", "decel": "deceleration"}
+
+
+def _ordinal(n: int) -> str:
+    return f"{n}{'th' if 10 <= n % 100 <= 20 else {1: 'st', 2: 'nd', 3: 'rd'}.get(n % 10, 'th')}"
+
+
+def segment_in_words(name: str) -> str:
+    """A segment's name (``stage:part``) as a press engineer reads it: ``feed:accel4`` -> ``feed, 4th
+    acceleration sub-segment``; ``feed:accel`` -> ``feed, acceleration``; ``draw:constant`` -> ``draw,
+    constant speed``; ``transfer:dwell`` -> ``transfer, constant speed``; the optimal law's ``transfer:24``
+    -> ``transfer, interval 24``."""
+    stage, _, part = name.partition(":")
+    if part.isdigit():
+        return f"{stage}, interval {part}"
+    if part in ("constant", "dwell"):
+        return f"{stage}, constant speed"
+    kind, number = part.rstrip("0123456789"), part[len(part.rstrip("0123456789")) :]
+    if kind in SUB_SEGMENTS:
+        words = SUB_SEGMENTS[kind]
+        return f"{stage}, {_ordinal(int(number))} {words} sub-segment" if number else f"{stage}, {words}"
+    return f"{stage}, {part}" if part else stage

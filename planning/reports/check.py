@@ -10,6 +10,7 @@ import numpy as np
 from planning.model.case import KEY_POINT_NAMES, RPM, Case
 from planning.model.limits import draw_speed_bounds, limits_of
 from planning.model.limits.base import Check, Draw
+from planning.model.limits.robot_window import radians_hint
 
 ROUND_OFF = 1e-9  # relative: a check at the highest draw speed sits on its limit up to floating-point round-off
 
@@ -48,7 +49,7 @@ def check_case(case: Case) -> dict[str, Any]:
             "down_share_pct": bdc / 3.6,
             # the dead centres in the mechanism's own crank angle (its maker's drawings, mechpress, presslink)
             "own_angle_origin": m.own_angle_origin,
-            "tdc_own_deg": math.degrees(m.tdc_own_angle),
+            "tdc_own_deg": round(math.degrees(m.tdc_own_angle), 9) + 0.0,  # no "-0.00" from round-off
             "bdc_own_deg": math.degrees(m.tdc_own_angle + m.bdc_angle) % 360.0,
         },
         "draw_speed_rpm": w2 / RPM,
@@ -62,9 +63,11 @@ def check_case(case: Case) -> dict[str, Any]:
 
 
 def warnings(case: Case) -> list[str]:
-    """What a press engineer should know before solving: a draw end (theta3) where the slide is still
-    below the die height, so the return cannot speed up until it has left the die zone."""
-    out = []
+    """What a press engineer should know before solving: key angles that look like radians; a draw end
+    (theta3) where the slide is still below the die height, so the return cannot speed up until it has
+    left the die zone."""
+    hint = radians_hint(case)
+    out = [hint.removeprefix("; ")] if hint else []
     m = case.machine
     die = case.limits.die_height_mm
     th3 = case.key_angles[2]
@@ -85,6 +88,7 @@ def _check(check: Check) -> dict[str, Any]:
     value, limit = float(check.value), float(check.limit)
     margin = limit - value if check.kind == "max" else value - limit
     return {
+        "id": check.id,
         "name": check.name,
         "value": value,
         "limit": limit,

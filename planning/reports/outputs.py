@@ -7,6 +7,8 @@ import json
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
+
 from planning.model.case import Case
 from planning.reports.cam_table import CAM_COLUMNS, DEFAULT_POINTS, cam_header, cam_table
 from planning.reports.folder import OutputError, write_json, write_table
@@ -35,7 +37,8 @@ def solution_writers(
     (``plot_format`` None: no figures); ``result``: the solution's :func:`result_dict` when the caller has
     it already."""
     result = result if result is not None else result_dict(solution, case)
-    traj = trajectory(solution, case)
+    columns = trajectory(solution, case)
+    traj = np.column_stack(list(columns.values()))
     cam = cam_table(solution.plan, cam_points)
     cam_head = cam_header(solution.plan, case.name, cam_points)
     writers: dict[str, Callable[[Path], None]] = {
@@ -51,7 +54,6 @@ def solution_writers(
     if plot_format:
         from planning.reports.plots import plot_files, save
 
-        columns = dict(zip(trajectory_columns(case), traj.T, strict=True))
         pub_cols = dict(zip(TRAJECTORY_COLUMNS, published.T, strict=True)) if published is not None else None
         for name, fig in plot_files(result, columns, pub_cols, plot_format).items():
             writers[name] = lambda p, fig=fig: save(fig, p)

@@ -57,10 +57,12 @@ def trajectory_columns(case: Case) -> tuple[str, ...]:
     return TRAJECTORY_COLUMNS + (DRIVE_COLUMNS if case.drive is not None else ())
 
 
-def trajectory(solution: Solution, case: Case, max_step: float = MAX_STEP_S) -> np.ndarray:
-    """One full cycle of the plan from TDC (see :func:`sample_profile`); first and last rows are one
-    period apart."""
-    return sample_profile(solution.plan.profile, case.machine, max_step, case)
+def trajectory(solution: Solution, case: Case, max_step: float = MAX_STEP_S) -> dict[str, np.ndarray]:
+    """One full cycle of the plan from TDC (see :func:`sample_profile`), one array per column of
+    ``trajectory.csv`` (:func:`trajectory_columns`: ``time_s``, ``crank_angle_deg``, ...,
+    ``slider_accel_mm_s2``, and the drive's with a drive); the first and last samples are one period apart."""
+    table = sample_profile(solution.plan.profile, case.machine, max_step, case)
+    return dict(zip(trajectory_columns(case), table.T, strict=True))
 
 
 def key_points(solution: Solution, case: Case) -> list[dict[str, Any]]:

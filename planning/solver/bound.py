@@ -77,7 +77,8 @@ class Bound:
 
 
 def angle_grid(case: Case, points: int) -> np.ndarray:
-    """Nodes [rad] from theta1 over one revolution, about ``points`` in all. Among them: the key angles,
+    """Nodes [rad] from theta1 over one revolution, ``points`` intervals in all (more only when ``points`` is
+    below :data:`MIN_INTERVALS_PER_ARC` per arc). Among them: the key angles,
     TDC, and the angles where the slide passes the die height, so that the die-height speed limit holds
     exactly where it starts and ends (between nodes it would be missed)."""
     th1, th2, th3, th4 = case.key_angles
@@ -89,11 +90,34 @@ def angle_grid(case: Case, points: int) -> np.ndarray:
     inside = sorted(a + two_pi if a <= th1 else a for a in breaks)
     inside = [a for a in inside if th1 + 1e-9 < a < th1 + two_pi - 1e-9]
     arcs = [th1, *sorted(set(inside)), th1 + two_pi]
+    spans = np.diff(arcs)
     nodes = [np.array([th1])]
-    for a, b in zip(arcs[:-1], arcs[1:], strict=True):
-        n = max(4, int(round(points * (b - a) / (2 * math.pi))))
+    for a, b, n in zip(arcs[:-1], arcs[1:], _apportion(points, spans / two_pi), strict=True):
         nodes.append(np.linspace(a, b, n + 1)[1:])
     return np.concatenate(nodes)
+
+
+MIN_INTERVALS_PER_ARC = 4  # between neighbouring breaks (key angles, TDC, die-height crossings)
+
+
+def _apportion(points: int, shares: np.ndarray) -> list[int]:
+    """``points`` intervals shared among arcs in proportion to ``shares`` (summing to 1), each at least
+    :data:`MIN_INTERVALS_PER_ARC`, by the largest remainders: exactly ``points`` in all unless the minimum
+    per arc needs more."""
+    ideal = points * shares
+    counts = np.maximum(MIN_INTERVALS_PER_ARC, np.floor(ideal)).astype(int)
+    spare = points - int(counts.sum())
+    if spare > 0:
+        order = np.argsort(-(ideal - np.floor(ideal)), kind="stable")
+        counts[order[:spare]] += 1  # spare < len(shares): each floor lost less than one interval
+    elif spare < 0:  # the minimum per arc took more: give it back from the largest arcs
+        for k in np.argsort(-counts, kind="stable"):
+            give = min(-spare, counts[k] - MIN_INTERVALS_PER_ARC)
+            counts[k] -= give
+            spare += give
+            if spare == 0:
+                break
+    return counts.tolist()
 
 
 def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:

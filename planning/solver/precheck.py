@@ -32,7 +32,7 @@ def precheck(case: Case) -> tuple[float, float]:
         key = min(bounds, key=bounds.get)
         raise Infeasible(
             f"{BY_ID[key].field} ({BY_ID[key].name}) allows a draw speed of at most "
-            f"{highest / RPM:.3f} rpm, below min_crank_speed_rpm = {case.limits.min_crank_speed_rpm:g}",
+            f"{highest / RPM:.3f} rpm, below limits.min_crank_speed_rpm = {case.limits.min_crank_speed_rpm:g}",
             limit="limits.min_crank_speed_rpm",
             value=case.limits.min_crank_speed_rpm,
             needed=highest / RPM,

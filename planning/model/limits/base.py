@@ -82,10 +82,10 @@ class Check:
         return self.kind in ("max", "min") and abs(self.margin) <= BINDING_SHARE * max(abs(self.limit), 1e-12)
 
     def as_dict(self) -> dict:
-        """The check as ``result.json`` writes it (display name, value, limit, unit, kind, passed, margin)."""
+        """The check as ``result.json`` writes it (stable id, display name, value, limit, unit, kind, passed,
+        margin): a script finds a check by its ``id``, the name is for people."""
         out = asdict(self)
-        del out["id"]
-        return {**out, "margin": self.margin}
+        return {"id": out.pop("id"), **out, "margin": self.margin}
 
 
 class Row(NamedTuple):

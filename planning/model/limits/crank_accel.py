@@ -15,7 +15,7 @@ class CrankAccelLimit(Limit):
     S-curve), at a free profile's knots (it is piecewise linear there), on the bound's intervals."""
 
     id = "crank_accel"
-    name = "|crank acceleration| <= crank_accel_rad_s2"
+    name = "|crank acceleration| <= limits.crank_accel_rad_s2"
     unit = "rad/s^2"
     field = "limits.crank_accel_rad_s2"
     order = 60

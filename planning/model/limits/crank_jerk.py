@@ -18,7 +18,7 @@ class CrankJerkLimit(Limit):
     at least the interval's time it relaxes the jerk limit, and the bound stays an upper bound)."""
 
     id = "crank_jerk"
-    name = "|crank jerk| <= crank_jerk_rad_s3"
+    name = "|crank jerk| <= limits.crank_jerk_rad_s3"
     unit = "rad/s^3"
     field = "limits.crank_jerk_rad_s3"
     order = 70

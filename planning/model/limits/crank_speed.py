@@ -16,7 +16,7 @@ class CrankSpeedLimit(Limit):
     samples; a bound on the draw speed and on the bound's speeds."""
 
     id = "crank_speed"
-    name = "crank speed <= crank_speed_rpm"
+    name = "crank speed <= limits.crank_speed_rpm"
     unit = "rpm"
     field = "limits.crank_speed_rpm"
     order = 50

@@ -71,7 +71,7 @@ class DieSpeedLimit(Limit):
         lim = draw.case.limits
         bound = self.draw_speed_bound(draw)
         value = lim.die_speed_mm_s * speed / bound if math.isfinite(bound) else 0.0
-        name = f"slider speed at or below {lim.die_height_mm:g} mm <= die_speed_mm_s"
+        name = f"slider speed at or below {lim.die_height_mm:g} mm <= limits.die_speed_mm_s"
         return [Check.of(self.id, name, value, lim.die_speed_mm_s, self.unit, "max", 0.0)]
 
     def parameter_values(self, case: Any) -> dict[str, float]:

@@ -28,7 +28,9 @@ class DrawStartSpeedLimit(Limit):
         limit = draw.case.limits.draw_start_speed_mm_s
         v = abs(float(draw.d1[0])) * speed
         return [
-            Check.of(self.id, "slider speed at draw start <= draw_start_speed_mm_s", v, limit, self.unit, "max", 0.0)
+            Check.of(
+                self.id, "slider speed at draw start <= limits.draw_start_speed_mm_s", v, limit, self.unit, "max", 0.0
+            )
         ]
 
     def check(self, dense: Dense) -> list[Check]:

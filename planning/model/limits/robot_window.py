@@ -46,9 +46,9 @@ class TransferTimeLimit(Limit):
         if window / w_min >= case.process.transfer_time_s:
             return None
         return Impossible(
-            f"transfer_time_s = {case.process.transfer_time_s:g} cannot be met: at min_crank_speed_rpm = "
-            f"{case.limits.min_crank_speed_rpm:g} the crank crosses the {math.degrees(window):.1f} deg from "
-            f"theta4 to theta1 in at most {window / w_min:.3f} s",
+            f"process.transfer_time_s = {case.process.transfer_time_s:g} cannot be met: at "
+            f"limits.min_crank_speed_rpm = {case.limits.min_crank_speed_rpm:g} the crank crosses the "
+            f"{math.degrees(window):.1f} deg from theta4 to theta1 in at most {window / w_min:.3f} s",
             self.field,
             case.process.transfer_time_s,
             window / w_min,
@@ -91,14 +91,31 @@ class SafetyHeightLimit(Limit):
                 )
 
     def at_draw_speed(self, draw: Draw, speed: float) -> list[Check]:
+        """The lowest slide position over the whole window theta4 -> TDC -> theta1, not only its ends."""
         case = draw.case
-        th1, _, _, th4 = case.key_angles
-        h = case.machine.height(np.array([th1, th4]))
+        lowest, angle = lowest_in_window(case)
+        th1, _, _, th4 = (math.degrees(a) for a in case.key_angles)
+        name = (
+            f"lowest slider height from opening {th4:g} deg through TDC to closing {th1:g} deg "
+            f"(at {math.degrees(angle):.1f} deg) >= safety height"
+        )
+        return [Check.of(self.id, name, lowest, case.process.safety_height_mm, self.unit, "min", 0.0)]
+
+    def precheck(self, case: Any, given: float | None, lowest: float) -> Impossible | None:
+        """The slide's path is fixed by the key angles: a window whose arc dips below the safety height
+        cannot be met by any motion (a window that passes BDC: key angles in radians, as a rule)."""
+        low, angle = lowest_in_window(case)
         safety = case.process.safety_height_mm
-        return [
-            Check.of(self.id, f"slider height at {where} >= safety height", height, safety, self.unit, "min", 0.0)
-            for where, height in (("closing", h[0]), ("opening", h[1]))
-        ]
+        if low >= safety:
+            return None
+        k = case.key_points
+        reason = (
+            f"key_points.opening_deg = {k.opening_deg:g} and key_points.closing_deg = {k.closing_deg:g}: from "
+            f"opening through TDC to closing the crank turns {k.closing_deg + 360 - k.opening_deg:.1f} deg and "
+            f"the slide goes down to {low:.1f} mm at {math.degrees(angle):.1f} deg, below {self.field} = "
+            f"{safety:g}; the robot's window must stay above it{radians_hint(case)}"
+        )
+        return Impossible(reason, "key_points", k.opening_deg, None, math.degrees(angle))
 
     def check(self, dense: Dense) -> list[Check]:
         t1, _, _, t4 = dense.key_times
@@ -108,3 +125,24 @@ class SafetyHeightLimit(Limit):
         ends = dense.case.machine.height(np.array([th1, th4]))  # the window's ends, exactly (not a grid point)
         lowest = float(min(np.min(dense.h[window], initial=np.inf), np.min(ends)))
         return [Check.of(self.id, self.name, lowest, safety, self.unit, "min", REL_TOL * safety)]
+
+
+def lowest_in_window(case: Any) -> tuple[float, float]:
+    """The slide's lowest position over the robot's window, theta4 -> TDC -> theta1: ``(height [mm],
+    crank angle [rad])``."""
+    th1, _, _, th4 = case.key_angles
+    return case.machine.lowest_on_arc(th4, th1 + 2 * math.pi)
+
+
+RADIANS_HINT_DEG = 2 * math.pi  # [deg] key angles all below this were likely written in radians
+
+
+def radians_hint(case: Any) -> str:
+    """``"; the key angles look like radians (...)"`` when every key angle is below 2 pi degrees (the whole
+    cycle in a few degrees of crank), else ``""``."""
+    angles = [getattr(case.key_points, f) for f in ("closing_deg", "draw_start_deg", "draw_end_deg", "opening_deg")]
+    if max(angles) >= RADIANS_HINT_DEG:
+        return ""
+    given = ", ".join(f"{a:g}" for a in angles)
+    meant = ", ".join(f"{math.degrees(a):.1f}" for a in angles)
+    return f"; the key angles look like radians: {given} rad are {meant} deg"

@@ -47,7 +47,7 @@ class SliderAccelLimit(Limit):
     def at_draw_speed(self, draw: Draw, speed: float) -> list[Check]:
         limit = draw.case.limits.slider_accel_mm_s2
         value = limit * (speed / self.draw_speed_bound(draw)) ** 2
-        name = "|slider acceleration| during the draw <= slider_accel_mm_s2"
+        name = "|slider acceleration| during the draw <= limits.slider_accel_mm_s2"
         return [Check.of(self.id, name, value, limit, self.unit, "max", 0.0)]
 
     def precheck(self, case: Any, given: float | None, lowest: float) -> Impossible | None:
@@ -60,7 +60,7 @@ class SliderAccelLimit(Limit):
         a_draw = limit * (given / bound) ** 2
         return Impossible(
             f"at the draw speed {case.process.draw_speed_rpm:g} rpm the slider acceleration in the draw reaches "
-            f"{a_draw:.0f} mm/s^2 > slider_accel_mm_s2 = {limit:g}",
+            f"{a_draw:.0f} mm/s^2 > limits.slider_accel_mm_s2 = {limit:g}",
             self.field,
             limit,
             a_draw,

@@ -50,7 +50,13 @@ class SliderSpeedLimit(Limit):
         fastest = float(np.max(np.abs(draw.d1))) * speed
         return [
             Check.of(
-                self.id, "|slider speed| during the draw <= slider_speed_mm_s", fastest, limit, self.unit, "max", 0.0
+                self.id,
+                "|slider speed| during the draw <= limits.slider_speed_mm_s",
+                fastest,
+                limit,
+                self.unit,
+                "max",
+                0.0,
             )
         ]
 
@@ -63,7 +69,7 @@ class SliderSpeedLimit(Limit):
         limit = case.limits.slider_speed_mm_s
         return Impossible(
             f"at the draw speed {case.process.draw_speed_rpm:g} rpm the slider moves at up to "
-            f"{limit * given / bound:.1f} mm/s in the draw > slider_speed_mm_s = {limit:g}",
+            f"{limit * given / bound:.1f} mm/s in the draw > limits.slider_speed_mm_s = {limit:g}",
             self.field,
             limit,
             limit * given / bound,

@@ -1,0 +1,194 @@
+"""``pressplan new``: a first case file, commented field by field, that passes ``check`` and solves.
+
+One template per mechanism (its press section, key angles where that press reaches the usual heights,
+a process and limits that suit it) and, with a drive, the drive section of a press of that size. The
+figures are the shipped examples' (``cases/``): a starting point to edit, not a recommendation.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+MECHANISMS = ("crank-slider", "link-drive", "knuckle-joint")
+
+_HEAD = """\
+# {name}: a pressplan case. Edit the numbers for your press and process, then
+#   pressplan check {path}     (the key points and the limits at the draw speed, no solve)
+#   pressplan solve {path}     (the fastest verified cycle, written to out/{name}/)
+# Units are in the key names: mm, deg, s, rpm, mm/s, mm/s^2, kN, kg, N m. Crank angles count from top dead
+# centre (TDC) in the direction of rotation; heights from bottom dead centre (BDC), upward.
+name: {name}
+title: {title}
+"""
+
+_PRESS = {
+    "crank-slider": """\
+press:
+  mechanism: crank-slider
+  crank_radius_mm: 450               # half the stroke
+  rod_length_mm: 1200                # crank pin to the slide's pin
+  offset_mm: 0                       # the slide's line to the side of the crank axis (0: in line)
+key_points:                          # crank angle from TDC [deg], in this order
+  closing_deg: 66                    # theta1: the slide passes the robot's safety height going down
+  draw_start_deg: 131.5              # theta2: the upper die meets the blank; the draw starts
+  draw_end_deg: 195                  # theta3: the draw ends (BDC is at 180 deg on an in-line press)
+  opening_deg: 294                   # theta4: the slide is back above the safety height
+process:
+  safety_height_mm: 700              # the slide stays at or above this while the robot moves a part
+  transfer_time_s: 2.0               # the robot needs at least this long from theta4 to theta1
+  # draw_speed_rpm: 6.7              # a fixed crank speed for the draw; leave out to let the limits choose
+limits:
+  draw_start_speed_mm_s: 300         # the slide's speed when the die meets the blank, at most
+  die_height_mm: 10                  # at and below this height ...
+  die_speed_mm_s: 80                 # ... the slide moves slower than this
+  slider_accel_mm_s2: 3500           # |slide acceleration| everywhere, at most
+  # crank_speed_rpm: 30              # optional: the crank's top speed, acceleration, jerk, the slide's top
+  # crank_accel_rad_s2: 10           #   speed anywhere (slider_speed_mm_s); the optimal law needs a jerk
+  # crank_jerk_rad_s3: 60            #   limit
+""",
+    "link-drive": """\
+press:
+  mechanism: link-drive              # a six-bar link drive; sketch and letters: docs/link-drive.svg
+  link_drive:
+    crank_radius_mm: 235             # (a) the eccentric
+    ternary_rocker_side_mm: 720      # (b) ternary link, crank pin to the rocker's joint
+    rocker_mm: 810                   # (c)
+    rocker_pivot_x_mm: 1060          # (d) the rocker's pivot at (-d, -f) from the crank centre
+    rocker_pivot_y_mm: 340           # (f)
+    ternary_angle_deg: 134           # (tht) between the ternary link's two sides
+    ternary_rod_side_mm: 1060        # (m) ternary link, crank pin to the connecting rod's joint
+    rod_length_mm: 1060              # (g) connecting rod to the slide
+    slide_offset_mm: 0               # (h)
+key_points:                          # crank angle from this press's TDC [deg] (`check` prints where BDC is)
+  closing_deg: 56                    # theta1: the slide passes the robot's safety height going down
+  draw_start_deg: 143.5              # theta2: the upper die meets the blank; the draw starts
+  draw_end_deg: 233                  # theta3: the draw ends (BDC is at 220.9 deg on this press)
+  opening_deg: 316.3                 # theta4: the slide is back above the safety height
+process:
+  safety_height_mm: 700              # the slide stays at or above this while the robot moves a part
+  transfer_time_s: 2.0               # the robot needs at least this long from theta4 to theta1
+limits:
+  draw_start_speed_mm_s: 300         # the slide's speed when the die meets the blank, at most
+  die_height_mm: 10                  # at and below this height ...
+  die_speed_mm_s: 80                 # ... the slide moves slower than this
+  slider_accel_mm_s2: 3500           # |slide acceleration| everywhere, at most
+""",
+    "knuckle-joint": """\
+press:
+  mechanism: knuckle-joint           # a knuckle-joint (toggle) press; sketch and letters: docs/knuckle-joint.svg
+  knuckle_joint:
+    crank_radius_mm: 205             # (a)
+    rod_length_mm: 1010              # (b) crank pin to the knuckle
+    rocker_mm: 910                   # (c) the upper link, from its pivot to the knuckle
+    rocker_pivot_x_mm: 800           # (d) the upper link's pivot at (d, e) from the crank centre
+    rocker_pivot_y_mm: 810           # (e)
+    main_rod_mm: 910                 # (g) knuckle to the slide
+    slide_offset_mm: 0               # (h) the slide's line, to the side of the pivot
+key_points:                          # crank angle from this press's TDC [deg] (`check` prints where BDC is)
+  closing_deg: 49                    # theta1: the slide passes the transfer's safety height going down
+  draw_start_deg: 127.8              # theta2: the die closes on the blank
+  draw_end_deg: 216                  # theta3: the part is struck and released (BDC at 179.9 deg)
+  opening_deg: 307                   # theta4: the slide is back above the safety height
+process:
+  safety_height_mm: 120              # the slide stays at or above this while the transfer moves
+  transfer_time_s: 0.8               # the transfer needs at least this long from theta4 to theta1
+limits:
+  draw_start_speed_mm_s: 60          # the slide's speed when the die meets the blank, at most
+  die_height_mm: 2                   # at and below this height ...
+  die_speed_mm_s: 40                 # ... the slide moves slower than this
+  slider_accel_mm_s2: 10000          # |slide acceleration| everywhere, at most
+""",
+}
+
+_PLANNER = """\
+planner:
+  motion_law: improved-s-curve       # or seven-segment, quintic, cycloidal, logistic, optimal (`pressplan laws`)
+  placement: free                    # free: the motion may pass theta1/theta4 anywhere in its stages
+"""
+
+_FORCE = {
+    "crank-slider": "  forming_force_kN: [[200, 0], [180, 4500], [60, 6000], [10, 4000], [0, 1500]]",
+    "link-drive": "  forming_force_kN: [[200, 0], [180, 4500], [60, 6000], [10, 4000], [0, 1500]]",
+    "knuckle-joint": "  forming_force_kN: [[2.8, 0], [1.5, 800], [0.6, 3000], [0.2, 5200], [0, 6000]]",
+}
+
+_DRIVE = {
+    "crank-slider": """\
+drive:                               # the motor and what it moves; with it the plan keeps the motor's limits
+  slide_mass_kg: 65000               # slide and upper die
+  rod_mass_kg: 8000                  # the connecting rods
+  rod_cg_from_crank_pin_mm: 480      # the rods' centre of gravity, from the crank pin
+  crank_inertia_kg_m2: 30000         # crankshaft, eccentrics and bull gears
+  counterbalance_kN: 600             # air cylinders carrying the slide and die
+  gear_ratio: 30                     # motor turns per crank turn
+  gear_efficiency: 0.93
+  motor_inertia_kg_m2: 8             # the motors and their pinions, about the motor axis
+  motor:                             # the servo motors together
+    peak_torque_Nm: 72000
+    rated_torque_Nm: 20000           # the RMS torque over a cycle stays at or below this
+    base_speed_rpm: 500
+    max_speed_rpm: 1000
+""",
+    "link-drive": """\
+drive:                               # the motor and what it moves; with it the plan keeps the motor's limits
+  slide_mass_kg: 40000               # slide and upper die
+  crank_inertia_kg_m2: 12000         # eccentric shaft and bull gears
+  counterbalance_kN: 390             # air cylinders carrying the slide and die
+  gear_ratio: 25                     # motor turns per crank turn
+  gear_efficiency: 0.93
+  motor_inertia_kg_m2: 5             # the motors and their pinions, about the motor axis
+  links:                             # each link's mass, centre of gravity (from its first joint toward its
+                                     # second, and to the left) and inertia about it
+    ternary: {mass_kg: 3000, cg_along_mm: 0, cg_across_mm: 250, inertia_kg_m2: 350}
+    rocker: {mass_kg: 1800, cg_along_mm: 405, inertia_kg_m2: 110}
+    rod: {mass_kg: 2200, cg_along_mm: 480, inertia_kg_m2: 220}
+  motor:                             # the servo motors together
+    peak_torque_Nm: 50000
+    rated_torque_Nm: 20000           # the RMS torque over a cycle stays at or below this
+    base_speed_rpm: 500
+    max_speed_rpm: 1000
+""",
+    "knuckle-joint": """\
+drive:                               # the motor and what it moves; with it the plan keeps the motor's limits
+  slide_mass_kg: 12000               # slide and upper die
+  crank_inertia_kg_m2: 800           # crankshaft and bull gear
+  counterbalance_kN: 115             # air cylinders carrying the slide and die
+  gear_ratio: 12                     # motor turns per crank turn
+  gear_efficiency: 0.93
+  motor_inertia_kg_m2: 1.5           # the motor and its pinion
+  links:                             # each link's mass, centre of gravity (from its first joint toward its
+                                     # second) and inertia about it
+    rod: {mass_kg: 1200, cg_along_mm: 450, inertia_kg_m2: 100}
+    rocker: {mass_kg: 1500, cg_along_mm: 455, inertia_kg_m2: 110}
+    main_rod: {mass_kg: 1500, cg_along_mm: 455, inertia_kg_m2: 110}
+  motor:
+    peak_torque_Nm: 15000
+    rated_torque_Nm: 5000            # the RMS torque over a cycle stays at or below this
+    base_speed_rpm: 1000
+    max_speed_rpm: 2000
+""",
+}
+
+TITLES = {
+    "crank-slider": "Deep drawing on a 450/1200 mm crank servo press",
+    "link-drive": "Deep drawing on a six-bar link-drive servo press",
+    "knuckle-joint": "Coining on a knuckle-joint servo press",
+}
+
+
+def new_case_text(name: str, path: str, mechanism: str = "crank-slider", drive: bool = False) -> str:
+    """The text of a first case for ``mechanism`` (one of :data:`MECHANISMS`), with a drive section when
+    ``drive``; ``name`` is the case's name, ``path`` where it is written (for the commands in its head)."""
+    text = _HEAD.format(name=name, path=path, title=TITLES[mechanism]) + _PRESS[mechanism]
+    if drive:  # the forming force the motor works against, in the process section
+        force = "  # the forming force against the slide's height above BDC [mm, kN]\n" + _FORCE[mechanism] + "\n"
+        text = text.replace("limits:\n", force + "limits:\n", 1)
+    return text + _PLANNER + (_DRIVE[mechanism] if drive else "")
+
+
+def write_new_case(path: Path, mechanism: str = "crank-slider", drive: bool = False) -> None:
+    """Write :func:`new_case_text` to ``path`` (named after the file); never over an existing file
+    (``FileExistsError``)."""
+    text = new_case_text(path.stem, str(path), mechanism, drive)
+    with path.open("x", encoding="utf-8") as f:
+        f.write(text)
