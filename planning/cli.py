@@ -506,7 +506,8 @@ def _new(args) -> int:
         write_new_case(path, args.mechanism, args.drive)
     except FileExistsError:
         raise CommandError(f"{path}: exists already (choose another name; nothing was written)") from None
-    print(f"wrote {path}: a {args.mechanism} case{' with a drive' if args.drive else ''}. Next: pressplan check {path}")
+    kind = f"a {args.mechanism} case{' with a drive' if args.drive else ''}"
+    print(f"{path}: {kind}, commented field by field, to edit. Next: pressplan check {path}")
     return EXIT_OK
 
 

@@ -1,4 +1,4 @@
-"""Rewrite the SPM-against-jerk-limit table of the optimal law in README.md.
+"""Rewrite the SPM-against-jerk-limit table of the optimal law in docs/results.md.
 
     python scripts/readme_jerk.py
 

@@ -1,4 +1,4 @@
-"""Rewrite the law-comparison table in README.md from `pressplan laws` on the published case.
+"""Rewrite the law-comparison table in docs/results.md from `pressplan laws` on the published case.
 
     python scripts/readme_laws.py
 

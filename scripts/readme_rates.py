@@ -1,4 +1,4 @@
-"""Rewrite the at-the-line's-rate table in README.md and the trade-off figures in docs/.
+"""Rewrite the at-the-line's-rate table in docs/rates.md and the trade-off figures in docs/.
 
     python scripts/readme_rates.py
 

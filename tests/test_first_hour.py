@@ -94,7 +94,7 @@ def test_a_new_case_passes_check_and_solves(mechanism, drive, tmp_path, capsys):
     path = tmp_path / "my-press.yaml"
     assert main(["new", str(path), "--mechanism", mechanism, *(["--drive"] if drive else [])]) == 0
     text = path.read_text()
-    assert "Next: pressplan check" in capsys.readouterr().out
+    assert capsys.readouterr().out.startswith(f"{path}: a {mechanism} case")
     assert f"mechanism: {mechanism}" in text and ("\ndrive:" in text) == drive and "name: my-press" in text
     assert main(["check", str(path), "--json"]) == 0
     report = yaml.safe_load(capsys.readouterr().out)
@@ -248,3 +248,16 @@ def test_trajectory_has_named_columns(case, free_solution):
     assert tuple(table) == trajectory_columns(case)
     assert table["crank_angle_deg"][-1] - table["crank_angle_deg"][0] == pytest.approx(360.0)
     assert max(abs(table["slider_accel_mm_s2"])) <= case.limits.slider_accel_mm_s2 * (1 + 1e-6)
+
+
+def test_compare_says_undecided_where_the_printed_digits_decide_nothing():
+    """The angle swept by the rebuilt published profile can be off by 168 deg within the printed digits:
+    that check decides nothing and says so, instead of 'ok'."""
+    from planning.model.case_file import read_case
+    from planning.reports.source_solution import consistency
+
+    checks = {c.name: c for c in consistency(read_case(CASES / "wang2023-side-panel.yaml"))}
+    swept = checks["angle swept by the rebuilt profile"]
+    assert swept.consistent and swept.allowance > 90 and swept.verdict == "undecided"
+    assert checks["T9 (draw time)"].verdict == "consistent"
+    assert checks["x3 (return peak)"].verdict == "inconsistent"

@@ -150,7 +150,7 @@ def test_every_law_solves_every_case(path, law):
 
 def test_laws_command_and_the_readme_table(tmp_path, capsys):
     """`pressplan laws` on the published case: a verified row per law, all below the bound, the files
-    written; the README's table is this command's laws.md (numbers within their printed digits)."""
+    written; the table in docs/results.md is this command's laws.md (numbers within their printed digits)."""
     from planning.cli import main
 
     from .conftest import PUBLISHED_CASE, ROOT
@@ -161,7 +161,7 @@ def test_laws_command_and_the_readme_table(tmp_path, capsys):
     rows = {r["law"]: r for r in data["laws"]}
     assert set(rows) == set(LAWS) and all(r["status"] == "verified" for r in rows.values())
     assert all(r["spm"] <= data["bound"]["spm"] for r in rows.values())
-    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    readme = (ROOT / "docs" / "results.md").read_text(encoding="utf-8")
     block = readme.split("<!-- laws:begin -->")[1].split("<!-- laws:end -->")[0]
     printed = {cells[0]: cells for cells in _table_rows(block)}
     fresh = {cells[0]: cells for cells in _table_rows((tmp_path / "laws.md").read_text(encoding="utf-8"))}
@@ -170,7 +170,7 @@ def test_laws_command_and_the_readme_table(tmp_path, capsys):
         for a, b in zip(cells[1:], printed[name][1:], strict=True):
             if a.replace(".", "").isdigit():
                 unit = 10.0 ** -len(a.split(".")[1]) if "." in a else 1.0
-                assert abs(float(a) - float(b)) <= unit, (name, a, b)  # the last printed digit may differ by 1
+                assert abs(float(a) - float(b)) <= unit * (1 + 1e-9), (name, a, b)  # the last digit may differ by 1
             else:
                 assert a == b
 

@@ -24,13 +24,8 @@ def limited():
 def test_motor_limits_hold_on_the_dense_grid(limited):
     case, sol = limited
     lim = case.limits
-    names = {c.name: c for c in sol.verification.checks}
-    for name in (
-        "crank speed <= crank_speed_rpm",
-        "|crank acceleration| <= crank_accel_rad_s2",
-        "|crank jerk| <= crank_jerk_rad_s3",
-    ):
-        assert names[name].passed
+    for limit_id in ("crank_speed", "crank_accel", "crank_jerk"):
+        assert sol.verification.check(limit_id).passed
     t = np.linspace(0, sol.plan.period, 20001)
     _, om, al, je = sol.plan.profile.at_time(t)
     assert om.max() * 60 / (2 * np.pi) <= lim.crank_speed_rpm * (1 + 1e-6)

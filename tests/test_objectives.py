@@ -46,7 +46,7 @@ def test_cli_objective_errors_are_one_line_exit_2(tmp_path: Path, capsys: pytest
     out = str(tmp_path / "out")
     assert main(["solve", str(CUP), "--objective", "min-energy", "--out", out]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "planner.target_spm" in err
+    assert len(err.splitlines()) == 1 and "--objective min-energy" in err and "--spm" in err
     assert main(["solve", str(CUP), "--spm", "20", "--out", out]) == 2
     assert "--spm" in capsys.readouterr().err
     assert main(["tradeoff", str(CASES / "small-fast-cup.yaml"), "--spm", "10:20:3", "--out", out]) == 2

@@ -40,8 +40,8 @@ def test_free_placement_beats_the_published_structure(free_solution, published_s
     assert plan.spm >= FREE_SPM_MIN
     assert plan.spm >= published_solution.plan.spm - 1e-9
     assert free_solution.verification.passed
-    assert plan.structure["closing"].startswith("feed:")
-    assert plan.structure["opening"].startswith("return:")
+    assert plan.structure["closing"].startswith("feed, ")
+    assert plan.structure["opening"].startswith("return, ")
 
 
 @pytest.mark.parametrize("which", ["published_solution", "free_solution"])

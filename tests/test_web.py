@@ -151,7 +151,7 @@ def test_a_bad_value_shows_the_cli_line_next_to_the_field(page, tmp_path: Path) 
 def test_an_infeasible_case_shows_the_limit(page) -> None:
     edit(page, "process.transfer_time_s", "60")
     status = page.locator("#status").inner_text()
-    assert status.startswith(f"{LABEL}: infeasible: transfer_time_s = 60 cannot be met")
+    assert status.startswith(f"{LABEL}: infeasible: process.transfer_time_s = 60 cannot be met")
     assert status.endswith("(the limit: process.transfer_time_s)")
     assert "cannot be met" in page.locator('.msg[data-for="process.transfer_time_s"]').inner_text()
 

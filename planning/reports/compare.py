@@ -162,7 +162,7 @@ def comparison_markdown(data: dict[str, Any]) -> str:
         "|---|---|---:|---:|---:|---:|---|---|",
     ]
     for c in data["published_consistency"]:
-        verdict = "consistent" if c["consistent"] else "**inconsistent**"
+        verdict = "**inconsistent**" if c["verdict"] == "inconsistent" else c["verdict"]
         lines.append(
             f"| {c['name']} | {c['unit']} | {_fmt(c['printed'])} | {_fmt(c['recomputed'])} | "
             f"{c['difference']:+.4f} | {c['allowance']:.4f} | {verdict} | {c['formula']} |"
@@ -193,16 +193,18 @@ def comparison_text(data: dict[str, Any]) -> str:
             f"  {r['symbol']:<9} {r['unit']:<8} {_fmt(r['published'], 3):>10} {_fmt(r['ours_published']):>10} "
             f"{_fmt(r['ours_free']):>10}"
         )
-    bad = [c for c in data["published_consistency"] if not c["consistent"]]
+    checks = data["published_consistency"]
+    counts = {v: sum(c["verdict"] == v for c in checks) for v in ("inconsistent", "undecided")}
     out += [
         "",
-        f"  published solution checked against itself: {len(bad)} inconsistent of {len(data['published_consistency'])}",
+        f"  the published solution checked against itself: {counts['inconsistent']} of {len(checks)} quantities "
+        f"inconsistent, {counts['undecided']} undecided (their printed digits allow more than a quarter of the value)",
     ]
-    for c in data["published_consistency"]:
-        mark = "ok " if c["consistent"] else "BAD"
+    for c in checks:
         out.append(
-            f"  {mark} {c['name']:<36} printed {c['printed']:9.4f} recomputed {c['recomputed']:9.4f} "
-            f"({c['difference']:+.4f} {c['unit']}, digits allow {c['allowance']:.4f}) from {c['formula']}"
+            f"  {c['verdict'].upper() if c['verdict'] == 'inconsistent' else c['verdict']:<12} {c['name']:<36} "
+            f"printed {c['printed']:9.4f} recomputed {c['recomputed']:9.4f} ({c['difference']:+.4f} {c['unit']}; "
+            f"the printed digits allow ±{c['allowance']:.4f}) from {c['formula']}"
         )
     for k, v in data["derived"].items():
         out.append(f"  {k}: {v:.3f}")

@@ -1,7 +1,9 @@
 """Figures of a solved plan, drawn from its files (``result.json``, ``trajectory.csv`` and, when the
 case has a published solution, ``published_profile.csv``). Headless: matplotlib's Agg canvas, no
-pyplot. Two figures, each with the paper's three result plots stacked (Figs. 7, 8, 9): one against
-time from TDC, one against crank angle. Key points marked, limits dashed, stages shaded."""
+pyplot. Two motion figures, one against time from TDC, one against crank angle: the paper's three result
+plots (Figs. 7, 8, 9) and the crank jerk, every limit of the case dashed where it applies and named by
+its field, the robot's window and the draw shaded, the key points as ticks above. Legends stand outside
+the panels, so they never hide a curve."""
 
 from __future__ import annotations
 
@@ -13,13 +15,10 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-STAGE_COLOURS = {"transfer": "#d9ecff", "feed": "#fff2cc", "draw": "#e2f0d9", "return": "#fde2e2"}
-KEY_LABELS = {
-    "closing": "θ1 closing",
-    "draw_start": "θ2 draw start",
-    "draw_end": "θ3 draw end",
-    "opening": "θ4 opening",
-}
+WINDOW_COLOUR, DRAW_COLOUR = "#d9ecff", "#e2f0d9"  # the robot's window, the draw
+KEY_TICKS = {"closing": "θ1", "draw_start": "θ2", "draw_end": "θ3", "opening": "θ4"}
+LEGEND_RIGHT = 0.66  # the panels end here; their legends stand right of them
+LEGEND_ANCHOR = (1.09, 1.0)  # a legend's top left corner, in its panel's axes fraction (past the twin's label)
 PLOT_FORMATS = ("png", "svg", "pdf")
 FIGURES = ("motion_vs_time", "motion_vs_angle")
 
@@ -45,57 +44,79 @@ def read_table(path: Path) -> dict[str, np.ndarray]:
     return {name: data[:, i] for i, name in enumerate(header)}
 
 
-def _stages(result: dict[str, Any], axis: str) -> list[tuple[str, float, float]]:
-    """(stage, start, end) spans in time [s] or crank angle [deg], merged over neighbouring segments."""
-    spans: list[tuple[str, float, float]] = []
-    for seg in result["segments"]:
-        stage = seg["name"].split(":")[0]
-        if axis == "time":
-            a, b = seg["start_time_s"], seg["start_time_s"] + seg["duration_s"]
-        else:
-            a, b = seg["start_angle_deg"], seg["end_angle_deg"]
-        if spans and spans[-1][0] == stage:
-            spans[-1] = (stage, spans[-1][1], b)
-        else:
-            spans.append((stage, a, b))
-    return spans
+def _windows(result: dict[str, Any], axis: str, x: np.ndarray) -> list[tuple[float, float]]:
+    """The robot's window theta4 -> TDC -> theta1 as spans of the x axis (time [s] or crank angle [deg]):
+    from theta4 to the cycle's end and from its start to theta1."""
+    keys = {k["name"]: k for k in result["key_points"]}
+    at = "time_s" if axis == "time" else "angle_deg"
+    return [(keys["opening"][at], float(x[-1])), (float(x[0]), keys["closing"][at])]
 
 
-def _decorate(ax, result: dict[str, Any], axis: str, label_stages: bool) -> None:
-    for stage, a, b in _stages(result, axis):
-        ax.axvspan(a, b, color=STAGE_COLOURS.get(stage, "#eeeeee"), alpha=0.6, lw=0, zorder=0)
-        if label_stages and b > a:
-            ax.text(
-                (a + b) / 2,
-                0.97,
-                stage,
-                transform=ax.get_xaxis_transform(),
-                ha="center",
-                va="top",
-                fontsize=8,
-                color="#555555",
-                style="italic",
-            )
+def _in_spans(x: np.ndarray, spans: list[tuple[float, float]]) -> np.ndarray:
+    return np.any([(x >= a) & (x <= b) for a, b in spans], axis=0)
+
+
+def _decorate(ax, result: dict[str, Any], axis: str, x: np.ndarray, label: bool) -> None:
+    """The robot's window shaded (its achieved time written once), the draw shaded, the key points as
+    dotted lines."""
+    window = result.get("transfer_window_s")
+    required = result.get("process", {}).get("transfer_time_s")
+    text = f"robot window θ4 → θ1: {window:.3f} s" + (f" (≥ {required:g} s)" if required is not None else "")
+    for i, (a, b) in enumerate(_windows(result, axis, x)):
+        ax.axvspan(a, b, color=WINDOW_COLOUR, alpha=0.7, lw=0, zorder=0, label=text if label and i == 0 else None)
+    keys = {k["name"]: k for k in result["key_points"]}
+    at = "time_s" if axis == "time" else "angle_deg"
+    ax.axvspan(
+        keys["draw_start"][at],
+        keys["draw_end"][at],
+        color=DRAW_COLOUR,
+        alpha=0.7,
+        lw=0,
+        zorder=0,
+        label="draw θ2 → θ3" if label else None,
+    )
     for k in result["key_points"]:
-        x = k["time_s"] if axis == "time" else k["angle_deg"]
-        ax.axvline(x, color="#444444", lw=0.8, ls=":", zorder=1)
+        ax.axvline(k[at], color="#444444", lw=0.8, ls=":", zorder=1)
     ax.grid(True, lw=0.3, alpha=0.6)
 
 
-def _key_labels(ax, result: dict[str, Any], axis: str) -> None:
-    for k in result["key_points"]:
-        x = k["time_s"] if axis == "time" else k["angle_deg"]
-        ax.text(
-            x,
-            0.02,
-            " " + KEY_LABELS.get(k["name"], k["name"]),
-            transform=ax.get_xaxis_transform(),
-            rotation=90,
-            fontsize=7.5,
-            va="bottom",
-            ha="right",
-            color="#333333",
-        )
+def _key_ticks(ax, result: dict[str, Any], axis: str) -> None:
+    """theta1 ... theta4 as ticks of a second x axis above the panel: never over the data."""
+    at = "time_s" if axis == "time" else "angle_deg"
+    top = ax.secondary_xaxis("top")
+    top.set_xticks([k[at] for k in result["key_points"]])
+    top.set_xticklabels([KEY_TICKS.get(k["name"], k["name"]) for k in result["key_points"]], fontsize=8)
+    top.tick_params(length=3)
+
+
+def _limit(
+    ax,  # noqa: ANN001 - a matplotlib Axes
+    x: np.ndarray,
+    value: float | np.ndarray,
+    label: str,
+    colour: str,
+    where: np.ndarray | None = None,
+    both: bool = False,
+) -> None:
+    """A limit drawn as a dashed line over the x where it applies (``where``; None: everywhere), at
+    +value (and -value when ``both``; ``value`` a number or one per x), labelled once for the legend."""
+    for sign in (1, -1) if both else (1,):
+        y = sign * np.broadcast_to(np.asarray(value, dtype=float), np.shape(x)).copy()
+        if where is not None:
+            y[~where] = np.nan
+        ax.plot(x, y, color=colour, ls="--", lw=1.0, label=label if sign == 1 else None, zorder=2)
+
+
+def _legend(ax, *axes, anchor: tuple[float, float] = LEGEND_ANCHOR) -> None:  # noqa: ANN001 - matplotlib Axes
+    """One legend for a panel and its twins, outside the axes to the right (never over the data)."""
+    handles, labels = [], []
+    for a in (ax, *axes):
+        h, lab = a.get_legend_handles_labels()
+        handles += h
+        labels += lab
+    ax.legend(
+        handles, labels, loc="upper left", bbox_to_anchor=anchor, borderaxespad=0.0, fontsize=7.5, framealpha=0.95
+    )
 
 
 MAX_POINTS = 2000  # per plotted line: beyond this a 1 ms trajectory adds nothing visible
@@ -112,12 +133,15 @@ def _thin(table: dict[str, np.ndarray] | None) -> dict[str, np.ndarray] | None:
 
 
 def _overlay(ax, x, published: dict[str, np.ndarray] | None, column: str, colour: str, alpha: float) -> None:
-    """The rebuilt published solution, dashed, when there is one."""
+    """The rebuilt published solution, dotted (limits are dashed), when there is one."""
     if published is not None:
-        ax.plot(x, published[column], color=colour, lw=1.0, ls="--", alpha=alpha, label="published solution (rebuilt)")
+        ax.plot(x, published[column], color=colour, lw=1.2, ls=":", alpha=alpha, label="published solution (rebuilt)")
 
 
 def _figure(result, traj, published, axis: str) -> Figure:
+    """Four panels against time or crank angle: slide height and crank speed; crank acceleration; crank
+    jerk; slide speed and acceleration. Every limit the case sets is a dashed line over the part of the
+    cycle where it applies, named by its case field in the legend; the legends sit right of the panels."""
     traj, published = _thin(traj), _thin(published)
     lim = result.get("limits", {})
     proc = result.get("process", {})
@@ -125,66 +149,116 @@ def _figure(result, traj, published, axis: str) -> Figure:
     xp = None
     if published is not None:
         xp = published["time_s"] if axis == "time" else published["crank_angle_deg"]
+    paper = published is not None  # the paper's figure numbers only beside the paper's own solution
     xlabel = "time from TDC [s]" if axis == "time" else "crank angle from TDC [deg]"
-    fig = Figure(figsize=(11, 10.5), dpi=90)
-    fig.subplots_adjust(left=0.08, right=0.91, top=0.93, bottom=0.06, hspace=0.22)
+    fig = Figure(figsize=(13.5, 13), dpi=80)
+    fig.subplots_adjust(left=0.07, right=LEGEND_RIGHT, top=0.93, bottom=0.05, hspace=0.3)
     FigureCanvasAgg(fig)
-    axes = fig.subplots(3, 1, sharex=True)
+    axes = fig.subplots(4, 1, sharex=True)
     title = (
         f"{result['case']}: {result['spm']:.2f} strokes/min, cycle {result['cycle_time_s']:.3f} s "
         f"({result['motion_law']}, {result['placement']} placement, {result['status']})"
     )
     fig.suptitle(title, fontsize=11)
+    window = _in_spans(x, _windows(result, axis, x))
+    height = traj["slider_height_mm"]
 
-    # (a) Fig. 7: slider height and crank speed
+    # (a) slide height and crank speed
     ax = axes[0]
-    _decorate(ax, result, axis, True)
-    ax.plot(x, traj["slider_height_mm"], color="tab:blue", lw=1.6, label="slider height")
-    for name, val in (("safety height", proc.get("safety_height_mm")), ("die height", lim.get("die_height_mm"))):
-        if val is not None:
-            ax.axhline(val, color="tab:blue", ls="--", lw=0.9)
-            ax.text(x[-1], val, f" {name} {val:g} mm", fontsize=7.5, va="bottom", ha="right", color="tab:blue")
-    ax.set_ylabel("slider height above BDC [mm]", color="tab:blue")
+    _decorate(ax, result, axis, x, True)
+    _key_ticks(ax, result, axis)
+    ax.plot(x, height, color="tab:blue", lw=1.6, label="slide height")
+    safety = proc.get("safety_height_mm")
+    if safety is not None:
+        _limit(ax, x, safety, f"process.safety_height_mm = {safety:g} mm (robot window)", "tab:blue", window)
+    die = lim.get("die_height_mm")
+    if die is not None:
+        _limit(ax, x, die, f"limits.die_height_mm = {die:g} mm", "#5b8cc0")
+    ax.set_ylabel("slide height above BDC [mm]", color="tab:blue")
     ax2 = ax.twinx()
-    ax2.plot(x, traj["crank_speed_rpm"], color="tab:red", lw=1.6, label="crank speed")
+    speed = traj["crank_speed_rpm"]
+    ax2.plot(x, speed, color="tab:red", lw=1.6, label="crank speed")
     _overlay(ax2, xp, published, "crank_speed_rpm", "tab:red", 0.7)
+    top = lim.get("crank_speed_rpm")
+    if top is not None:
+        _limit(ax2, x, top, f"limits.crank_speed_rpm = {top:g} rpm", "#8b0000")
+    low = lim.get("min_crank_speed_rpm")
+    if low is not None:
+        _limit(ax2, x, low, f"limits.min_crank_speed_rpm = {low:g} rpm", "#e07070")
     ax2.set_ylabel("crank speed [rpm]", color="tab:red")
-    ax2.set_ylim(bottom=0)
-    h1, l1 = ax.get_legend_handles_labels()
-    h2, l2 = ax2.get_legend_handles_labels()
-    ax.legend(h1 + h2, l1 + l2, loc="center left", fontsize=8, framealpha=0.9)
-    ax.set_title("slider height and crank speed (paper Fig. 7)", fontsize=9, loc="left")
-    _key_labels(ax, result, axis)
+    ax2.set_ylim(0, 1.1 * max(float(np.max(speed)), top or 0.0))
+    _legend(ax, ax2)
+    ax.set_title("slide height and crank speed" + (" (paper Fig. 7)" if paper else ""), fontsize=9, loc="left")
 
-    # (b) Fig. 8: crank acceleration
+    # (b) crank acceleration
     ax = axes[1]
-    _decorate(ax, result, axis, False)
-    ax.plot(x, traj["crank_accel_rad_s2"], color="tab:purple", lw=1.6, label="crank acceleration")
+    _decorate(ax, result, axis, x, False)
+    accel = traj["crank_accel_rad_s2"]
+    ax.plot(x, accel, color="tab:purple", lw=1.6, label="crank acceleration")
     _overlay(ax, xp, published, "crank_accel_rad_s2", "tab:purple", 0.7)
+    a_crank = lim.get("crank_accel_rad_s2")
+    if a_crank is not None:
+        _limit(ax, x, a_crank, f"limits.crank_accel_rad_s2 = ±{a_crank:g} rad/s²", "#4b0082", both=True)
     ax.axhline(0, color="black", lw=0.6)
     ax.set_ylabel("crank acceleration [rad/s²]")
-    ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
-    ax.set_title("crank acceleration (paper Fig. 8)", fontsize=9, loc="left")
+    _legend(ax)
+    ax.set_title("crank acceleration" + (" (paper Fig. 8)" if paper else ""), fontsize=9, loc="left")
 
-    # (c) Fig. 9: slider speed and acceleration
+    # (c) crank jerk
     ax = axes[2]
-    _decorate(ax, result, axis, False)
-    ax.plot(x, traj["slider_speed_mm_s"], color="tab:green", lw=1.6, label="slider speed (up +)")
-    ax.set_ylabel("slider speed [mm/s]", color="tab:green")
+    _decorate(ax, result, axis, x, False)
+    ax.plot(x, traj["crank_jerk_rad_s3"], color="tab:brown", lw=1.2, label="crank jerk")
+    j_crank = lim.get("crank_jerk_rad_s3")
+    if j_crank is not None:
+        _limit(ax, x, j_crank, f"limits.crank_jerk_rad_s3 = ±{j_crank:g} rad/s³", "#5c3317", both=True)
+    ax.axhline(0, color="black", lw=0.6)
+    ax.set_ylabel("crank jerk [rad/s³]")
+    _legend(ax)
+    ax.set_title("crank jerk", fontsize=9, loc="left")
+
+    # (d) slide speed and acceleration
+    ax = axes[3]
+    _decorate(ax, result, axis, x, False)
+    ax.plot(x, traj["slider_speed_mm_s"], color="tab:green", lw=1.6, label="slide speed (up +)")
+    die_speed = lim.get("die_speed_mm_s")
+    if die_speed is not None and die is not None:
+        _limit(
+            ax,
+            x,
+            die_speed,
+            f"limits.die_speed_mm_s = ±{die_speed:g} mm/s (below the die height)",
+            "#006400",
+            height <= die,
+            both=True,
+        )
+    v_top = lim.get("slider_speed_mm_s")
+    if v_top is not None:
+        _limit(ax, x, v_top, f"limits.slider_speed_mm_s = ±{v_top:g} mm/s", "#2e8b57", both=True)
+    v2 = lim.get("draw_start_speed_mm_s")
+    if v2 is not None:
+        keys = {k["name"]: k for k in result["key_points"]}
+        at = keys["draw_start"]["time_s" if axis == "time" else "angle_deg"]
+        ax.plot(
+            [at, at],
+            [-v2, v2],
+            ls="none",
+            marker="_",
+            ms=14,
+            mew=2.2,
+            color="#006400",
+            label=f"limits.draw_start_speed_mm_s = ±{v2:g} mm/s (at θ2)",
+        )
+    ax.set_ylabel("slide speed [mm/s]", color="tab:green")
     ax2 = ax.twinx()
-    ax2.plot(x, traj["slider_accel_mm_s2"], color="tab:orange", lw=1.6, label="slider acceleration")
+    ax2.plot(x, traj["slider_accel_mm_s2"], color="tab:orange", lw=1.6, label="slide acceleration")
     a_lim = lim.get("slider_accel_mm_s2")
     if a_lim is not None:
-        for sign in (1, -1):
-            ax2.axhline(sign * a_lim, color="tab:orange", ls="--", lw=0.9)
-        ax2.text(x[-1], a_lim, f"±{a_lim:g} mm/s² limit ", fontsize=7.5, va="top", ha="right", color="tab:orange")
+        _limit(ax2, x, a_lim, f"limits.slider_accel_mm_s2 = ±{a_lim:g} mm/s²", "#cc5500", both=True)
         ax2.set_ylim(-1.15 * a_lim, 1.15 * a_lim)
     _overlay(ax2, xp, published, "slider_accel_mm_s2", "tab:orange", 0.6)
-    ax2.set_ylabel("slider acceleration [mm/s²]", color="tab:orange")
-    h1, l1 = ax.get_legend_handles_labels()
-    h2, l2 = ax2.get_legend_handles_labels()
-    ax.legend(h1 + h2, l1 + l2, loc="lower left", fontsize=8, framealpha=0.9)
-    ax.set_title("slider speed and acceleration (paper Fig. 9)", fontsize=9, loc="left")
+    ax2.set_ylabel("slide acceleration [mm/s²]", color="tab:orange")
+    _legend(ax, ax2)
+    ax.set_title("slide speed and acceleration" + (" (paper Fig. 9)" if paper else ""), fontsize=9, loc="left")
 
     axes[-1].set_xlabel(xlabel)
     axes[-1].set_xlim(x[0], x[-1])
@@ -215,6 +289,7 @@ def drive_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
     motor = d["motor"]
     t = _thin(traj)
     fig = Figure(figsize=(12, 8.5), layout="constrained")
+    FigureCanvasAgg(fig)
     grid = fig.add_gridspec(2, 2, width_ratios=(1, 1.35))
     plane = fig.add_subplot(grid[:, 0])
     n_top = max(motor["max_speed_rpm"], float(np.max(np.abs(t["motor_speed_rpm"])))) * 1.05
@@ -240,22 +315,27 @@ def drive_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
     plane.set_ylabel("motor torque [kN m]")
     plane.set_title("torque-speed plane (all motors)")
     plane.grid(True, lw=0.3, alpha=0.6)
-    plane.legend(fontsize=8, loc="lower right")
+    plane.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.09), ncol=2)
     torque = fig.add_subplot(grid[0, 1])
     power = fig.add_subplot(grid[1, 1], sharex=torque)
     x = t["crank_angle_deg"]
-    for ax, label_stages in ((torque, True), (power, False)):
-        _decorate(ax, result, "angle", label_stages)
+    for ax, label in ((torque, True), (power, False)):
+        _decorate(ax, result, "angle", x, label)
+    _key_ticks(torque, result, "angle")
     torque.plot(x, t["motor_torque_Nm"] / 1e3, color="#1f77b4", lw=1.4, label="motor torque")
-    _plus_minus(torque, motor["peak_torque_Nm"] / 1e3, "peak torque", color="#b22222", lw=1.0, ls="--")
+    speed = np.abs(t["motor_speed_rpm"])
+    at_speed = motor["peak_torque_Nm"] * np.minimum(1.0, motor["base_speed_rpm"] / np.maximum(speed, 1e-9)) / 1e3
+    envelope_label = "drive.motor.peak_torque_Nm: the envelope at the motor's speed"
+    _limit(torque, x, at_speed, envelope_label, "#b22222", both=True)  # falls above the base speed
+    rated = motor["rated_torque_Nm"] / 1e3
+    _limit(torque, x, rated, f"drive.motor.rated_torque_Nm = {rated:g} kN m (RMS limit)", "#e08000", both=True)
     torque.set_ylabel("motor torque [kN m]")
-    torque.legend(fontsize=8, loc="lower left")
+    _legend(torque)
     power.plot(x, t["motor_power_kW"], color="#2ca02c", lw=1.4, label="motor power (drawn > 0)")
     power.axhline(0.0, color="#444444", lw=0.6)
     power.set_ylabel("motor power [kW]")
     power.set_xlabel("crank angle from TDC [deg]")
-    power.legend(fontsize=8, loc="lower left")
-    _key_labels(power, result, "angle")
+    _legend(power)
     fig.suptitle(
         f"{result['case']}: the drive at {result['spm']:.3f} strokes/min\n"
         f"peak {d['peak_motor_torque_Nm'] / 1e3:.1f} kN m "
@@ -271,39 +351,72 @@ def save(fig: Figure, path: Path) -> None:
 
 
 def sweep_figure(rows: list[dict[str, Any]], fields: list[str], title: str) -> Figure:
-    """SPM against the swept field (one field) or a heat map of SPM (two fields); failed points shown."""
-    fig = Figure(figsize=(9, 6), dpi=90)
+    """SPM against the swept field (one field: the points without a verified plan as red crosses on a row
+    of their own below the curve) or a heat map of SPM (two fields: each cell's SPM written in it, the
+    cells without a plan hatched); legends outside the data."""
+    from matplotlib.patches import Patch, Rectangle
+
+    fig = Figure(figsize=(10, 6.5), dpi=90)
     FigureCanvasAgg(fig)
-    ax = fig.subplots()
     spm = np.array([float(r["spm"]) if r.get("spm") not in ("", None) else np.nan for r in rows])
     ok = np.array([r.get("status") == "verified" for r in rows])
     if len(fields) == 1:
+        ax, fails = fig.subplots(2, 1, sharex=True, height_ratios=(1, 0.08))
+        fig.subplots_adjust(right=0.75, hspace=0.08)
         x = np.array([float(r[fields[0]]) for r in rows])
         ax.plot(x[ok], spm[ok], "o-", color="tab:blue", ms=4, lw=1.4, label="verified plan")
-        if (~ok).any():
-            ax.plot(
-                x[~ok],
-                np.full((~ok).sum(), np.nanmin(spm) if ok.any() else 0.0),
-                "x",
-                color="tab:red",
-                label="no verified plan",
-            )
-        ax.set_xlabel(fields[0])
+        fails.plot(x[~ok], np.zeros((~ok).sum()), "x", color="tab:red", ms=7, mew=1.5, label="no verified plan")
+        fails.set_yticks([])
+        fails.set_ylabel("failed", rotation=0, ha="right", va="center", fontsize=8)
+        fails.set_xlabel(fields[0])
         ax.set_ylabel("strokes per minute")
         ax.grid(True, lw=0.3)
-        ax.legend(fontsize=9)
+        fails.grid(True, axis="x", lw=0.3)
+        _legend(ax, fails, anchor=(1.02, 1.0))
     else:
+        ax = fig.subplots()
+        fig.subplots_adjust(right=0.78)
         xs = sorted({float(r[fields[0]]) for r in rows})
         ys = sorted({float(r[fields[1]]) for r in rows})
         z = np.full((len(ys), len(xs)), np.nan)
-        for r, v in zip(rows, spm, strict=True):
-            z[ys.index(float(r[fields[1]])), xs.index(float(r[fields[0]]))] = v
+        for r, v, good in zip(rows, spm, ok, strict=True):
+            z[ys.index(float(r[fields[1]])), xs.index(float(r[fields[0]]))] = v if good else np.nan
         mesh = ax.pcolormesh(xs, ys, z, shading="nearest", cmap="viridis")
         fig.colorbar(mesh, ax=ax, label="strokes per minute")
+        dx = (xs[1] - xs[0]) if len(xs) > 1 else 1.0
+        dy = (ys[1] - ys[0]) if len(ys) > 1 else 1.0
+        small = len(xs) * len(ys) <= MAX_CELL_LABELS
+        for i, yv in enumerate(ys):
+            for j, xv in enumerate(xs):
+                if np.isnan(z[i, j]):
+                    ax.add_patch(
+                        Rectangle((xv - dx / 2, yv - dy / 2), dx, dy, fill=False, hatch="xx", lw=0, edgecolor="tab:red")
+                    )
+                elif small:
+                    bright = (z[i, j] - np.nanmin(z)) > 0.6 * (np.nanmax(z) - np.nanmin(z))
+                    ax.text(
+                        xv,
+                        yv,
+                        f"{z[i, j]:.2f}",
+                        ha="center",
+                        va="center",
+                        fontsize=7,
+                        color="black" if bright else "white",
+                    )
+        ax.legend(
+            handles=[Patch(fill=False, hatch="xx", edgecolor="tab:red", label="no verified plan")],
+            loc="upper left",
+            bbox_to_anchor=(1.25, 1.0),
+            borderaxespad=0.0,
+            fontsize=8,
+        )
         ax.set_xlabel(fields[0])
         ax.set_ylabel(fields[1])
     ax.set_title(title, fontsize=10)
     return fig
+
+
+MAX_CELL_LABELS = 400  # a heat map writes each cell's SPM up to this many cells
 
 
 def laws_figure(curves: dict[str, dict[str, np.ndarray]], title: str) -> Figure:
@@ -321,18 +434,22 @@ def laws_figure(curves: dict[str, dict[str, np.ndarray]], title: str) -> Figure:
     bottom.set_xlim(0.0, 360.0)
     for ax in (top, bottom):
         ax.grid(True, lw=0.3)
-    top.legend(fontsize=8, ncol=3)
+    fig.subplots_adjust(right=0.8)
+    _legend(top, anchor=(1.02, 1.0))
     top.set_title(title, fontsize=10)
     return fig
 
 
 def tradeoff_figure(rows: list[dict[str, Any]], case: Any, title: str) -> Figure:
     """The motor-sizing picture: RMS and peak motor torque against SPM with the motor's rated and peak
-    torque as lines (top), energy from the supply per stroke against SPM (bottom); optimised plans solid,
-    the baseline (the max-SPM plan with the spare time given to the transfer) dashed."""
-    fig = Figure(figsize=(9, 7.5), dpi=90)
+    torque as lines (top), energy from the supply per stroke against SPM on an axis around the data
+    (middle), and what the optimised plan saves against the baseline, in % (bottom); optimised plans
+    solid, the baseline (the max-SPM plan with the spare time given to the transfer) dashed; a rate
+    without a plan as a red line. Legends right of the panels."""
+    fig = Figure(figsize=(12, 10), dpi=90)
+    fig.subplots_adjust(left=0.08, right=0.68, top=0.94, bottom=0.07, hspace=0.25)
     FigureCanvasAgg(fig)
-    top, bottom = fig.subplots(2, 1, sharex=True)
+    top, middle, bottom = fig.subplots(3, 1, sharex=True)
     ok = [r for r in rows if r.get("status") == "verified"]
     spm = np.array([float(r["target_spm"]) for r in ok])
 
@@ -343,7 +460,7 @@ def tradeoff_figure(rows: list[dict[str, Any]], case: Any, title: str) -> Figure
     curves = (  # axis, column, scale, marker, colour, label; each optimised (solid) and baseline (dashed)
         (top, "rms_motor_torque_Nm", 1e-3, "o", "tab:blue", "RMS"),
         (top, "peak_motor_torque_Nm", 1e-3, "s", "tab:orange", "peak"),
-        (bottom, "supply_energy_kJ", 1.0, "o", "tab:green", ""),
+        (middle, "supply_energy_kJ", 1.0, "o", "tab:green", "energy"),
     )
     for ax, name, unit, marker, colour, what in curves if ok else ():
         for prefix, style, label in (
@@ -351,26 +468,29 @@ def tradeoff_figure(rows: list[dict[str, Any]], case: Any, title: str) -> Figure
             ("baseline_", dict(lw=1, ms=3, mfc="none"), "baseline"),
         ):
             ls = "-" if not prefix else "--"
-            ax.plot(
-                spm,
-                column(prefix + name) * unit,
-                marker + ls,
-                color=colour,
-                label=", ".join(filter(None, (what, label))),
-                **style,
-            )
-    top.axhline(motor.rated_torque_Nm / 1e3, color="tab:blue", lw=1, ls=":", label="rated torque")
-    top.axhline(motor.peak_torque_Nm / 1e3, color="tab:orange", lw=1, ls=":", label="peak torque")
+            ax.plot(spm, column(prefix + name) * unit, marker + ls, color=colour, label=f"{what}, {label}", **style)
+    for name, marker, colour, what in (
+        ("rms_motor_torque_Nm", "o", "tab:blue", "RMS torque"),
+        ("supply_energy_kJ", "o", "tab:green", "energy per stroke"),
+    ):
+        if ok:
+            saving = 100.0 * (1.0 - column(name) / column("baseline_" + name))
+            bottom.plot(spm, saving, marker + "-", color=colour, lw=1.5, ms=4, label=f"{what} saved")
+    bottom.axhline(0.0, color="#444444", lw=0.6)
+    top.axhline(motor.rated_torque_Nm / 1e3, color="tab:blue", lw=1, ls=":", label="drive.motor.rated_torque_Nm")
+    top.axhline(motor.peak_torque_Nm / 1e3, color="tab:orange", lw=1, ls=":", label="drive.motor.peak_torque_Nm")
     failed = [float(r["target_spm"]) for r in rows if r.get("status") != "verified"]
-    for x in failed:
-        top.axvline(x, color="tab:red", lw=0.8, alpha=0.5)
+    for ax in (top, middle, bottom):
+        for i, x in enumerate(failed):
+            ax.axvline(x, color="tab:red", lw=0.8, alpha=0.6, label="no plan at this rate" if i == 0 else None)
     top.set_ylabel("motor torque [kN m]")
     top.set_ylim(bottom=0)
-    bottom.set_ylabel("energy from the supply per stroke [kJ]")
-    bottom.set_xlabel("strokes per minute" + (" (red: no plan at this rate)" if failed else ""))
-    bottom.set_ylim(bottom=0)
-    for ax in (top, bottom):
+    middle.set_ylabel("energy from the supply\nper stroke [kJ]")
+    middle.margins(y=0.15)  # around the data: the difference between the curves is the point
+    bottom.set_ylabel("saved against\nthe baseline [%]")
+    bottom.set_xlabel("strokes per minute")
+    for ax in (top, middle, bottom):
         ax.grid(True, lw=0.3)
-        ax.legend(fontsize=8, ncol=3)
+        _legend(ax, anchor=(1.02, 1.0))
     top.set_title(title, fontsize=10)
     return fig

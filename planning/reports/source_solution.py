@@ -35,6 +35,9 @@ def half_unit(value: float) -> float:
     return 0.5 * 10.0 ** (-decimals)
 
 
+UNDECIDED_SHARE = 0.25  # a check whose printed digits allow more than this share of the value decides nothing
+
+
 @dataclass(frozen=True)
 class Consistency:
     """One published quantity against its value recomputed from other published quantities."""
@@ -57,8 +60,20 @@ class Consistency:
             return self.difference >= -self.allowance - 1e-12
         return abs(self.difference) <= self.allowance + 1e-12
 
+    @property
+    def verdict(self) -> str:
+        """``inconsistent`` (the difference is beyond what the printed digits allow), ``undecided`` (it is
+        within, but the digits allow more than :data:`UNDECIDED_SHARE` of the value: the check says
+        nothing), else ``consistent``."""
+        if not self.consistent:
+            return "inconsistent"
+        if self.allowance > UNDECIDED_SHARE * abs(self.printed):
+            return "undecided"
+        return "consistent"
+
     def as_dict(self) -> dict:
         return {
+            "verdict": self.verdict,
             "name": self.name,
             "printed": self.printed,
             "recomputed": self.recomputed,

@@ -115,7 +115,7 @@ class SafetyHeightLimit(Limit):
             f"the slide goes down to {low:.1f} mm at {math.degrees(angle):.1f} deg, below {self.field} = "
             f"{safety:g}; the robot's window must stay above it{radians_hint(case)}"
         )
-        return Impossible(reason, "key_points", k.opening_deg, None, math.degrees(angle))
+        return Impossible(reason, "key_points.opening_deg", k.opening_deg, None, math.degrees(angle))
 
     def check(self, dense: Dense) -> list[Check]:
         t1, _, _, t4 = dense.key_times

@@ -1,0 +1,151 @@
+"""Write every command output shown in README.md and docs/*.md from a fresh run of that command.
+
+A block in a page is
+
+    <!-- output: pressplan check my-press.yaml -->
+    ```text
+    ... (written here)
+    ```
+    <!-- output:end -->
+
+(indented as the list item it sits in). The blocks of all pages run in page order in one scratch folder
+that holds a link to ``cases/``, so a later block may read a file an earlier one wrote (``pressplan new
+my-press.yaml``, then ``pressplan check my-press.yaml``). What the block shows is the command's stdout
+and stderr, without what depends on the machine or the moment: the solver's time and iteration count,
+the files written. ``tests/test_docs.py`` runs the same commands and compares (numbers to their last
+printed digit), so a number changed by hand, or one a change of the code makes stale, fails.
+
+    python scripts/docs_outputs.py          # rewrite every block
+    python scripts/docs_outputs.py --check  # exit 1 naming the stale blocks
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import os
+import re
+import shlex
+import sys
+import tempfile
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+PAGES = (ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md")))
+BLOCK = re.compile(
+    r"(?P<indent>[ \t]*)<!-- output: (?P<command>.+?) -->\n(?P=indent)```text\n(?P<body>.*?)(?P=indent)```\n"
+    r"(?P=indent)<!-- output:end -->",
+    re.S,
+)
+OUT_OPTION = ("solve", "laws", "compare")  # commands that write a folder: sent to the scratch folder
+DROPPED = re.compile(r"^\s+(wrote |solver: )")  # lines that depend on the run, not on the case
+NUMBER = re.compile(r"[-+]?\d+(?:\.\d+)?")
+
+
+@dataclass(frozen=True)
+class Block:
+    page: Path
+    command: str
+    indent: str
+    body: str  # as the page holds it, without the indent
+    span: tuple[int, int]
+
+
+def blocks(pages: tuple[Path, ...] = PAGES) -> list[Block]:
+    """Every output block of ``pages``, in page order."""
+    found = []
+    for page in pages:
+        text = page.read_text(encoding="utf-8")
+        for m in BLOCK.finditer(text):
+            body = "".join(line.removeprefix(m["indent"]) for line in m["body"].splitlines(keepends=True))
+            found.append(Block(page, m["command"], m["indent"], body, m.span()))
+    return found
+
+
+@contextlib.contextmanager
+def scratch() -> Iterator[Path]:
+    """A scratch folder, the working folder meanwhile, with ``cases`` linked to the project's."""
+    here = Path.cwd()
+    with tempfile.TemporaryDirectory(prefix="pressplan-docs-") as folder:
+        (Path(folder) / "cases").symlink_to(ROOT / "cases")
+        os.chdir(folder)
+        try:
+            yield Path(folder)
+        finally:
+            os.chdir(here)
+
+
+def run(command: str) -> str:
+    """The shown output of ``command`` (``pressplan ...``), run in the working folder."""
+    from planning.cli import main
+
+    args = shlex.split(command)
+    if args[0] != "pressplan":
+        raise ValueError(f"not a pressplan command: {command}")
+    args = args[1:]
+    if args[0] in OUT_OPTION and "--out" not in args:
+        args += ["--out", f"out/{len(os.listdir('.'))}"]
+    if args[0] == "solve":
+        args.append("--no-plots")
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        main(args)
+    lines = (out.getvalue() + err.getvalue()).splitlines()
+    return "".join(f"{line}\n" for line in lines if not DROPPED.match(line))
+
+
+def fresh_outputs(pages: tuple[Path, ...] = PAGES) -> list[tuple[Block, str]]:
+    """Each block with its command's output now."""
+    with scratch():
+        return [(block, run(block.command)) for block in blocks(pages)]
+
+
+def differences(shown: str, fresh: str) -> list[str]:
+    """Where ``shown`` and ``fresh`` differ: words must be equal, numbers within one unit of the last
+    digit ``shown`` prints (round-off across machines)."""
+    problems = []
+    a_lines, b_lines = shown.splitlines(), fresh.splitlines()
+    if len(a_lines) != len(b_lines):
+        return [f"{len(a_lines)} lines shown, {len(b_lines)} now"]
+    for a, b in zip(a_lines, b_lines, strict=True):
+        if NUMBER.sub("#", a) != NUMBER.sub("#", b):
+            problems.append(f"shown {a.strip()!r}, now {b.strip()!r}")
+            continue
+        for x, y in zip(NUMBER.findall(a), NUMBER.findall(b), strict=True):
+            unit = 10.0 ** -len(x.split(".")[1]) if "." in x else 1.0
+            if abs(float(x) - float(y)) > unit * (1 + 1e-9):
+                problems.append(f"shown {x}, now {y} in {a.strip()!r}")
+    return problems
+
+
+def write(results: list[tuple[Block, str]]) -> None:
+    """Put each fresh output into its block (pages rewritten from the last block up)."""
+    for page in {block.page for block, _ in results}:
+        text = page.read_text(encoding="utf-8")
+        mine = sorted(((b, o) for b, o in results if b.page == page), key=lambda r: -r[0].span[0])
+        for block, output in mine:
+            body = "".join(f"{block.indent}{line}\n" if line else "\n" for line in output.splitlines())
+            new = (
+                f"{block.indent}<!-- output: {block.command} -->\n{block.indent}```text\n{body}"
+                f"{block.indent}```\n{block.indent}<!-- output:end -->"
+            )
+            text = text[: block.span[0]] + new + text[block.span[1] :]
+        page.write_text(text, encoding="utf-8")
+
+
+def main(argv: list[str]) -> int:
+    results = fresh_outputs()
+    if "--check" in argv:
+        stale = [(b, d) for b, o in results if (d := differences(b.body, o))]
+        for block, problems in stale:
+            print(f"{block.page.name}: {block.command}: {problems[0]}")
+        return 1 if stale else 0
+    write(results)
+    print(f"wrote {len(results)} blocks in {len({b.page for b, _ in results})} pages")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

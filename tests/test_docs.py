@@ -1,0 +1,61 @@
+"""The README and docs/: short enough to read, links that resolve, and every command output they show
+as the command prints it today (``scripts/docs_outputs.py`` writes them; this fails when one is stale)."""
+
+from __future__ import annotations
+
+import functools
+import importlib.util
+import re
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+README_LIMIT_BYTES = 20_000
+
+
+@functools.cache
+def _docs_outputs():
+    spec = importlib.util.spec_from_file_location("docs_outputs", ROOT / "scripts" / "docs_outputs.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # its dataclass looks its module up
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_readme_is_short():
+    assert len((ROOT / "README.md").read_bytes()) <= README_LIMIT_BYTES
+
+
+def test_every_shown_output_is_what_the_command_prints_now():
+    docs = _docs_outputs()
+    results = docs.fresh_outputs()
+    assert len(results) >= 8 and any(b.page.name == "README.md" for b, _ in results)
+    stale = {f"{b.page.name}: {b.command}": d for b, o in results if (d := docs.differences(b.body, o))}
+    assert not stale, f"run `python scripts/docs_outputs.py` (or fix the code): {stale}"
+
+
+@pytest.mark.parametrize(
+    ("shown", "now", "stale"),
+    (
+        ("12.123 strokes/min", "12.123 strokes/min", False),
+        ("12.123 strokes/min", "12.124 strokes/min", False),  # the last digit, round-off across machines
+        ("12.123 strokes/min", "12.125 strokes/min", True),
+        ("12.124 strokes/min", "12.123 strokes/min", False),
+        ("12.2 strokes/min", "12.123 strokes/min", False),  # shown to one decimal: 12.2 is within 0.1
+        ("12.0 strokes/min", "12.123 strokes/min", True),
+        ("binding: transfer time", "binding: slider acceleration", True),
+        ("one line", "one line\nand another", True),
+    ),
+)
+def test_a_number_changed_by_hand_is_stale(shown, now, stale):
+    assert bool(_docs_outputs().differences(shown, now)) == stale
+
+
+def test_links_resolve():
+    for page in (ROOT / "README.md", *(ROOT / "docs").glob("*.md")):
+        for target in re.findall(r"\]\(([^)#\s]+)(?:#[^)]*)?\)", page.read_text(encoding="utf-8")):
+            if target.startswith(("http://", "https://")):
+                continue
+            assert (page.parent / target).exists(), f"{page.name}: {target}"
