@@ -27,7 +27,8 @@ CAPTIONS = {
     "drive.png": "the drive (`pressplan solve`, a case with a drive)",
     "laws_overlay.png": "every motion law (`pressplan laws`)",
     "tradeoff.png": "RMS torque and energy at the line's rate (`pressplan tradeoff --spm 5:max:5`)",
-    "sweep_1d.png": "a sweep over the transfer time (`pressplan sweep`; beyond 22 s no plan: the window cannot take so long at 1 rpm)",
+    "sweep_1d.png": "a sweep over the transfer time (`pressplan sweep`; beyond 22 s no plan: the window cannot "
+    "take so long at 1 rpm)",
     "sweep_2d.png": "a sweep over the transfer time and the slide's acceleration limit (`pressplan sweep`)",
 }
 

@@ -56,7 +56,8 @@ def test_check_lists_it_and_a_draw_speed_above_it_is_infeasible(tmp_path: Path, 
     path = tmp_path / "fast_draw.yaml"
     path.write_text(json.dumps(with_slider_speed(250.0, draw_speed_rpm=6.7)))  # the draw reaches 297.7 mm/s
     assert main(["check", str(path)]) == 3
-    assert "FAIL  |slider speed| during the draw <= limits.slider_speed_mm_s: 297.7 mm/s (limit 250" in capsys.readouterr().out
+    expect = "FAIL  |slider speed| during the draw <= limits.slider_speed_mm_s: 297.7 mm/s (limit 250"
+    assert expect in capsys.readouterr().out
     assert main(["solve", str(path), "--out", str(tmp_path / "out")]) == 3
     err = capsys.readouterr().err.strip()
     assert "infeasible: at the draw speed 6.7 rpm the slider moves at up to 297.7 mm/s" in err
