@@ -8,12 +8,18 @@ A block in a page is
     ```
     <!-- output:end -->
 
-(indented as the list item it sits in). The blocks of all pages run in page order in one scratch folder
-that holds a link to ``cases/``, so a later block may read a file an earlier one wrote (``pressplan new
-my-press.yaml``, then ``pressplan check my-press.yaml``). What the block shows is the command's stdout
-and stderr, without what depends on the machine or the moment: the solver's time and iteration count,
-the files written. ``tests/test_docs.py`` runs the same commands and compares (numbers to their last
-printed digit), so a number changed by hand, or one a change of the code makes stale, fails.
+(indented as the list item it sits in), and a number in the text is
+
+    <!-- value: pressplan bound cases/wang2023-side-panel.yaml --json | spm -->13.04<!-- /value -->
+
+(the command's JSON output, a dotted path into it: keys, list indices, or ``[key=value]`` for the item of
+a list whose ``key`` is ``value``, optionally ``/ 1000`` or ``* 100``; written with the decimals shown). The blocks and values of all pages
+run in page order in one scratch folder that holds a link to ``cases/``, so a later block may read a file
+an earlier one wrote (``pressplan new my-press.yaml``, then ``pressplan check my-press.yaml``). What a
+block shows is the command's stdout and stderr, without what depends on the machine or the moment: the
+solver's time and iteration count, the files written. ``tests/test_docs.py`` runs the same commands and
+compares (numbers to their last printed digit), so a number changed by hand, or one a change of the code
+makes stale, fails.
 
     python scripts/docs_outputs.py          # rewrite every block
     python scripts/docs_outputs.py --check  # exit 1 naming the stale blocks
@@ -42,6 +48,57 @@ BLOCK = re.compile(
 OUT_OPTION = ("solve", "laws", "compare")  # commands that write a folder: sent to the scratch folder
 DROPPED = re.compile(r"^\s+(wrote |solver: )")  # lines that depend on the run, not on the case
 NUMBER = re.compile(r"[-+]?\d+(?:\.\d+)?")
+
+
+VALUE = re.compile(r"<!-- value: (?P<command>.+?) \| (?P<path>[^>]+?) -->(?P<shown>[^<]*)<!-- /value -->")
+
+
+@dataclass(frozen=True)
+class Value:
+    page: Path
+    command: str
+    path: str
+    shown: str
+    span: tuple[int, int]
+
+
+def values(pages: tuple[Path, ...] = PAGES) -> list[Value]:
+    """Every inline value of ``pages``, in page order."""
+    return [
+        Value(page, m["command"], m["path"], m["shown"], m.span())
+        for page in pages
+        for m in VALUE.finditer(page.read_text(encoding="utf-8"))
+    ]
+
+
+def lookup(data, path: str):  # noqa: ANN001, ANN201 - JSON data
+    """The item at dotted ``path`` in ``data``: keys (``{a key with . or [ in it}``), list indices,
+    ``[key=value]`` list items."""
+    for part in re.findall(r"\{[^}]*\}|\[[^\]]+\]|[^.\[\]{}]+", path):
+        if part.startswith("{"):
+            data = data[part[1:-1]]
+        elif part.startswith("["):
+            key, _, want = part[1:-1].partition("=")
+            data = next(item for item in data if str(item.get(key)) == want)
+        elif isinstance(data, list):
+            data = data[int(part)]
+        else:
+            data = data[part]
+    return data
+
+
+def evaluate(data, expression: str) -> float:  # noqa: ANN001 - JSON data
+    """``PATH``, ``PATH / NUMBER`` or ``PATH * NUMBER`` (a unit shown: N m as kN m)."""
+    m = re.fullmatch(r"(.*?)(?:\s+([*/])\s+([0-9.eE+-]+))?", expression.strip())
+    path, op, factor = m[1], m[2], m[3]
+    value = float(lookup(data, path))
+    return value / float(factor) if op == "/" else value * float(factor) if op == "*" else value
+
+
+def shown_like(value: float, shown: str) -> str:
+    """``value`` with as many decimals as ``shown`` has."""
+    decimals = len(shown.split(".")[1]) if "." in shown else 0
+    return f"{value:.{decimals}f}"
 
 
 @dataclass(frozen=True)
@@ -102,6 +159,21 @@ def fresh_outputs(pages: tuple[Path, ...] = PAGES) -> list[tuple[Block, str]]:
         return [(block, run(block.command)) for block in blocks(pages)]
 
 
+def fresh_values(pages: tuple[Path, ...] = PAGES) -> list[tuple[Value, str]]:
+    """Each inline value as its command gives it now, written with the decimals shown (each command
+    run once)."""
+    import json
+
+    outputs: dict[str, object] = {}
+    found = []
+    with scratch():
+        for value in values(pages):
+            if value.command not in outputs:
+                outputs[value.command] = json.loads(run(value.command))
+            found.append((value, shown_like(evaluate(outputs[value.command], value.path), value.shown)))
+    return found
+
+
 def differences(shown: str, fresh: str) -> list[str]:
     """Where ``shown`` and ``fresh`` differ: words must be equal, numbers within one unit of the last
     digit ``shown`` prints (round-off across machines)."""
@@ -120,30 +192,47 @@ def differences(shown: str, fresh: str) -> list[str]:
     return problems
 
 
-def write(results: list[tuple[Block, str]]) -> None:
-    """Put each fresh output into its block (pages rewritten from the last block up)."""
-    for page in {block.page for block, _ in results}:
+def _replacement(item: Block | Value, fresh: str) -> str:
+    if isinstance(item, Value):
+        return f"<!-- value: {item.command} | {item.path} -->{fresh}<!-- /value -->"
+    body = "".join(f"{item.indent}{line}\n" if line else "\n" for line in fresh.splitlines())
+    return (
+        f"{item.indent}<!-- output: {item.command} -->\n{item.indent}```text\n{body}"
+        f"{item.indent}```\n{item.indent}<!-- output:end -->"
+    )
+
+
+def write(results: list[tuple[Block | Value, str]]) -> None:
+    """Put each fresh output into its block or value (pages rewritten from the last one up)."""
+    for page in {item.page for item, _ in results}:
         text = page.read_text(encoding="utf-8")
         mine = sorted(((b, o) for b, o in results if b.page == page), key=lambda r: -r[0].span[0])
-        for block, output in mine:
-            body = "".join(f"{block.indent}{line}\n" if line else "\n" for line in output.splitlines())
-            new = (
-                f"{block.indent}<!-- output: {block.command} -->\n{block.indent}```text\n{body}"
-                f"{block.indent}```\n{block.indent}<!-- output:end -->"
-            )
-            text = text[: block.span[0]] + new + text[block.span[1] :]
+        for item, fresh in mine:
+            text = text[: item.span[0]] + _replacement(item, fresh) + text[item.span[1] :]
         page.write_text(text, encoding="utf-8")
 
 
+def stale(results: list[tuple[Block | Value, str]]) -> dict[str, list[str]]:
+    """What differs between each shown block or value and its fresh one, by where it is."""
+    found = {}
+    for item, fresh in results:
+        shown = item.body if isinstance(item, Block) else item.shown
+        problems = differences(shown, fresh)
+        if problems:
+            where = item.command if isinstance(item, Block) else f"{item.command} | {item.path}"
+            found[f"{item.page.name}: {where}"] = problems
+    return found
+
+
 def main(argv: list[str]) -> int:
-    results = fresh_outputs()
+    results = [*fresh_outputs(), *fresh_values()]
     if "--check" in argv:
-        stale = [(b, d) for b, o in results if (d := differences(b.body, o))]
-        for block, problems in stale:
-            print(f"{block.page.name}: {block.command}: {problems[0]}")
-        return 1 if stale else 0
+        problems = stale(results)
+        for where, what in problems.items():
+            print(f"{where}: {what[0]}")
+        return 1 if problems else 0
     write(results)
-    print(f"wrote {len(results)} blocks in {len({b.page for b, _ in results})} pages")
+    print(f"wrote {len(results)} blocks and values in {len({b.page for b, _ in results})} pages")
     return 0
 
 

@@ -30,10 +30,22 @@ def test_the_readme_is_short():
 
 def test_every_shown_output_is_what_the_command_prints_now():
     docs = _docs_outputs()
-    results = docs.fresh_outputs()
-    assert len(results) >= 8 and any(b.page.name == "README.md" for b, _ in results)
-    stale = {f"{b.page.name}: {b.command}": d for b, o in results if (d := docs.differences(b.body, o))}
+    blocks, values = docs.fresh_outputs(), docs.fresh_values()
+    assert len(blocks) >= 8 and any(b.page.name == "README.md" for b, _ in blocks)
+    assert len(values) >= 20
+    stale = docs.stale([*blocks, *values])
     assert not stale, f"run `python scripts/docs_outputs.py` (or fix the code): {stale}"
+
+
+def test_a_value_is_found_in_the_json():
+    docs = _docs_outputs()
+    data = {"laws": [{"law": "quintic", "spm": 11.97}, {"law": "optimal", "spm": 12.4}], "drive": {"x": [1, 2]}}
+    assert docs.lookup(data, "laws.[law=optimal].spm") == 12.4
+    assert docs.lookup(data, "drive.x.1") == 2
+    assert docs.lookup({"d": {"peak [mm/s^2]": 3}}, "d.{peak [mm/s^2]}") == 3
+    assert docs.evaluate({"n": [{"name": "a b", "v": 2.0}]}, "n.[name=a b].v * 100") == 200
+    assert docs.evaluate({"t": [5, 23400.0]}, "t.1 / 1000") == 23.4
+    assert docs.shown_like(13.0379, "13.04") == "13.04" and docs.shown_like(952.46, "952") == "952"
 
 
 @pytest.mark.parametrize(
