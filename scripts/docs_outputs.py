@@ -15,8 +15,8 @@ A block in a page is
 (the command's JSON output, a dotted path into it: keys, ``{a key with dots}``, list indices, or
 ``[key=value]`` for the item of a list whose ``key`` is ``value``, optionally ``/ 1000`` or ``* 100``; written
 with the decimals shown). The blocks and values of all pages run in page order in one scratch folder that
-holds a link to ``cases/``, so a later block may read a file an earlier one wrote (``pressplan new my-
-press.yaml``, then ``pressplan check my-press.yaml``). What a block shows is the command's stdout and stderr,
+holds a link to ``cases/``, so a later block may read a file an earlier one wrote (``pressplan new
+my-press.yaml``, then ``pressplan check my-press.yaml``). What a block shows is the command's stdout and stderr,
 without what depends on the machine or the moment: the solver's time and iteration count, the files written.
 ``tests/test_docs.py`` runs the same commands and compares (numbers to their last printed digit), so a number
 changed by hand, or one a change of the code makes stale, fails.
