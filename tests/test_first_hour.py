@@ -137,7 +137,9 @@ def test_set_replaces_a_field_for_one_run(command, tmp_path, capsys, monkeypatch
     assert main([command, PUBLISHED, "--set", "process.safety_height_mm=800"]) == 2
     err = capsys.readouterr().err
     assert "key_points.closing_deg" in err and "process.safety_height_mm = 800" in err
-    assert main([command, PUBLISHED, "--set", "process.safety_height_mm=650", "--set", "limits.die_speed_mm_s=80"]) == 0
+    if command in ("check", "bound"):  # a valid --set runs (solve: test_infeasibility_names_the_full_dotted_field)
+        valid = ["--set", "process.safety_height_mm=650", "--set", "limits.die_speed_mm_s=80"]
+        assert main([command, PUBLISHED, *valid]) == 0
 
 
 def test_set_changes_the_answer(capsys):
