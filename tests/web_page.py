@@ -69,9 +69,11 @@ def chromium() -> Iterator[object]:
 
 
 def wait_rendered(page, after: int = 0) -> int:  # noqa: ANN001 - a Playwright page
-    """Wait until the page has answered an edit after number ``after``; returns the answer's number."""
+    """Wait until the page has answered an edit after number ``after`` with its confirmed answer (not the
+    fast one it shows while confirming); returns the answer's number."""
     page.wait_for_function(
-        f"Number(document.body.dataset.rendered) > {after} && document.body.dataset.state !== 'solving'",
+        f"Number(document.body.dataset.rendered) > {after} && "
+        "!['solving', 'confirming'].includes(document.body.dataset.state)",
         timeout=RENDER_TIMEOUT_MS,
     )
     return int(page.evaluate("document.body.dataset.rendered"))

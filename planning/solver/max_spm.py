@@ -26,15 +26,12 @@ from planning.solver.verify import assess
 MOTOR_LIMITS = frozenset(limit.id for limit in BY_ID.values() if limit.motor)  # the motor's limits
 
 
-def solve_max_spm(
-    case: Case, placement: Placement | None = None, neighbour: Plan | None = None, follow: bool = False
-) -> Solution:
-    """The fastest verified cycle of ``case`` under its law with halves (see ``planning.solver.optimize.solve``
-    for ``neighbour`` and ``follow``)."""
+def solve_max_spm(case: Case, placement: Placement | None = None, neighbour: Plan | None = None) -> Solution:
+    """The fastest verified cycle of ``case`` under its law with halves; ``neighbour``: a plan whose values
+    start the multi-start (and which answers when it verifies here and beats the starts). Without a
+    neighbour: the cold solve (``planning.solver.optimize.solve`` compares the two)."""
     search = prepare(case, placement or case.planner.placement)
     neighbour = adopt(search, neighbour)
-    if follow and _follow(search, neighbour):
-        return search.answer()
     ran: tuple[Ran, ...] = ()
     if case.drive is not None and search.best is None:
         ran = _probe(search, neighbour)
@@ -118,6 +115,15 @@ def adopt(search: Search, neighbour: Plan | None) -> Plan | None:
     if neighbour.motion_law != search.case.planner.motion_law or not neighbour.nlp_values:
         return None  # another law's plan neither answers this case nor starts its NLP
     return neighbour
+
+
+def from_neighbour(case: Case, placement: Placement | None, neighbour: Plan) -> Solution | None:
+    """The answer from ``neighbour`` alone: its plan when it holds here, and one start from its values
+    (same placement rule); None when neither verifies. Fast, but not confirmed: the cold multi-start may
+    find a better optimum (``planning.solver.optimize.solve``)."""
+    search = prepare(case, placement or case.planner.placement)
+    _follow(search, adopt(search, neighbour))
+    return search.answer() if search.best is not None else None
 
 
 def _follow(search: Search, neighbour: Plan | None) -> bool:

@@ -19,7 +19,7 @@ from planning.model.plan import Plan
 from planning.solver.free_nlp import free_nlp_for
 from planning.solver.max_spm import converged_plan, solve_max_spm
 from planning.solver.outcomes import Infeasible
-from planning.solver.search import prepare
+from planning.solver.search import Search, prepare
 from planning.solver.solution import Solution
 from planning.solver.verify import assess
 
@@ -53,26 +53,53 @@ def seed_values(seed: Plan) -> dict[str, float]:
     return values
 
 
+def from_neighbour_optimal(case: Case, neighbour: Plan) -> Solution | None:
+    """The answer from ``neighbour`` alone (its plan when it holds here, one start from its values), or
+    None: fast, not confirmed (``planning.solver.optimize.solve``)."""
+    _require_jerk_limit(case)
+    search = _search(case)
+    return search.answer() if _from(search, neighbour) else None
+
+
+def _search(case: Case) -> Search:
+    """The optimal law's search: prechecks, parameters, bounds, scales; the minimum crank speed backed off."""
+    search = prepare(case, "free", free_nlp_for(case))
+    search.parameters = search.parameters.copy()
+    search.parameters[search.parameter("min_crank_speed")] *= 1 + MIN_SPEED_BACKOFF
+    return search
+
+
+def _from(search: Search, neighbour: Plan) -> bool:
+    """A neighbouring case's optimal plan: a candidate when it holds here, and a start; whether either
+    verified."""
+    case = search.case
+    if neighbour.motion_law != OptimalLaw.name or not neighbour.nlp_values:
+        return False
+    if np.allclose(neighbour.key_angles, case.key_angles, rtol=0, atol=1e-12):
+        verification, drive = assess(neighbour, case)  # a neighbouring case's plan that holds here is an answer
+        if verification.passed:
+            search.consider(Solution(neighbour, verification, drive), neighbour.period)
+    search.attempt(neighbour.nlp_values, "free")
+    return search.best is not None
+
+
+def _require_jerk_limit(case: Case) -> None:
+    if case.limits.crank_jerk_rad_s3 is None:
+        raise Infeasible(
+            "the optimal law needs limits.crank_jerk_rad_s3 (the jerk it may use)", limit="limits.crank_jerk_rad_s3"
+        )
+
+
 def solve_optimal(case: Case, neighbour: Plan | None = None) -> Solution:
     """The fastest verified cycle of ``case`` under the optimal law (needs ``limits.crank_jerk_rad_s3``).
 
     ``neighbour``: an optimal plan of a neighbouring case (a sweep, an edit on the web page, a looser
     limit). When it holds here it is a candidate; its values start the NLP, and when that start verifies
     the seed law is not solved at all (a warm re-solve)."""
-    if case.limits.crank_jerk_rad_s3 is None:
-        raise Infeasible(
-            "the optimal law needs limits.crank_jerk_rad_s3 (the jerk it may use)", limit="limits.crank_jerk_rad_s3"
-        )
-    search = prepare(case, "free", free_nlp_for(case))  # prechecks, parameters, bounds, scales
-    search.parameters = search.parameters.copy()
-    search.parameters[search.parameter("min_crank_speed")] *= 1 + MIN_SPEED_BACKOFF
-    if neighbour is not None and neighbour.motion_law == OptimalLaw.name and neighbour.nlp_values:
-        if np.allclose(neighbour.key_angles, case.key_angles, rtol=0, atol=1e-12):
-            verification, drive = assess(neighbour, case)  # a neighbouring case's plan that holds here is an answer
-            if verification.passed:
-                search.consider(Solution(neighbour, verification, drive), neighbour.period)
-        if search.attempt(neighbour.nlp_values, "free") is not None:
-            return search.answer()
+    _require_jerk_limit(case)
+    search = _search(case)
+    if neighbour is not None and _from(search, neighbour):
+        return search.answer()
     seeded = case.with_law(SEED_LAW)
     seed = converged_plan(seeded) or solve_max_spm(seeded, "free").plan
     search.iterations += seed.solver.iterations

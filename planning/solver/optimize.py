@@ -11,15 +11,20 @@ Each returns a verified :class:`~planning.solver.solution.Solution` or raises a 
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from planning.model.case import Case, Placement
 from planning.model.laws import get_law
 from planning.model.plan import Plan
-from planning.solver.max_spm import solve_max_spm
+from planning.solver.max_spm import from_neighbour, solve_max_spm
 from planning.solver.objectives import solve_at_rate
-from planning.solver.optimal import solve_optimal
+from planning.solver.optimal import from_neighbour_optimal, solve_optimal
+from planning.solver.outcomes import PlanningError
 from planning.solver.solution import Solution
 
-__all__ = ["Solution", "solve"]
+__all__ = ["Solution", "solve", "solve_from"]
+
+BETTER_SHARE = 1e-9  # a plan from a neighbour replaces the cold one when its period is this share shorter
 
 
 def solve(
@@ -27,16 +32,64 @@ def solve(
 ) -> Solution:
     """The fastest verified cycle for ``case``; raises a :class:`PlanningError` when there is none.
 
-    ``neighbour``: a plan of a neighbouring case (a sweep, a relaxed limit). It is verified against
-    this case as it stands (when its placement fits and its key angles and draw speed are this
-    case's) and its NLP values start the multi-start, so the answer is never worse than ``neighbour``
-    where ``neighbour`` is feasible here. ``follow``: with a fitting ``neighbour``, solve from it alone
-    and return what that start finds when it verifies (a sweep following its neighbours); otherwise
-    the full multi-start runs. A case whose ``planner.objective`` is not ``max-spm`` is solved at its
-    target rate (``planning.solver.objectives.solve_at_rate``).
+    One answer per case: the cold solve (its starts and stopping rule as if there were no neighbour),
+    or better. ``neighbour``: a plan of a neighbouring case (a sweep's point before, a relaxed limit, the
+    page's plan before an edit). Its plan, when it holds here, and a start from its values compete with
+    the cold solve; the shorter verified cycle wins, so the answer is never worse than the cold solve's
+    nor than the neighbour's where the neighbour holds. ``follow``: the neighbour's answer alone when it
+    verifies, unconfirmed (fast, but it may be another local optimum than the cold solve's: the web
+    page shows it while the confirmed answer is computed). A case whose ``planner.objective`` is not
+    ``max-spm`` is solved at its target rate (``planning.solver.objectives.solve_at_rate``; a neighbour
+    there starts the search and is not compared with a cold solve).
     """
     if case.planner.objective != "max-spm":
         return solve_at_rate(case, placement, neighbour)
+    if neighbour is None:
+        return _cold(case, placement)
+    warm = _from_neighbour(case, placement, neighbour)
+    if follow and warm is not None:
+        return warm
+    try:
+        cold = _cold(case, placement)
+    except PlanningError:
+        if warm is None:
+            raise
+        return warm
+    return _better(cold, warm)
+
+
+def solve_from(case: Case, neighbour: Plan, placement: Placement | None = None) -> Solution | None:
+    """The fast, unconfirmed answer of ``case`` from ``neighbour`` alone (its plan when it holds here, one
+    start from its values), or None when neither verifies; raises a :class:`PlanningError` when a
+    precheck refuses the case. ``solve(case, neighbour=...)`` confirms it against the cold solve. For
+    ``max-spm`` only (an objective at a rate: None)."""
+    if case.planner.objective != "max-spm":
+        return None
+    return _from_neighbour(case, placement, neighbour)
+
+
+def _cold(case: Case, placement: Placement | None) -> Solution:
     if get_law(case.planner.motion_law).free_profile:
-        return solve_optimal(case, neighbour)
-    return solve_max_spm(case, placement, neighbour, follow)
+        return solve_optimal(case)
+    return solve_max_spm(case, placement)
+
+
+def _from_neighbour(case: Case, placement: Placement | None, neighbour: Plan) -> Solution | None:
+    if get_law(case.planner.motion_law).free_profile:
+        return from_neighbour_optimal(case, neighbour)
+    return from_neighbour(case, placement, neighbour)
+
+
+def _better(cold: Solution, warm: Solution | None) -> Solution:
+    """The cold solve's answer unless the neighbour's is shorter; either way with both searches' totals."""
+    if warm is None:
+        return cold
+    best = warm if warm.plan.period < cold.plan.period * (1 - BETTER_SHARE) else cold
+    a, b = cold.plan.solver, warm.plan.solver
+    totals = replace(
+        best.plan.solver,
+        iterations=a.iterations + b.iterations,
+        starts=a.starts + b.starts,
+        wall_time_s=a.wall_time_s + b.wall_time_s,
+    )
+    return replace(best, plan=replace(best.plan, solver=totals))

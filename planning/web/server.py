@@ -155,7 +155,7 @@ def create_app(cases_dir: Path | None = None, initial: Path | None = None) -> Fl
         with session.lock:
             if seq < session.newest:
                 return jsonify({"status": "superseded", "seq": seq})
-            answer = solve_case(body.get("case"), _label_of(body), session)
+            answer = solve_case(body.get("case"), _label_of(body), session, body.get("confirm") is True)
         answer["seq"] = seq
         return jsonify(answer)
 
@@ -252,10 +252,12 @@ def _model_at(dotted: str) -> tuple[type, str]:
     return model, leaf
 
 
-def solve_case(data: Any, label: str, session: Session) -> dict[str, Any]:
-    """Validate and solve ``data`` from the session's last plan; the page's answer."""
+def solve_case(data: Any, label: str, session: Session, confirm: bool = True) -> dict[str, Any]:
+    """Validate and solve ``data`` from the session's last plan; the page's answer. ``confirm`` False: the
+    fast answer from the last plan alone when it verifies (``confirmed`` False in the answer: the page
+    then asks again with ``confirm``); else the cold solve's answer or better (``confirmed`` True)."""
     from planning.reports.report import result_dict, sample_profile, trajectory_columns
-    from planning.solver.optimize import solve
+    from planning.solver.optimize import solve, solve_from
     from planning.solver.outcomes import Infeasible, PlanningError
 
     try:
@@ -263,17 +265,27 @@ def solve_case(data: Any, label: str, session: Session) -> dict[str, Any]:
     except CaseFileError as exc:
         return {"status": "bad input", "message": str(exc), "field": exc.field}
     try:
-        # the last plan alone when it leads to a verified plan (what a sweep does between neighbours)
-        solution = solve(case, neighbour=session.plan, follow=session.plan is not None)
+        solution = None
+        if not confirm and session.plan is not None:
+            solution = solve_from(case, session.plan)  # fast; another local optimum is possible
+        confirmed = solution is None
+        if solution is None:
+            solution = solve(case, neighbour=session.plan)  # the cold solve's answer or better
     except PlanningError as exc:
         limit = exc.limit if isinstance(exc, Infeasible) else None
-        return {"status": exc.kind, "message": f"{label}: {exc}", "field": limit}
+        return {"status": exc.kind, "message": f"{label}: {exc}", "field": limit, "confirmed": True}
     session.plan = solution.plan
     result = result_dict(solution, case)
     plan = solution.plan
     table = sample_profile(plan.profile, case.machine, plan.period / CHART_POINTS, case)
     curves = {name: _rounded(col) for name, col in zip(trajectory_columns(case), table.T, strict=True)}
-    return {"status": "verified", "result": _finite(result), "curves": curves, "mechanism": mechanism_drawing(case)}
+    return {
+        "status": "verified",
+        "confirmed": confirmed,
+        "result": _finite(result),
+        "curves": curves,
+        "mechanism": mechanism_drawing(case),
+    }
 
 
 def mechanism_drawing(case: Case) -> dict[str, Any]:
