@@ -103,7 +103,7 @@ EDITS = (  # (field path, values) the sequences draw from
     (("limits", "slider_accel_mm_s2"), (2500.0, 3500.0, 5000.0)),
     (("limits", "die_speed_mm_s"), (60.0, 80.0, 100.0)),
 )
-SEQUENCES = 8  # in the default run; ``pytest -m slow`` runs SLOW_SEQUENCES
+SEQUENCES = 5  # in the default run; ``pytest -m slow`` runs SLOW_SEQUENCES
 SLOW_SEQUENCES = 50
 
 

@@ -148,6 +148,20 @@ def test_a_bad_value_shows_the_cli_line_next_to_the_field(page, tmp_path: Path) 
 
 
 @browser
+def test_an_upload_too_large_shows_the_servers_message(page) -> None:
+    """An upload over the request limit is answered 413 as JSON, and the page shows its message (it used to
+    parse an HTML page and show nothing)."""
+    from planning.web.server import MAX_REQUEST_BYTES
+
+    page.set_input_files(
+        "#upload", files=[{"name": "huge.yaml", "mimeType": "text/yaml", "buffer": b"#" * (MAX_REQUEST_BYTES + 10)}]
+    )
+    page.wait_for_function("document.querySelector('#load-message').textContent.length > 0", timeout=10_000)
+    assert "larger than" in page.locator("#load-message").inner_text()
+    assert page.locator("#case-label").inner_text() == LABEL  # the case on screen is still the one shown
+
+
+@browser
 def test_an_infeasible_case_shows_the_limit(page) -> None:
     edit(page, "process.transfer_time_s", "60")
     status = page.locator("#status").inner_text()
@@ -339,3 +353,46 @@ def test_a_newer_edit_supersedes_a_waiting_one() -> None:
     assert (
         other.post("/api/solve", json={"session": "tab-2", "seq": 1, "case": data}).get_json()["status"] == "verified"
     )
+
+
+def test_every_error_is_json_with_a_4xx() -> None:
+    """Deep nesting, a body too large, malformed JSON, an unknown route, a wrong method: each a JSON answer
+    with its 4xx and a message, never a 500 or an HTML page (the page shows the message)."""
+    pytest.importorskip("flask")
+    from planning.web.server import MAX_REQUEST_BYTES, create_app
+
+    client = create_app(CASES).test_client()
+    deep = b"[" * 1000 + b"]" * 1000  # 2 kB: past Python's recursion limit if it were parsed
+    for url in ("/api/solve", "/api/bound", "/api/download/result.json"):
+        answer = client.post(url, data=deep, content_type="application/json")
+        assert answer.status_code == 400 and "nests deeper" in answer.get_json()["message"], url
+        answer = client.post(url, data=b'{"case": ', content_type="application/json")
+        assert answer.status_code == 400 and answer.get_json()["message"] == "the request's body is not JSON", url
+        answer = client.post(url, data=b"[1, 2]", content_type="application/json")
+        assert answer.status_code == 400 and "not a JSON object" in answer.get_json()["message"], url
+    too_big = client.post("/api/solve", data=b"{" + b" " * MAX_REQUEST_BYTES + b"}", content_type="application/json")
+    assert too_big.status_code == 413 and "larger than" in too_big.get_json()["message"]
+    upload = client.post("/api/upload", data={"file": (io.BytesIO(b"#" * (MAX_REQUEST_BYTES + 10)), "big.yaml")})
+    assert upload.status_code == 413 and upload.get_json()["status"] == "bad input"
+    assert client.get("/api/nothing").status_code == 404 and client.get("/api/nothing").get_json()["message"]
+    wrong = client.get("/api/solve")
+    assert wrong.status_code == 405 and wrong.get_json()["status"] == "bad input"
+    quoted = client.post("/api/solve", json={"session": "s", "case": {"name": 'a "]]]] [[[' + "[" * 40}})
+    assert quoted.status_code == 200  # brackets inside strings do not count as nesting
+
+
+def test_only_this_machines_names_are_served() -> None:
+    """DNS rebinding: a request naming another host is refused; this machine's names and the bound
+    address are served; bound to every address (--host 0.0.0.0), every name is."""
+    pytest.importorskip("flask")
+    from planning.web.server import create_app
+
+    client = create_app(CASES).test_client()
+    assert client.get("/api/meta", headers={"Host": "evil.example:8050"}).status_code == 403
+    for host in ("localhost:8050", "127.0.0.1:8050", "[::1]:8050", "localhost"):
+        assert client.get("/api/meta", headers={"Host": host}).status_code == 200, host
+    lan = create_app(CASES, allowed_hosts=("192.168.1.20",)).test_client()
+    assert lan.get("/api/meta", headers={"Host": "192.168.1.20:8050"}).status_code == 200
+    assert lan.get("/api/meta", headers={"Host": "evil.example"}).status_code == 403
+    everyone = create_app(CASES, allowed_hosts=("0.0.0.0",)).test_client()
+    assert everyone.get("/api/meta", headers={"Host": "press-7.plant.local:8050"}).status_code == 200

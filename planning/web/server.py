@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 import yaml
 from flask import Flask, Response, jsonify, request, send_file
+from werkzeug.exceptions import HTTPException
 
 from planning.model.case import OBJECTIVES, Case
 from planning.model.case_file import MAX_BYTES, CaseFileError, case_from_data, load_yaml, read_case
@@ -75,8 +76,11 @@ def case_files(folder: Path | None) -> dict[str, Path]:
     return {p.name: p for p in sorted(folder.glob("*.yaml")) if p.is_file()}
 
 
-def create_app(cases_dir: Path | None = None, initial: Path | None = None) -> Flask:
-    """The application: the page, its static files and the JSON endpoints."""
+def create_app(
+    cases_dir: Path | None = None, initial: Path | None = None, allowed_hosts: tuple[str, ...] = ()
+) -> Flask:
+    """The application: the page, its static files and the JSON endpoints. Requests are answered for the
+    host names of this machine and ``allowed_hosts`` (the address ``serve`` binds) only."""
     import logging
 
     logging.getLogger("werkzeug").setLevel(logging.WARNING)  # no line per request
@@ -90,6 +94,29 @@ def create_app(cases_dir: Path | None = None, initial: Path | None = None) -> Fl
     offered = case_files(cases_dir)
     if initial is not None:
         offered = {initial.name: initial, **{k: v for k, v in offered.items() if k != initial.name}}
+
+    allowed = {"localhost", "127.0.0.1", "::1", *allowed_hosts}
+    everyone = bool(allowed & {"0.0.0.0", "::"})  # bound to every address: the user opened it to the network
+
+    @app.before_request
+    def host_allowed() -> tuple[Response, int] | None:
+        """Only the names of this machine and the address it binds: a page on another site that rebinds
+        its own name to 127.0.0.1 (DNS rebinding) reaches nothing."""
+        host = _hostname(request.host or "")
+        if everyone or host in allowed:
+            return None
+        return jsonify({"status": "bad input", "message": f"host {host!r} is not served here"}), 403
+
+    @app.errorhandler(BadRequest)
+    def bad_request(exc: BadRequest) -> Response:
+        return jsonify({"status": "bad input", "message": str(exc)}), 400
+
+    @app.errorhandler(HTTPException)
+    def http_error(exc: HTTPException) -> Response:
+        """Every HTTP error as JSON the page reads (413 too large, 404 no such route, 405 wrong method)."""
+        messages = {413: f"the request is larger than {MAX_REQUEST_BYTES} bytes"}
+        message = messages.get(exc.code, f"{exc.code} {exc.name}")
+        return jsonify({"status": "bad input", "message": message}), exc.code
 
     @app.get("/")
     def index() -> Response:
@@ -192,9 +219,56 @@ def create_app(cases_dir: Path | None = None, initial: Path | None = None) -> Fl
     return app
 
 
+def _hostname(host: str) -> str:
+    """The name in a Host header: ``localhost:8050`` -> ``localhost``, ``[::1]:8050`` -> ``::1``."""
+    if host.startswith("["):
+        return host[1:].split("]", 1)[0]
+    return host.rsplit(":", 1)[0] if host.count(":") == 1 else host
+
+
+class BadRequest(Exception):
+    """A request the page never sends: answered 400 with ``{"status": "bad input", "message": ...}``."""
+
+
+MAX_JSON_DEPTH = 32  # a request nests 4 deep (case -> section -> table -> row); deeper is refused unparsed
+
+
 def _body() -> dict[str, Any]:
-    body = request.get_json(silent=True)
-    return body if isinstance(body, dict) else {}
+    """The request's JSON object; :class:`BadRequest` when it is not one (malformed, nested deeper than
+    :data:`MAX_JSON_DEPTH`, another type). The depth is counted before parsing, so no input reaches the
+    parser's recursion limit."""
+    raw = request.get_data(cache=True)
+    if _depth(raw) > MAX_JSON_DEPTH:
+        raise BadRequest(f"the request nests deeper than {MAX_JSON_DEPTH} levels")
+    try:
+        body = json.loads(raw)
+    except (ValueError, RecursionError):
+        raise BadRequest("the request's body is not JSON") from None
+    if not isinstance(body, dict):
+        raise BadRequest("the request's body is not a JSON object")
+    return body
+
+
+def _depth(raw: bytes) -> int:
+    """The deepest nesting of brackets and braces in JSON text ``raw``, strings skipped."""
+    depth = deepest = 0
+    in_string = escaped = False
+    for byte in raw:
+        if in_string:
+            if escaped:
+                escaped = False
+            elif byte == 0x5C:  # backslash
+                escaped = True
+            elif byte == 0x22:  # quote
+                in_string = False
+        elif byte == 0x22:
+            in_string = True
+        elif byte in (0x5B, 0x7B):
+            depth += 1
+            deepest = max(deepest, depth)
+        elif byte in (0x5D, 0x7D):
+            depth -= 1
+    return deepest
 
 
 def _label_of(body: dict[str, Any]) -> str:
@@ -374,6 +448,6 @@ def _finite(value: Any) -> Any:
 
 def serve(case_path: Path | None, host: str, port: int, cases_dir: Path | None) -> None:
     """Run the server until Ctrl-C; prints the address."""
-    app = create_app(cases_dir, case_path)
+    app = create_app(cases_dir, case_path, (host,))
     print(f"pressplan: serving on http://{host}:{port}/ (Ctrl-C stops)", flush=True)
     app.run(host=host, port=port, threaded=True, use_reloader=False)

@@ -108,17 +108,29 @@ function caseFromForm() {
 let editTimer = null;
 function onEdit() { clearTimeout(editTimer); solveNow(); }
 
+// every answer of the server is JSON (errors too); anything else (a proxy's page, a dropped connection)
+// becomes an error answer the page shows, never an exception
+async function readJson(responsePromise) {
+  let response;
+  try {
+    response = await responsePromise;
+  } catch (e) {
+    return { status: "error", message: "the server did not answer: " + e, confirmed: true };
+  }
+  try {
+    return await response.json();
+  } catch (e) {
+    return { status: "error", message: `the server answered ${response.status} without JSON`, confirmed: true };
+  }
+}
+
 async function post(url, body) {
   const response = await fetch(url, { method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body) });
   return response;
 }
 
 async function askSolve(data, seq, confirm) {
-  try {
-    return await (await post("/api/solve", { session: SESSION, seq, label: state.label, case: data, confirm })).json();
-  } catch (e) {
-    return { status: "error", message: "the server did not answer: " + e, confirmed: true };
-  }
+  return readJson(post("/api/solve", { session: SESSION, seq, label: state.label, case: data, confirm }));
 }
 
 async function solveNow() {
@@ -155,7 +167,7 @@ async function solveNow() {
 }
 
 async function requestBound(data, seq) {
-  const answer = await (await post("/api/bound", { label: state.label, case: data })).json();
+  const answer = await readJson(post("/api/bound", { label: state.label, case: data }));
   if (seq !== state.shownSeq) return;
   const spm = state.last.result.spm;
   $("#bound-share").textContent = answer.status === "ok" ? (100 * spm / answer.spm).toFixed(1) + " %" : "no bound";
@@ -370,7 +382,7 @@ function followChart(event) {  // the drawing follows the crank angle under the 
 
 // ---- cases, uploads, downloads ----------------------------------------------------------------------
 async function loadCase(name) {
-  const answer = await (await fetch("/api/case/" + encodeURIComponent(name))).json();
+  const answer = await readJson(fetch("/api/case/" + encodeURIComponent(name)));
   showLoaded(answer);
 }
 
@@ -387,7 +399,7 @@ function showLoaded(answer) {
 async function upload(file) {
   const body = new FormData();
   body.append("file", file);
-  const answer = await (await fetch("/api/upload", { method: "POST", body })).json();
+  const answer = await readJson(fetch("/api/upload", { method: "POST", body }));
   showLoaded(answer);
 }
 
@@ -395,7 +407,7 @@ async function download(name) {
   const data = caseFromForm();
   const response = await post("/api/download/" + name, { label: state.label, case: data });
   if (!response.ok) {
-    const answer = await response.json();
+    const answer = await readJson(Promise.resolve(response));
     clearMessages();
     showMessage(answer.field || "", answer.message);
     return;
