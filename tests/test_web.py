@@ -194,7 +194,8 @@ def test_downloads_equal_the_files_of_solve(page, tmp_path: Path) -> None:
     assert got["trajectory.csv"] == (out / "trajectory.csv").read_bytes()
     page_result, cli_result = json.loads(got["result.json"]), json.loads((out / "result.json").read_text())
     for r in (page_result, cli_result):
-        r["solver"]["wall_time_s"] = None  # a measurement, not a result
+        # how the search went, not what it found (the page's plan counts the confirming search's starts too)
+        r["solver"] = None
     assert page_result == cli_result
     assert yaml.safe_load(got["case.yaml"])["key_points"]["draw_end_deg"] == 200.0
 
@@ -396,3 +397,29 @@ def test_only_this_machines_names_are_served() -> None:
     assert lan.get("/api/meta", headers={"Host": "evil.example"}).status_code == 403
     everyone = create_app(CASES, allowed_hosts=("0.0.0.0",)).test_client()
     assert everyone.get("/api/meta", headers={"Host": "press-7.plant.local:8050"}).status_code == 200
+
+
+def test_a_download_is_the_confirmed_plan_on_screen_without_a_solve(monkeypatch) -> None:
+    """The files come from the plan the page shows once confirmed: no solve runs for a download (a solve
+    would fail the test), a case whose plan is not on screen is refused with a message."""
+    pytest.importorskip("flask")
+    import planning.solver.optimize as optimize
+    from planning.web.server import create_app
+
+    client = create_app(CASES).test_client()
+    data = published_data()
+    body = {"session": "tab", "label": LABEL, "case": data}
+    early = client.post("/api/download/result.json", json=body)
+    assert early.status_code == 409 and "no confirmed plan" in early.get_json()["message"]
+    answer = client.post("/api/solve", json={**body, "seq": 1, "confirm": True}).get_json()
+    assert answer["status"] == "verified" and answer["confirmed"]
+
+    def no_solve(*args, **kwargs):
+        raise AssertionError("a download solved the case again")
+
+    monkeypatch.setattr(optimize, "solve", no_solve)
+    got = client.post("/api/download/result.json", json=body)
+    assert got.status_code == 200 and json.loads(got.data)["spm"] == answer["result"]["spm"]
+    other = {**body, "case": {**data, "process": {**data["process"], "transfer_time_s": 2.5}}}
+    assert client.post("/api/download/trajectory.csv", json=other).status_code == 409
+

@@ -51,6 +51,7 @@ class Session:
     guard: threading.Lock = field(default_factory=threading.Lock)  # held while ``newest`` changes
     newest: int = -1
     plan: Any = None
+    shown: tuple[str, Any, Any] | None = None  # the last confirmed plan: (its case's key, case, solution)
 
 
 class Sessions:
@@ -190,7 +191,7 @@ def create_app(
     def bound_endpoint() -> Response:
         body = _body()
         data = body.get("case")
-        key = hashlib.sha256(json.dumps(data, sort_keys=True, default=str).encode()).hexdigest()
+        key = case_key(data)
         with bounds_lock:
             if key in bounds:
                 return jsonify(bounds[key])
@@ -213,8 +214,11 @@ def create_app(
             text = yaml.safe_dump(_data(case), sort_keys=False, allow_unicode=True)
             return Response(text, mimetype="application/x-yaml", headers=_attachment(f"{case.name}.yaml"))
         if name not in DOWNLOADS:
-            return Response("not found", status=404)
-        return files_of(case, label, name)
+            return jsonify({"status": "bad input", "message": f"{name}: no such file"}), 404
+        session = sessions.get(str(body.get("session", ""))[:80])
+        with session.guard:
+            shown = session.shown
+        return files_of(shown, body.get("case"), label, name)
 
     return app
 
@@ -349,6 +353,9 @@ def solve_case(data: Any, label: str, session: Session, confirm: bool = True) ->
         limit = exc.limit if isinstance(exc, Infeasible) else None
         return {"status": exc.kind, "message": f"{label}: {exc}", "field": limit, "confirmed": True}
     session.plan = solution.plan
+    if confirmed:  # the downloads' plan: the last confirmed one (a fast answer on screen is confirmed next)
+        with session.guard:
+            session.shown = (case_key(data), case, solution)
     result = result_dict(solution, case)
     plan = solution.plan
     table = sample_profile(plan.profile, case.machine, plan.period / CHART_POINTS, case)
@@ -411,16 +418,20 @@ def bound_of(data: Any, label: str) -> dict[str, Any]:
     return {"status": "ok", "spm": bound.spm}
 
 
-def files_of(case: Case, label: str, name: str) -> Response:
-    """One file as ``pressplan solve`` writes it for ``case`` (the same cold solve and writers)."""
-    from planning.reports.outputs import solution_writers
-    from planning.solver.optimize import solve
-    from planning.solver.outcomes import PlanningError
+def case_key(data: Any) -> str:
+    """A key of a case's data as the page sends it (the same edits give the same key)."""
+    return hashlib.sha256(json.dumps(data, sort_keys=True, default=str).encode()).hexdigest()
 
-    try:
-        solution = solve(case)
-    except PlanningError as exc:
-        return jsonify({"status": exc.kind, "message": f"{label}: {exc}"}), 409
+
+def files_of(shown: tuple[str, Any, Any] | None, data: Any, label: str, name: str) -> tuple[Response, int] | Response:
+    """One file of the confirmed plan on screen, as ``pressplan solve`` writes it (the same writers; no
+    solve here); 409 when the case sent is not the one whose confirmed plan is shown."""
+    from planning.reports.outputs import solution_writers
+
+    if shown is None or shown[0] != case_key(data):
+        message = f"{label}: no confirmed plan of this case on the page yet; wait for the plan, then download"
+        return jsonify({"status": "bad input", "message": message}), 409
+    _, case, solution = shown
     writers = solution_writers(solution, case, plot_format=None)
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / name

@@ -106,7 +106,12 @@ function caseFromForm() {
 
 // ---- solving ----------------------------------------------------------------------------------------
 let editTimer = null;
-function onEdit() { clearTimeout(editTimer); solveNow(); }
+function onEdit() {
+  clearTimeout(editTimer);
+  // a change event that changes nothing (the field left after its edit was solved) solves nothing
+  if (state.solvedJson !== undefined && JSON.stringify(caseFromForm()) === state.solvedJson) return;
+  solveNow();
+}
 
 // every answer of the server is JSON (errors too); anything else (a proxy's page, a dropped connection)
 // becomes an error answer the page shows, never an exception
@@ -135,6 +140,7 @@ async function askSolve(data, seq, confirm) {
 
 async function solveNow() {
   const data = caseFromForm();
+  state.solvedJson = JSON.stringify(data);
   const seq = ++state.seq;
   setStatus("solving…", "busy");
   document.body.dataset.state = "solving";
@@ -405,7 +411,7 @@ async function upload(file) {
 
 async function download(name) {
   const data = caseFromForm();
-  const response = await post("/api/download/" + name, { label: state.label, case: data });
+  const response = await post("/api/download/" + name, { session: SESSION, label: state.label, case: data });
   if (!response.ok) {
     const answer = await readJson(Promise.resolve(response));
     clearMessages();
