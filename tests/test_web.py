@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from planning.model.case_file import case_from_data, load_yaml
+from planning.model.case_file import case_from_data, load_yaml, read_case
 from planning.reports.report import result_dict
 from planning.solver.bound import time_optimal_bound
 from planning.solver.optimize import solve
@@ -423,3 +423,22 @@ def test_a_download_is_the_confirmed_plan_on_screen_without_a_solve(monkeypatch)
     other = {**body, "case": {**data, "process": {**data["process"], "transfer_time_s": 2.5}}}
     assert client.post("/api/download/trajectory.csv", json=other).status_code == 409
 
+
+
+@browser
+def test_the_charts_draw_every_limit_of_the_case_and_the_robot_window(page) -> None:
+    """On the servo-limited case (crank speed, acceleration and jerk bind) every limit of the case is a
+    named line on the charts (the figures' own lines), the robot window is shaded with its time written."""
+    before = int(page.evaluate("document.body.dataset.rendered"))
+    page.select_option("#case-select", "side-panel-servo-limits.yaml")
+    wait_rendered(page, before)
+    names = page.evaluate("document.getElementById('motion-chart').data.map((t) => t.name)")
+    case = read_case(CASES / "side-panel-servo-limits.yaml")
+    set_limits = [f"limits.{k}" for k, v in case.limits.model_dump().items() if v is not None]
+    fields = ["process.safety_height_mm", *set_limits]
+    missing = [f for f in fields if not any(str(n).startswith(f) for n in names)]
+    assert not missing, missing
+    assert "crank jerk [rad/s³]" in names
+    notes = page.evaluate("document.getElementById('motion-chart').layout.annotations.map((a) => a.text)")
+    assert any(n.startswith("robot window θ4 → θ1: 2.000 s") for n in notes), notes
+    screenshot(page, "web-limits")

@@ -15,6 +15,8 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from planning.reports.limit_lines import LimitLine, limit_lines, robot_windows
+
 WINDOW_COLOUR, DRAW_COLOUR = "#d9ecff", "#e2f0d9"  # the robot's window, the draw
 KEY_TICKS = {"closing": "θ1", "draw_start": "θ2", "draw_end": "θ3", "opening": "θ4"}
 LEGEND_RIGHT = 0.66  # the panels end here; their legends stand right of them
@@ -44,25 +46,13 @@ def read_table(path: Path) -> dict[str, np.ndarray]:
     return {name: data[:, i] for i, name in enumerate(header)}
 
 
-def _windows(result: dict[str, Any], axis: str, x: np.ndarray) -> list[tuple[float, float]]:
-    """The robot's window theta4 -> TDC -> theta1 as spans of the x axis (time [s] or crank angle [deg]):
-    from theta4 to the cycle's end and from its start to theta1."""
-    keys = {k["name"]: k for k in result["key_points"]}
-    at = "time_s" if axis == "time" else "angle_deg"
-    return [(keys["opening"][at], float(x[-1])), (float(x[0]), keys["closing"][at])]
-
-
-def _in_spans(x: np.ndarray, spans: list[tuple[float, float]]) -> np.ndarray:
-    return np.any([(x >= a) & (x <= b) for a, b in spans], axis=0)
-
-
 def _decorate(ax, result: dict[str, Any], axis: str, x: np.ndarray, label: bool) -> None:
     """The robot's window shaded (its achieved time written once), the draw shaded, the key points as
     dotted lines."""
     window = result.get("transfer_window_s")
     required = result.get("process", {}).get("transfer_time_s")
     text = f"robot window θ4 → θ1: {window:.3f} s" + (f" (≥ {required:g} s)" if required is not None else "")
-    for i, (a, b) in enumerate(_windows(result, axis, x)):
+    for i, (a, b) in enumerate(robot_windows(result, axis, x)):
         ax.axvspan(a, b, color=WINDOW_COLOUR, alpha=0.7, lw=0, zorder=0, label=text if label and i == 0 else None)
     keys = {k["name"]: k for k in result["key_points"]}
     at = "time_s" if axis == "time" else "angle_deg"
@@ -93,7 +83,7 @@ def _limit(
     ax,  # noqa: ANN001 - a matplotlib Axes
     x: np.ndarray,
     value: float | np.ndarray,
-    label: str,
+    label: str | None,
     colour: str,
     where: np.ndarray | None = None,
     both: bool = False,
@@ -138,13 +128,41 @@ def _overlay(ax, x, published: dict[str, np.ndarray] | None, column: str, colour
         ax.plot(x, published[column], color=colour, lw=1.2, ls=":", alpha=alpha, label="published solution (rebuilt)")
 
 
+LIMIT_COLOURS = {  # by case field; the curve a limit bounds has the same hue, lighter or darker
+    "process.safety_height_mm": "tab:blue",
+    "limits.die_height_mm": "#5b8cc0",
+    "limits.crank_speed_rpm": "#8b0000",
+    "limits.min_crank_speed_rpm": "#e07070",
+    "limits.crank_accel_rad_s2": "#4b0082",
+    "limits.crank_jerk_rad_s3": "#5c3317",
+    "limits.die_speed_mm_s": "#006400",
+    "limits.slider_speed_mm_s": "#2e8b57",
+    "limits.draw_start_speed_mm_s": "#006400",
+    "limits.slider_accel_mm_s2": "#cc5500",
+}
+
+
+def _draw_limits(axes_of: dict[str, Any], lines: list[LimitLine]) -> None:
+    """Each limit line on the panel of the quantity it bounds (``planning.reports.limit_lines``)."""
+    for line in lines:
+        ax = axes_of[line.quantity]
+        colour = LIMIT_COLOURS.get(line.field, "#444444")
+        if line.point:
+            ys = [*line.upper, *(line.lower if line.lower is not None else [])]
+            ax.plot([line.x[0]] * len(ys), ys, ls="none", marker="_", ms=14, mew=2.2, color=colour, label=line.label)
+            continue
+        _limit(ax, line.x, line.upper, line.label, colour)
+        if line.lower is not None:
+            _limit(ax, line.x, line.lower, None, colour)
+
+
 def _figure(result, traj, published, axis: str) -> Figure:
     """Four panels against time or crank angle: slide height and crank speed; crank acceleration; crank
-    jerk; slide speed and acceleration. Every limit the case sets is a dashed line over the part of the
-    cycle where it applies, named by its case field in the legend; the legends sit right of the panels."""
+    jerk; slide speed and acceleration. Every limit the case sets (``limit_lines``) is a dashed line over
+    the part of the cycle where it applies, named by its case field in the legend; the legends sit right
+    of the panels."""
     traj, published = _thin(traj), _thin(published)
     lim = result.get("limits", {})
-    proc = result.get("process", {})
     x = traj["time_s"] if axis == "time" else traj["crank_angle_deg"]
     xp = None
     if published is not None:
@@ -160,106 +178,56 @@ def _figure(result, traj, published, axis: str) -> Figure:
         f"({result['motion_law']}, {result['placement']} placement, {result['status']})"
     )
     fig.suptitle(title, fontsize=11)
-    window = _in_spans(x, _windows(result, axis, x))
-    height = traj["slider_height_mm"]
+    for ax in axes:
+        _decorate(ax, result, axis, x, ax is axes[0])
+    _key_ticks(axes[0], result, axis)
+    height_ax, speed_ax = axes[0], axes[0].twinx()
+    accel_ax, jerk_ax = axes[1], axes[2]
+    slide_ax, slide_accel_ax = axes[3], axes[3].twinx()
 
-    # (a) slide height and crank speed
-    ax = axes[0]
-    _decorate(ax, result, axis, x, True)
-    _key_ticks(ax, result, axis)
-    ax.plot(x, height, color="tab:blue", lw=1.6, label="slide height")
-    safety = proc.get("safety_height_mm")
-    if safety is not None:
-        _limit(ax, x, safety, f"process.safety_height_mm = {safety:g} mm (robot window)", "tab:blue", window)
-    die = lim.get("die_height_mm")
-    if die is not None:
-        _limit(ax, x, die, f"limits.die_height_mm = {die:g} mm", "#5b8cc0")
-    ax.set_ylabel("slide height above BDC [mm]", color="tab:blue")
-    ax2 = ax.twinx()
-    speed = traj["crank_speed_rpm"]
-    ax2.plot(x, speed, color="tab:red", lw=1.6, label="crank speed")
-    _overlay(ax2, xp, published, "crank_speed_rpm", "tab:red", 0.7)
-    top = lim.get("crank_speed_rpm")
-    if top is not None:
-        _limit(ax2, x, top, f"limits.crank_speed_rpm = {top:g} rpm", "#8b0000")
-    low = lim.get("min_crank_speed_rpm")
-    if low is not None:
-        _limit(ax2, x, low, f"limits.min_crank_speed_rpm = {low:g} rpm", "#e07070")
-    ax2.set_ylabel("crank speed [rpm]", color="tab:red")
-    ax2.set_ylim(0, 1.1 * max(float(np.max(speed)), top or 0.0))
-    _legend(ax, ax2)
-    ax.set_title("slide height and crank speed" + (" (paper Fig. 7)" if paper else ""), fontsize=9, loc="left")
-
-    # (b) crank acceleration
-    ax = axes[1]
-    _decorate(ax, result, axis, x, False)
-    accel = traj["crank_accel_rad_s2"]
-    ax.plot(x, accel, color="tab:purple", lw=1.6, label="crank acceleration")
-    _overlay(ax, xp, published, "crank_accel_rad_s2", "tab:purple", 0.7)
-    a_crank = lim.get("crank_accel_rad_s2")
-    if a_crank is not None:
-        _limit(ax, x, a_crank, f"limits.crank_accel_rad_s2 = ±{a_crank:g} rad/s²", "#4b0082", both=True)
-    ax.axhline(0, color="black", lw=0.6)
-    ax.set_ylabel("crank acceleration [rad/s²]")
-    _legend(ax)
-    ax.set_title("crank acceleration" + (" (paper Fig. 8)" if paper else ""), fontsize=9, loc="left")
-
-    # (c) crank jerk
-    ax = axes[2]
-    _decorate(ax, result, axis, x, False)
-    ax.plot(x, traj["crank_jerk_rad_s3"], color="tab:brown", lw=1.2, label="crank jerk")
-    j_crank = lim.get("crank_jerk_rad_s3")
-    if j_crank is not None:
-        _limit(ax, x, j_crank, f"limits.crank_jerk_rad_s3 = ±{j_crank:g} rad/s³", "#5c3317", both=True)
-    ax.axhline(0, color="black", lw=0.6)
-    ax.set_ylabel("crank jerk [rad/s³]")
-    _legend(ax)
-    ax.set_title("crank jerk", fontsize=9, loc="left")
-
-    # (d) slide speed and acceleration
-    ax = axes[3]
-    _decorate(ax, result, axis, x, False)
-    ax.plot(x, traj["slider_speed_mm_s"], color="tab:green", lw=1.6, label="slide speed (up +)")
-    die_speed = lim.get("die_speed_mm_s")
-    if die_speed is not None and die is not None:
-        _limit(
-            ax,
-            x,
-            die_speed,
-            f"limits.die_speed_mm_s = ±{die_speed:g} mm/s (below the die height)",
-            "#006400",
-            height <= die,
-            both=True,
-        )
-    v_top = lim.get("slider_speed_mm_s")
-    if v_top is not None:
-        _limit(ax, x, v_top, f"limits.slider_speed_mm_s = ±{v_top:g} mm/s", "#2e8b57", both=True)
-    v2 = lim.get("draw_start_speed_mm_s")
-    if v2 is not None:
-        keys = {k["name"]: k for k in result["key_points"]}
-        at = keys["draw_start"]["time_s" if axis == "time" else "angle_deg"]
-        ax.plot(
-            [at, at],
-            [-v2, v2],
-            ls="none",
-            marker="_",
-            ms=14,
-            mew=2.2,
-            color="#006400",
-            label=f"limits.draw_start_speed_mm_s = ±{v2:g} mm/s (at θ2)",
-        )
-    ax.set_ylabel("slide speed [mm/s]", color="tab:green")
-    ax2 = ax.twinx()
-    ax2.plot(x, traj["slider_accel_mm_s2"], color="tab:orange", lw=1.6, label="slide acceleration")
-    a_lim = lim.get("slider_accel_mm_s2")
-    if a_lim is not None:
-        _limit(ax2, x, a_lim, f"limits.slider_accel_mm_s2 = ±{a_lim:g} mm/s²", "#cc5500", both=True)
-        ax2.set_ylim(-1.15 * a_lim, 1.15 * a_lim)
-    _overlay(ax2, xp, published, "slider_accel_mm_s2", "tab:orange", 0.6)
-    ax2.set_ylabel("slide acceleration [mm/s²]", color="tab:orange")
-    _legend(ax, ax2)
-    ax.set_title("slide speed and acceleration" + (" (paper Fig. 9)" if paper else ""), fontsize=9, loc="left")
-
+    height_ax.plot(x, traj["slider_height_mm"], color="tab:blue", lw=1.6, label="slide height")
+    speed_ax.plot(x, traj["crank_speed_rpm"], color="tab:red", lw=1.6, label="crank speed")
+    _overlay(speed_ax, xp, published, "crank_speed_rpm", "tab:red", 0.7)
+    accel_ax.plot(x, traj["crank_accel_rad_s2"], color="tab:purple", lw=1.6, label="crank acceleration")
+    _overlay(accel_ax, xp, published, "crank_accel_rad_s2", "tab:purple", 0.7)
+    jerk_ax.plot(x, traj["crank_jerk_rad_s3"], color="tab:brown", lw=1.2, label="crank jerk")
+    slide_ax.plot(x, traj["slider_speed_mm_s"], color="tab:green", lw=1.6, label="slide speed (up +)")
+    slide_accel_ax.plot(x, traj["slider_accel_mm_s2"], color="tab:orange", lw=1.6, label="slide acceleration")
+    _overlay(slide_accel_ax, xp, published, "slider_accel_mm_s2", "tab:orange", 0.6)
+    _draw_limits(
+        {
+            "slider_height_mm": height_ax,
+            "crank_speed_rpm": speed_ax,
+            "crank_accel_rad_s2": accel_ax,
+            "crank_jerk_rad_s3": jerk_ax,
+            "slider_speed_mm_s": slide_ax,
+            "slider_accel_mm_s2": slide_accel_ax,
+        },
+        limit_lines(result, traj, axis),
+    )
+    for ax in (accel_ax, jerk_ax):
+        ax.axhline(0, color="black", lw=0.6)
+    speed_ax.set_ylim(0, 1.1 * max(float(np.max(traj["crank_speed_rpm"])), lim.get("crank_speed_rpm") or 0.0))
+    if lim.get("slider_accel_mm_s2") is not None:
+        slide_accel_ax.set_ylim(-1.15 * lim["slider_accel_mm_s2"], 1.15 * lim["slider_accel_mm_s2"])
+    height_ax.set_ylabel("slide height above BDC [mm]", color="tab:blue")
+    speed_ax.set_ylabel("crank speed [rpm]", color="tab:red")
+    accel_ax.set_ylabel("crank acceleration [rad/s²]")
+    jerk_ax.set_ylabel("crank jerk [rad/s³]")
+    slide_ax.set_ylabel("slide speed [mm/s]", color="tab:green")
+    slide_accel_ax.set_ylabel("slide acceleration [mm/s²]", color="tab:orange")
+    _legend(height_ax, speed_ax)
+    _legend(accel_ax)
+    _legend(jerk_ax)
+    _legend(slide_ax, slide_accel_ax)
+    for ax, what, figure_number in (
+        (height_ax, "slide height and crank speed", 7),
+        (accel_ax, "crank acceleration", 8),
+        (jerk_ax, "crank jerk", None),
+        (slide_ax, "slide speed and acceleration", 9),
+    ):
+        paper_figure = f" (paper Fig. {figure_number})" if paper and figure_number else ""
+        ax.set_title(what + paper_figure, fontsize=9, loc="left")
     axes[-1].set_xlabel(xlabel)
     axes[-1].set_xlim(x[0], x[-1])
     return fig

@@ -359,14 +359,35 @@ def solve_case(data: Any, label: str, session: Session, confirm: bool = True) ->
     result = result_dict(solution, case)
     plan = solution.plan
     table = sample_profile(plan.profile, case.machine, plan.period / CHART_POINTS, case)
-    curves = {name: _rounded(col) for name, col in zip(trajectory_columns(case), table.T, strict=True)}
+    columns = dict(zip(trajectory_columns(case), table.T, strict=True))
+    curves = {name: _rounded(col) for name, col in columns.items()}
     return {
         "status": "verified",
         "confirmed": confirmed,
         "result": _finite(result),
         "curves": curves,
+        "limit_lines": chart_limits(result, columns),
         "mechanism": mechanism_drawing(case),
     }
+
+
+def chart_limits(result: dict[str, Any], columns: dict[str, np.ndarray]) -> list[dict[str, Any]]:
+    """The case's limits as the page's charts draw them: the figures' lines (``limit_lines``), each over
+    the chart's samples (None where it does not apply; the same samples against time or crank angle), a
+    limit at one crank angle with that point on both axes."""
+    from planning.reports.limit_lines import limit_lines
+
+    by_time = limit_lines(result, columns, "time")
+    out = []
+    for line, timed in zip(limit_lines(result, columns, "angle"), by_time, strict=True):
+        item: dict[str, Any] = {"field": line.field, "label": line.label, "quantity": line.quantity}
+        item["point"] = line.point
+        item["upper"] = _finite(_rounded(line.upper))
+        item["lower"] = _finite(_rounded(line.lower)) if line.lower is not None else None
+        if line.point:
+            item["at"] = {"angle": float(line.x[0]), "time": float(timed.x[0])}
+        out.append(item)
+    return out
 
 
 def mechanism_drawing(case: Case) -> dict[str, Any]:

@@ -5,7 +5,13 @@ const SESSION = (crypto.randomUUID ? crypto.randomUUID() : String(Math.random())
 const SECTIONS = ["press", "press.link_drive", "press.knuckle_joint", "key_points", "process", "limits", "drive", "drive.motor", "planner"];
 // the press section's own keys belong to the crank-slider; a linkage's dimensions are in its subsection
 const CRANK_SLIDER_KEYS = ["press.crank_radius_mm", "press.rod_length_mm", "press.offset_mm", "drive.rod_mass_kg", "drive.rod_cg_from_crank_pin_mm"];
-const STAGE_COLOURS = { transfer: "#d9ecff", feed: "#fff2cc", draw: "#e2f0d9", return: "#fde2e2" };
+const WINDOW_COLOUR = "#d9ecff", DRAW_COLOUR = "#e2f0d9"; // the robot's window, the draw
+const LIMIT_COLOURS = {
+  "process.safety_height_mm": "#1f77b4", "limits.die_height_mm": "#5b8cc0", "limits.crank_speed_rpm": "#8b0000",
+  "limits.min_crank_speed_rpm": "#e07070", "limits.crank_accel_rad_s2": "#4b0082", "limits.crank_jerk_rad_s3": "#5c3317",
+  "limits.die_speed_mm_s": "#006400", "limits.slider_speed_mm_s": "#2e8b57", "limits.draw_start_speed_mm_s": "#006400",
+  "limits.slider_accel_mm_s2": "#cc5500",
+};
 const KEY_LABELS = { closing: "θ1", draw_start: "θ2", draw_end: "θ3", opening: "θ4" };
 const TYPING_REST_MS = 600;
 const BOUND_REST_MS = 800;
@@ -243,62 +249,77 @@ function xOf(curves) {
   return $("#x-axis").value === "time" ? curves.time_s : curves.crank_angle_deg;
 }
 
-function stageShapes(r, axis) {
-  const shapes = [];
-  for (const s of r.segments) {
-    const stage = s.name.split(":")[0];
-    const x0 = axis === "time" ? s.start_time_s : s.start_angle_deg;
-    const x1 = axis === "time" ? s.start_time_s + s.duration_s : s.end_angle_deg;
-    shapes.push({ type: "rect", xref: "x", yref: "paper", x0, x1, y0: 0, y1: 1, fillcolor: STAGE_COLOURS[stage] || "#eee", opacity: 0.5, line: { width: 0 }, layer: "below" });
-  }
+// the robot's window theta4 -> TDC -> theta1 and the draw theta2 -> theta3 shaded, the key points dotted,
+// the window's time written on it (the figures of `pressplan solve` show the same)
+function cycleShapes(r, x, axis) {
+  const at = (name) => { const k = r.key_points.find((p) => p.name === name); return axis === "time" ? k.time_s : k.angle_deg; };
+  const rect = (x0, x1, fillcolor) => ({ type: "rect", xref: "x", yref: "paper", x0, x1, y0: 0, y1: 1, fillcolor, opacity: 0.6, line: { width: 0 }, layer: "below" });
+  const shapes = [rect(at("opening"), x[x.length - 1], WINDOW_COLOUR), rect(x[0], at("closing"), WINDOW_COLOUR), rect(at("draw_start"), at("draw_end"), DRAW_COLOUR)];
   for (const k of r.key_points) {
-    const x = axis === "time" ? k.time_s : k.angle_deg;
-    shapes.push({ type: "line", xref: "x", yref: "paper", x0: x, x1: x, y0: 0, y1: 1, line: { dash: "dot", width: 1, color: "#555" } });
+    const kx = axis === "time" ? k.time_s : k.angle_deg;
+    shapes.push({ type: "line", xref: "x", yref: "paper", x0: kx, x1: kx, y0: 0, y1: 1, line: { dash: "dot", width: 1, color: "#555" } });
   }
-  return shapes;
+  const window = `robot window θ4 → θ1: ${r.transfer_window_s.toFixed(3)} s (≥ ${r.process.transfer_time_s} s)`;
+  const annotations = [{ xref: "x", yref: "paper", x: x[0], y: 1.0, xanchor: "left", yanchor: "bottom", text: window, showarrow: false, font: { size: 11, color: "#1f4e79" } }];
+  return { shapes, annotations };
 }
 
-function limitLine(x, value, yaxis, name) {
-  return { x: [x[0], x[x.length - 1]], y: [value, value], yaxis, mode: "lines", name, line: { dash: "dash", width: 1, color: "#c0392b" }, hoverinfo: "name+y", showlegend: false };
+// each limit of the case on the chart of the quantity it bounds, dashed where it applies (the server's
+// `limit_lines`, the figures' own), named by its case field in the legend
+const LIMIT_AXES = { slider_height_mm: "y", crank_speed_rpm: "y2", crank_accel_rad_s2: "y3", crank_jerk_rad_s3: "y6", slider_speed_mm_s: "y4", slider_accel_mm_s2: "y5" };
+function limitTraces(lines, x, axis) {
+  const traces = [];
+  for (const line of lines || []) {
+    const style = { dash: "dash", width: 1.2, color: LIMIT_COLOURS[line.field] || "#c0392b" };
+    const common = { yaxis: LIMIT_AXES[line.quantity], name: line.label, legendgroup: line.field, hoverinfo: "name" };
+    if (line.point) {
+      const px = axis === "time" ? line.at.time : line.at.angle;
+      traces.push({ ...common, x: [px, px], y: [line.upper[0], line.lower ? line.lower[0] : line.upper[0]], mode: "markers", marker: { symbol: "line-ew-open", size: 16, color: style.color, line: { width: 3 } } });
+      continue;
+    }
+    traces.push({ ...common, x, y: line.upper, mode: "lines", line: style, connectgaps: false });
+    if (line.lower) traces.push({ ...common, x, y: line.lower, mode: "lines", line: style, connectgaps: false, showlegend: false });
+  }
+  return traces;
 }
 
 function drawCharts() {
   const ans = state.last;
   const r = ans.result, c = ans.curves, axis = $("#x-axis").value;
   const x = xOf(c);
-  const lim = r.limits, proc = r.process;
   const traces = [
-    { x, y: c.slider_height_mm, name: "slider height [mm]", yaxis: "y", line: { color: "#1f77b4" } },
-    { x, y: c.crank_speed_rpm, name: "crank speed [rpm]", yaxis: "y2", line: { color: "#ff7f0e" } },
-    { x, y: c.crank_accel_rad_s2, name: "crank acceleration [rad/s²]", yaxis: "y3", line: { color: "#2ca02c" } },
-    { x, y: c.slider_speed_mm_s, name: "slider speed [mm/s]", yaxis: "y4", line: { color: "#9467bd" } },
-    { x, y: c.slider_accel_mm_s2, name: "slider acceleration [mm/s²]", yaxis: "y5", line: { color: "#8c564b" } },
-    limitLine(x, proc.safety_height_mm, "y", "safety height"),
-    limitLine(x, lim.die_height_mm, "y", "die height"),
-    limitLine(x, lim.slider_accel_mm_s2, "y5", "slider acceleration limit"),
-    limitLine(x, -lim.slider_accel_mm_s2, "y5", "slider acceleration limit"),
-    limitLine(x, -lim.die_speed_mm_s, "y4", "die speed (below the die height)"),
+    { x, y: c.slider_height_mm, name: "slide height [mm]", yaxis: "y", line: { color: "#1f77b4" } },
+    { x, y: c.crank_speed_rpm, name: "crank speed [rpm]", yaxis: "y2", line: { color: "#d62728" } },
+    { x, y: c.crank_accel_rad_s2, name: "crank acceleration [rad/s²]", yaxis: "y3", line: { color: "#9467bd" } },
+    { x, y: c.crank_jerk_rad_s3, name: "crank jerk [rad/s³]", yaxis: "y6", line: { color: "#8c564b" } },
+    { x, y: c.slider_speed_mm_s, name: "slide speed [mm/s]", yaxis: "y4", line: { color: "#2ca02c" } },
+    { x, y: c.slider_accel_mm_s2, name: "slide acceleration [mm/s²]", yaxis: "y5", line: { color: "#ff7f0e" } },
+    ...limitTraces(ans.limit_lines, x, axis),
   ];
   const keyX = r.key_points.map((k) => (axis === "time" ? k.time_s : k.angle_deg));
   const keyIndex = keyX.map((v) => nearest(x, v));
   traces.push({ x: keyX, y: keyIndex.map((i) => c.slider_height_mm[i]), text: r.key_points.map((k) => KEY_LABELS[k.name]), mode: "markers+text", textposition: "top center", yaxis: "y", name: "key points", marker: { color: "#000", size: 7 }, showlegend: false });
   if (state.pinned) {
-    const p = state.pinned.curves, px = xOf(p), dash = { dash: "dash", color: "#777", width: 1 };
+    const p = state.pinned.curves, px = xOf(p), dash = { dash: "dot", color: "#777", width: 1 };
     traces.push({ x: px, y: p.crank_speed_rpm, name: "pinned crank speed", yaxis: "y2", line: dash });
     traces.push({ x: px, y: p.crank_accel_rad_s2, name: "pinned crank acceleration", yaxis: "y3", line: dash });
-    traces.push({ x: px, y: p.slider_accel_mm_s2, name: "pinned slider acceleration", yaxis: "y5", line: dash });
+    traces.push({ x: px, y: p.slider_accel_mm_s2, name: "pinned slide acceleration", yaxis: "y5", line: dash });
   }
+  const { shapes, annotations } = cycleShapes(r, x, axis);
+  const round = { nticks: 6, tickformat: "~g" };
   const layout = {
-    margin: { l: 60, r: 60, t: 10, b: 40 },
+    margin: { l: 60, r: 60, t: 24, b: 40 },
     hovermode: "x unified",
-    legend: { orientation: "h", y: -0.1, yanchor: "top" },
-    xaxis: { title: { text: axis === "time" ? "time from TDC [s]" : "crank angle from TDC [deg]" }, anchor: "y5" },
-    yaxis: { domain: [0.70, 1.0], title: { text: "height [mm]" } },
-    yaxis2: { overlaying: "y", side: "right", title: { text: "crank [rpm]" } },
-    yaxis3: { domain: [0.37, 0.63], title: { text: "crank accel [rad/s²]" } },
-    yaxis4: { domain: [0.0, 0.30], title: { text: "slider [mm/s]" } },
-    yaxis5: { overlaying: "y4", side: "right", title: { text: "slider [mm/s²]" } },
-    shapes: stageShapes(r, axis),
+    legend: { orientation: "h", y: -0.08, yanchor: "top", font: { size: 10 } },
+    xaxis: { title: { text: axis === "time" ? "time from TDC [s]" : "crank angle from TDC [deg]" }, anchor: "y4" },
+    yaxis: { ...round, domain: [0.78, 1.0], title: { text: "height [mm]" } },
+    yaxis2: { ...round, tickmode: "auto", overlaying: "y", side: "right", rangemode: "tozero", showgrid: false, title: { text: "crank [rpm]" } },
+    yaxis3: { ...round, domain: [0.53, 0.73], zeroline: true, title: { text: "crank accel [rad/s²]" } },
+    yaxis6: { ...round, domain: [0.28, 0.48], zeroline: true, title: { text: "crank jerk [rad/s³]" } },
+    yaxis4: { ...round, domain: [0.0, 0.23], title: { text: "slide [mm/s]" } },
+    yaxis5: { ...round, tickmode: "auto", overlaying: "y4", side: "right", showgrid: false, zeroline: false, title: { text: "slide [mm/s²]" } },
+    shapes,
+    annotations,
   };
   Plotly.react("motion-chart", traces, layout, { responsive: true, displaylogo: false });
   const chart = $("#motion-chart");
@@ -321,24 +342,36 @@ function drawDrive(r, c, x, axis) {
   const speeds = [0, m.base_speed_rpm];
   for (let k = 1; k <= 20; k++) speeds.push(m.base_speed_rpm + (k / 20) * (m.max_speed_rpm - m.base_speed_rpm));
   const envelope = speeds.map((n) => (m.peak_torque_Nm / 1e3) * Math.min(1, m.base_speed_rpm / Math.max(n, 1e-9)));
+  // the torque's limits where the motor is: the peak envelope at its speed (falling above the base speed)
+  // and the rated torque (the RMS limit), both signs
+  const atSpeed = c.motor_speed_rpm.map((n) => (m.peak_torque_Nm / 1e3) * Math.min(1, m.base_speed_rpm / Math.max(Math.abs(n), 1e-9)));
+  const rated = m.rated_torque_Nm / 1e3;
+  const limit = (y, name, color, showlegend) => ({ x, y, name, legendgroup: name, showlegend, line: { dash: "dash", width: 1.2, color }, hoverinfo: "name+y" });
   const traces = [
     { x, y: torque, name: "motor torque [kN m]", line: { color: "#d62728" } },
+    limit(atSpeed, "drive.motor.peak_torque_Nm: the envelope at the motor's speed", "#b22222", true),
+    limit(atSpeed.map((v) => -v), "drive.motor.peak_torque_Nm: the envelope at the motor's speed", "#b22222", false),
+    limit(x.map(() => rated), `drive.motor.rated_torque_Nm = ${rated} kN m (RMS limit)`, "#e08000", true),
+    limit(x.map(() => -rated), `drive.motor.rated_torque_Nm = ${rated} kN m (RMS limit)`, "#e08000", false),
     { x, y: c.motor_power_kW, name: "motor power [kW]", yaxis: "y2", line: { color: "#17becf" } },
-    { x: c.motor_speed_rpm, y: torque, xaxis: "x2", yaxis: "y3", mode: "lines", name: "cycle in the torque–speed plane", line: { color: "#d62728" } },
-    { x: speeds, y: envelope, xaxis: "x2", yaxis: "y3", name: "peak envelope", line: { dash: "dash", color: "#c0392b" } },
-    { x: speeds, y: envelope.map((v) => -v), xaxis: "x2", yaxis: "y3", showlegend: false, line: { dash: "dash", color: "#c0392b" } },
-    { x: [0, m.max_speed_rpm], y: [m.rated_torque_Nm / 1e3, m.rated_torque_Nm / 1e3], xaxis: "x2", yaxis: "y3", name: "rated torque", line: { dash: "dot", color: "#1f77b4" } },
+    { x: c.motor_speed_rpm, y: torque, xaxis: "x2", yaxis: "y3", mode: "lines", name: "cycle in the torque–speed plane", line: { color: "#d62728" }, showlegend: false },
+    { x: speeds, y: envelope, xaxis: "x2", yaxis: "y3", name: "peak envelope", line: { dash: "dash", color: "#b22222" }, showlegend: false },
+    { x: speeds, y: envelope.map((v) => -v), xaxis: "x2", yaxis: "y3", showlegend: false, line: { dash: "dash", color: "#b22222" } },
+    { x: [0, m.max_speed_rpm], y: [rated, rated], xaxis: "x2", yaxis: "y3", showlegend: false, name: "rated torque", line: { dash: "dash", color: "#e08000" } },
+    { x: [0, m.max_speed_rpm], y: [-rated, -rated], xaxis: "x2", yaxis: "y3", showlegend: false, name: "rated torque", line: { dash: "dash", color: "#e08000" } },
   ];
+  const { shapes } = cycleShapes(r, x, axis);
+  const round = { nticks: 6, tickformat: "~g" };
   const layout = {
-    margin: { l: 60, r: 60, t: 10, b: 40 },
+    margin: { l: 60, r: 30, t: 10, b: 40 },
     hovermode: "closest",
-    legend: { orientation: "h", y: -0.2, yanchor: "top" },
-    xaxis: { domain: [0, 0.55], title: { text: axis === "time" ? "time from TDC [s]" : "crank angle [deg]" } },
-    yaxis: { title: { text: "torque [kN m]" } },
-    yaxis2: { overlaying: "y", side: "right", title: { text: "power [kW]" }, anchor: "x" },
-    xaxis2: { domain: [0.68, 1], title: { text: "motor speed [rpm]" }, anchor: "y3" },
-    yaxis3: { anchor: "x2", title: { text: "torque [kN m]" } },
-    shapes: stageShapes(r, axis).map((s) => ({ ...s, xref: "x" })),
+    legend: { orientation: "h", y: -0.15, yanchor: "top", font: { size: 10 } },
+    xaxis: { domain: [0, 0.58], anchor: "y2", title: { text: axis === "time" ? "time from TDC [s]" : "crank angle [deg]" } },
+    yaxis: { ...round, domain: [0.53, 1], anchor: "x", title: { text: "motor torque [kN m]" } },
+    yaxis2: { ...round, domain: [0, 0.45], anchor: "x", zeroline: true, title: { text: "motor power [kW]" } },
+    xaxis2: { ...round, domain: [0.7, 1], title: { text: "motor speed [rpm]" }, anchor: "y3" },
+    yaxis3: { ...round, anchor: "x2", title: { text: "torque [kN m]" } },
+    shapes: shapes.map((sh) => ({ ...sh, xref: "x", yref: "paper" })),
   };
   Plotly.react(el, traces, layout, { responsive: true, displaylogo: false });
 }

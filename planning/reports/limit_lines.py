@@ -1,0 +1,99 @@
+"""Where each limit of a case applies over a plan's cycle, as a line to draw: one definition for the
+figures (``planning.reports.plots``) and the web page's charts.
+
+A :class:`LimitLine` bounds one trajectory column (``quantity``) with ``upper`` (and ``lower`` for a
+two-sided limit) given per sample, NaN where the limit does not apply: the safety height only in the
+robot's window, the die speed only where the slide is at or below the die height. The draw-start speed
+holds at theta2 alone: a ``point`` line, one sample there. Labels name the case field and the value.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class LimitLine:
+    """The limit of case ``field`` on trajectory column ``quantity``: ``upper`` (and ``lower``) per sample
+    of ``x``, NaN where it does not apply; ``point``: it holds at one crank angle (theta2), drawn as a mark."""
+
+    field: str
+    label: str
+    quantity: str
+    x: np.ndarray
+    upper: np.ndarray
+    lower: np.ndarray | None = None
+    point: bool = False
+
+
+def robot_windows(result: dict[str, Any], axis: str, x: np.ndarray) -> list[tuple[float, float]]:
+    """The robot's window theta4 -> TDC -> theta1 as spans of ``x`` (time [s] or crank angle [deg]): from
+    theta4 to the cycle's end and from its start to theta1."""
+    keys = {k["name"]: k for k in result["key_points"]}
+    at = "time_s" if axis == "time" else "angle_deg"
+    return [(keys["opening"][at], float(x[-1])), (float(x[0]), keys["closing"][at])]
+
+
+def limit_lines(result: dict[str, Any], columns: dict[str, np.ndarray], axis: str) -> list[LimitLine]:
+    """Every limit ``result`` (``result.json``'s data: ``process``, ``limits``, ``key_points``) sets, over the
+    samples ``columns`` (``trajectory.csv``'s), against time (``axis`` "time") or crank angle."""
+    lim, proc = result.get("limits", {}), result.get("process", {})
+    x = np.asarray(columns["time_s"] if axis == "time" else columns["crank_angle_deg"], dtype=float)
+    everywhere = np.ones(len(x), dtype=bool)
+    window = np.any([(x >= a) & (x <= b) for a, b in robot_windows(result, axis, x)], axis=0)
+    height = np.asarray(columns["slider_height_mm"], dtype=float)
+    lines: list[LimitLine] = []
+
+    def add(field: str, label: str, quantity: str, value: float, where: np.ndarray, both: bool = False) -> None:
+        upper = np.where(where, value, np.nan)
+        lines.append(LimitLine(field, label, quantity, x, upper, -upper if both else None))
+
+    if proc.get("safety_height_mm") is not None:
+        safety = proc["safety_height_mm"]
+        add(
+            "process.safety_height_mm",
+            f"process.safety_height_mm = {safety:g} mm (robot window)",
+            "slider_height_mm",
+            safety,
+            window,
+        )
+    die = lim.get("die_height_mm")
+    if die is not None:
+        add("limits.die_height_mm", f"limits.die_height_mm = {die:g} mm", "slider_height_mm", die, everywhere)
+    for key, quantity, text, where, both in (
+        ("crank_speed_rpm", "crank_speed_rpm", "{v:g} rpm", everywhere, False),
+        ("min_crank_speed_rpm", "crank_speed_rpm", "{v:g} rpm", everywhere, False),
+        ("crank_accel_rad_s2", "crank_accel_rad_s2", "±{v:g} rad/s²", everywhere, True),
+        ("crank_jerk_rad_s3", "crank_jerk_rad_s3", "±{v:g} rad/s³", everywhere, True),
+        (
+            "die_speed_mm_s",
+            "slider_speed_mm_s",
+            "±{v:g} mm/s (below the die height)",
+            height <= (die if die is not None else -np.inf),
+            True,
+        ),
+        ("slider_speed_mm_s", "slider_speed_mm_s", "±{v:g} mm/s", everywhere, True),
+        ("slider_accel_mm_s2", "slider_accel_mm_s2", "±{v:g} mm/s²", everywhere, True),
+    ):
+        value = lim.get(key)
+        if value is not None:
+            add(f"limits.{key}", f"limits.{key} = " + text.format(v=value), quantity, value, where, both)
+    v2 = lim.get("draw_start_speed_mm_s")
+    if v2 is not None:
+        keys = {k["name"]: k for k in result["key_points"]}
+        at = np.array([keys["draw_start"]["time_s" if axis == "time" else "angle_deg"]])
+        lines.append(
+            LimitLine(
+                "limits.draw_start_speed_mm_s",
+                f"limits.draw_start_speed_mm_s = ±{v2:g} mm/s (at θ2)",
+                "slider_speed_mm_s",
+                at,
+                np.array([v2]),
+                np.array([-v2]),
+                point=True,
+            )
+        )
+    return lines
