@@ -442,3 +442,15 @@ def test_the_charts_draw_every_limit_of_the_case_and_the_robot_window(page) -> N
     notes = page.evaluate("document.getElementById('motion-chart').layout.annotations.map((a) => a.text)")
     assert any(n.startswith("robot window θ4 → θ1: 2.000 s") for n in notes), notes
     screenshot(page, "web-limits")
+
+
+@browser
+def test_the_pin_is_cleared_on_a_case_change(page) -> None:
+    page.locator("#pin").click()
+    assert page.locator("#pin-line").inner_text().startswith("pinned 12.123 SPM")
+    before = int(page.evaluate("document.body.dataset.rendered"))
+    page.select_option("#case-select", "small-fast-cup.yaml")
+    wait_rendered(page, before)
+    assert page.locator("#pin-line").inner_text() == ""
+    names = page.evaluate("document.getElementById('motion-chart').data.map((t) => t.name)")
+    assert not any(str(n).startswith("pinned") for n in names)

@@ -430,6 +430,7 @@ function showLoaded(answer) {
   if (answer.status !== "ok") return;
   state.label = answer.label;
   state.data = answer.case;
+  state.pinned = null; // a pinned plan belongs to the case it was pinned on
   $("#case-label").textContent = answer.label;
   buildForm(answer.case);
   solveNow();
