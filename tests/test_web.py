@@ -454,3 +454,23 @@ def test_the_pin_is_cleared_on_a_case_change(page) -> None:
     assert page.locator("#pin-line").inner_text() == ""
     names = page.evaluate("document.getElementById('motion-chart').data.map((t) => t.name)")
     assert not any(str(n).startswith("pinned") for n in names)
+
+
+@browser
+def test_typing_alone_solves_once_the_keys_pause(page) -> None:
+    """No change event: the keys alone solve once they pause; the status says so from the first key."""
+    before = int(page.evaluate("document.body.dataset.rendered"))
+    spm = float(page.locator("#spm").inner_text())
+    page.evaluate(
+        "window.statuses = []; new MutationObserver(() => window.statuses.push(document.querySelector('#status')"
+        ".textContent)).observe(document.querySelector('#status'), { childList: true, characterData: true, "
+        "subtree: true })"
+    )
+    box = page.locator('[data-field="process.transfer_time_s"]')
+    box.click()
+    box.press("Control+A")
+    box.type("1.5", delay=30)
+    wait_rendered(page, before)
+    statuses = page.evaluate("window.statuses")
+    assert statuses[0].startswith("editing"), statuses  # pending from the first key, before any solve
+    assert float(page.locator("#spm").inner_text()) > spm + 0.5  # a shorter transfer: more strokes

@@ -13,7 +13,7 @@ const LIMIT_COLOURS = {
   "limits.slider_accel_mm_s2": "#cc5500",
 };
 const KEY_LABELS = { closing: "θ1", draw_start: "θ2", draw_end: "θ3", opening: "θ4" };
-const TYPING_REST_MS = 600;
+const TYPING_REST_MS = 120; // a pause this long in typing solves (a fast typist's keys come closer)
 const BOUND_REST_MS = 800;
 
 const state = { meta: null, label: "case", data: null, seq: 0, shownSeq: -1, last: null, pinned: null };
@@ -90,7 +90,12 @@ function fieldRow(spec, value) {
   row.appendChild(msg);
   if (spec.kind !== "label") input.addEventListener("change", onEdit);
   if (spec.kind !== "choice" && spec.kind !== "label") {  // typing: solve once the keys rest (a change solves at once)
-    input.addEventListener("input", () => { clearTimeout(editTimer); editTimer = setTimeout(onEdit, TYPING_REST_MS); });
+    input.addEventListener("input", () => {
+      window.lastInputAt = performance.now(); // the typing benchmark reads it
+      clearTimeout(editTimer);
+      editTimer = setTimeout(onEdit, TYPING_REST_MS);
+      setStatus("editing… the plan follows when the typing pauses", "busy"); // pending from the first key
+    });
   }
   return row;
 }
