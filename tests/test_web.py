@@ -474,3 +474,38 @@ def test_typing_alone_solves_once_the_keys_pause(page) -> None:
     statuses = page.evaluate("window.statuses")
     assert statuses[0].startswith("editing"), statuses  # pending from the first key, before any solve
     assert float(page.locator("#spm").inner_text()) > spm + 0.5  # a shorter transfer: more strokes
+
+
+@browser
+def test_the_page_shows_the_clis_summary_lines(page, tmp_path: Path, capsys) -> None:
+    from planning.cli import main
+
+    assert main(["solve", str(PUBLISHED), "--no-plots", "--out", str(tmp_path / "o")]) == 0
+    cli = [line for line in capsys.readouterr().out.splitlines() if not line.lstrip().startswith(("solver:", "wrote"))]
+    shown = [line for line in page.locator("#summary").inner_text().splitlines() if "solver:" not in line]
+    assert shown == cli
+
+
+@browser
+def test_objectives_that_weigh_the_motor_are_offered_only_with_a_drive(page) -> None:
+    option = 'select[data-field="planner.objective"] option[value="min-energy"]'
+    assert page.locator(option).is_disabled()
+    assert "needs a drive" in page.locator(option).get_attribute("title")
+    before = int(page.evaluate("document.body.dataset.rendered"))
+    page.select_option("#case-select", "wang2023-side-panel-drive.yaml")
+    wait_rendered(page, before)
+    assert not page.locator(option).is_disabled()
+
+
+@browser
+def test_an_infeasible_upload_shows_the_new_case_and_no_old_plan(page, tmp_path: Path) -> None:
+    data = published_data()
+    data["name"] = "too-long-a-transfer"
+    data["process"]["transfer_time_s"] = 60
+    page.set_input_files(
+        "#upload", files=[{"name": "long.yaml", "mimeType": "text/yaml", "buffer": yaml.safe_dump(data).encode()}]
+    )
+    page.wait_for_function("document.body.dataset.state === 'infeasible'", timeout=30_000)
+    assert page.locator("#case-label").inner_text() == "long.yaml"
+    assert "process.transfer_time_s = 60" in page.locator("#status").inner_text()
+    assert page.locator("#spm").inner_text() == "–" and page.locator("#key-points tbody tr").count() == 0

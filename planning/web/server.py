@@ -334,7 +334,7 @@ def solve_case(data: Any, label: str, session: Session, confirm: bool = True) ->
     """Validate and solve ``data`` from the session's last plan; the page's answer. ``confirm`` False: the
     fast answer from the last plan alone when it verifies (``confirmed`` False in the answer: the page
     then asks again with ``confirm``); else the cold solve's answer or better (``confirmed`` True)."""
-    from planning.reports.report import result_dict, sample_profile, trajectory_columns
+    from planning.reports.report import result_dict, sample_profile, summary_text, trajectory_columns
     from planning.solver.optimize import solve, solve_from
     from planning.solver.outcomes import Infeasible, PlanningError
 
@@ -367,6 +367,7 @@ def solve_case(data: Any, label: str, session: Session, confirm: bool = True) ->
         "result": _finite(result),
         "curves": curves,
         "limit_lines": chart_limits(result, columns),
+        "summary": summary_text(result),
         "mechanism": mechanism_drawing(case),
     }
 

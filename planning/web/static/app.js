@@ -69,7 +69,15 @@ function fieldRow(spec, value) {
     input.value = value ?? "";
   } else if (spec.kind === "choice") {
     input = document.createElement("select");
-    for (const c of spec.choices) input.add(new Option(c, c));
+    for (const c of spec.choices) {
+      const option = new Option(c, c);
+      // an objective at the line's rate weighs the motor: not offered on a case without a drive
+      if (spec.name === "planner.objective" && c !== "max-spm" && !(state.data && state.data.drive)) {
+        option.disabled = true;
+        option.title = "needs a drive: section (the motor it weighs)";
+      }
+      input.add(option);
+    }
     input.value = value ?? spec.choices[0];
   } else {
     input = document.createElement("input");
@@ -174,13 +182,25 @@ async function solveNow() {
     // the bound (half a second, in the server's other process) once the edits rest
     setTimeout(() => { if (seq === state.shownSeq) requestBound(data, seq); }, BOUND_REST_MS);
   } else {
-    // keep the last good plan on screen; say what is wrong, next to the field when one is named
+    if (state.newCase) clearPlan(); // a case just loaded that has no plan: show none, not the last case's
+    // keep the last good plan of this case on screen; say what is wrong, next to the field when one is named
     const field = answer.field || "";
     showMessage(field, answer.message);
     setStatus(answer.message + (field && answer.status !== "bad input" ? ` (the limit: ${field})` : ""), "failed");
     document.body.dataset.state = answer.status;
     document.body.dataset.rendered = String(seq);
   }
+}
+
+function clearPlan() {
+  state.last = null;
+  for (const id of ["#spm", "#cycle", "#binding", "#bound-share"]) $(id).textContent = "–";
+  for (const id of ["#drive-line", "#objective-line", "#pin-line", "#summary"]) $(id).textContent = "";
+  $("#key-points tbody").innerHTML = "";
+  Plotly.purge("motion-chart");
+  Plotly.purge("drive-chart");
+  $("#drive-chart").style.display = "none";
+  $("#mechanism-svg").innerHTML = "";
 }
 
 async function requestBound(data, seq) {
@@ -215,6 +235,8 @@ function render(answer, seq, confirmed) {
   if (seq !== state.shownSeq) $("#bound-share").textContent = "…";
   state.last = answer;
   state.shownSeq = seq;
+  state.newCase = false;
+  $("#summary").textContent = answer.summary || "";
   const r = answer.result;
   $("#spm").textContent = r.spm.toFixed(3);
   $("#cycle").textContent = r.cycle_time_s.toFixed(4);
@@ -436,6 +458,7 @@ function showLoaded(answer) {
   state.label = answer.label;
   state.data = answer.case;
   state.pinned = null; // a pinned plan belongs to the case it was pinned on
+  state.newCase = true; // until it has a plan, no other case's plan stays on screen
   $("#case-label").textContent = answer.label;
   buildForm(answer.case);
   solveNow();
