@@ -509,3 +509,75 @@ def test_an_infeasible_upload_shows_the_new_case_and_no_old_plan(page, tmp_path:
     assert page.locator("#case-label").inner_text() == "long.yaml"
     assert "process.transfer_time_s = 60" in page.locator("#status").inner_text()
     assert page.locator("#spm").inner_text() == "–" and page.locator("#key-points tbody tr").count() == 0
+
+
+def _children(pid: int) -> set[int]:
+    """Every process below ``pid`` (from /proc)."""
+    found, frontier = set(), {pid}
+    while frontier:
+        parents, frontier = frontier, set()
+        for stat in Path("/proc").glob("[0-9]*/stat"):
+            try:
+                fields = stat.read_text().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            if int(fields[1]) in parents:
+                child = int(stat.parent.name)
+                if child not in found:
+                    found.add(child)
+                    frontier.add(child)
+    return found
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="reads /proc")
+def test_sigterm_stops_the_server_and_every_process_it_started(tmp_path: Path) -> None:
+    """The bound's worker process (and what it started) ends with the server on SIGTERM (exit 143)."""
+    pytest.importorskip("flask")
+    import signal
+    import socket
+    import time
+    import urllib.request
+
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    root = Path(__file__).resolve().parents[1]
+    server = subprocess.Popen(
+        [sys.executable, "-m", "planning.cli", "serve", "--port", str(port)],
+        cwd=root,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+    )
+    try:
+        assert "serving on" in server.stdout.readline()
+        body = json.dumps({"label": LABEL, "case": published_data()}).encode()
+        request = urllib.request.Request(
+            f"http://127.0.0.1:{port}/api/bound", data=body, headers={"Content-Type": "application/json"}
+        )
+        for _ in range(50):  # the server may take a moment to listen
+            try:
+                answer = json.loads(urllib.request.urlopen(request, timeout=60).read())
+                break
+            except OSError:
+                time.sleep(0.1)
+        assert answer["status"] == "ok"
+        workers = _children(server.pid)
+        assert workers  # the bound ran in a worker process
+        server.send_signal(signal.SIGTERM)
+        assert server.wait(timeout=20) == 143
+        deadline = time.time() + 10
+        while time.time() < deadline and any(Path(f"/proc/{p}").exists() for p in workers):
+            time.sleep(0.1)
+        alive = [p for p in workers if Path(f"/proc/{p}").exists() and "Z" not in _state(p)]
+        assert not alive, alive
+    finally:
+        if server.poll() is None:
+            server.kill()
+
+
+def _state(pid: int) -> str:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return "gone"

@@ -88,6 +88,7 @@ def create_app(
     app = Flask(__name__, static_folder=None)
     app.config["MAX_CONTENT_LENGTH"] = MAX_REQUEST_BYTES
     bound_pool = _BoundPool()
+    app.extensions["pressplan_bound_pool"] = bound_pool  # serve() stops its worker on the way out
     sessions = Sessions()
     app.extensions["pressplan_sessions"] = sessions  # the tests hold a session's lock to see superseding
     bounds: OrderedDict[str, dict] = OrderedDict()
@@ -426,6 +427,19 @@ class _BoundPool:
         except Exception as exc:  # noqa: BLE001 - the bound is extra information: say why it is missing
             return {"status": "none", "message": f"no bound ({type(exc).__name__})"}
 
+    def close(self) -> None:
+        """Stop the worker process now (a bound under way is dropped)."""
+        with self._lock:
+            pool, self._pool = self._pool, None
+        if pool is None:
+            return
+        processes = list(getattr(pool, "_processes", {}).values())  # the executor keeps no public handle
+        pool.shutdown(wait=False, cancel_futures=True)
+        for process in processes:
+            process.terminate()
+        for process in processes:
+            process.join(timeout=5)
+
 
 def bound_of(data: Any, label: str) -> dict[str, Any]:
     """The time-optimal bound of the case (``pressplan bound``), or why there is none."""
@@ -483,4 +497,7 @@ def serve(case_path: Path | None, host: str, port: int, cases_dir: Path | None) 
     """Run the server until Ctrl-C; prints the address."""
     app = create_app(cases_dir, case_path, (host,))
     print(f"pressplan: serving on http://{host}:{port}/ (Ctrl-C stops)", flush=True)
-    app.run(host=host, port=port, threaded=True, use_reloader=False)
+    try:
+        app.run(host=host, port=port, threaded=True, use_reloader=False)
+    finally:  # Ctrl-C or SIGTERM (raised in this thread by the CLI): no worker process outlives the server
+        app.extensions["pressplan_bound_pool"].close()
