@@ -15,46 +15,10 @@ import tempfile
 import time
 from pathlib import Path
 
-import yaml
-
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
 RUNS = 5
 TARGET_S = 1.0
-WINDOWS = {  # case, key angles [deg as typed], changed fields
-    "radians, crank-slider 300/1000": (
-        "wang2023-side-panel.yaml",
-        (1.05, 2.44, 3.32, 5.24),
-        {"process": {"safety_height_mm": 400}, "press": {"crank_radius_mm": 300, "rod_length_mm": 1000}},
-    ),
-    "crank-slider, all before BDC": (
-        "wang2023-side-panel.yaml",
-        (20, 40, 60, 80),
-        {"process": {"safety_height_mm": 300}, "limits": {"die_height_mm": 5}},
-    ),
-    "link drive, all after BDC": (
-        "link-drive-side-panel.yaml",
-        (300, 310, 320, 330),
-        {"process": {"safety_height_mm": 300}, "limits": {"die_height_mm": 5}},
-    ),
-    "knuckle joint, all before BDC": (
-        "knuckle-joint-coining.yaml",
-        (20, 40, 60, 80),
-        {"process": {"safety_height_mm": 30}, "limits": {"die_height_mm": 1}},
-    ),
-}
-
-
-def case_file(folder: Path, name: str) -> Path:
-    source, angles, changes = WINDOWS[name]
-    data = yaml.safe_load((ROOT / "cases" / source).read_text(encoding="utf-8"))
-    data.pop("published", None)
-    keys = ("closing_deg", "draw_start_deg", "draw_end_deg", "opening_deg")
-    data["key_points"] = dict(zip(keys, angles, strict=True))
-    for section, fields in changes.items():
-        data[section].update(fields)
-    path = folder / f"{len(list(folder.iterdir()))}.yaml"
-    path.write_text(yaml.safe_dump(data), encoding="utf-8")
-    return path
 
 
 def timed(cmd: list[str]) -> float:
@@ -66,11 +30,13 @@ def timed(cmd: list[str]) -> float:
 
 
 def main() -> None:
+    from tests.test_first_hour import WINDOWS_THROUGH_BDC, window_case  # the cases the test refuses
+
     exe = str(Path(sys.executable).with_name("pressplan"))
     rows = []
     with tempfile.TemporaryDirectory() as folder:
-        for name in WINDOWS:
-            path = case_file(Path(folder), name)
+        for name in WINDOWS_THROUGH_BDC:
+            path = window_case(Path(folder), name)
             check = statistics.median(timed([exe, "check", str(path)]) for _ in range(RUNS))
             solve = statistics.median(
                 timed([exe, "solve", str(path), "--out", str(Path(folder) / "out")]) for _ in range(RUNS)

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from functools import cached_property
 from typing import Any, ClassVar
 
@@ -174,17 +174,20 @@ class Linkage(Mechanism):
     """A mechanism whose slide is driven through a chain of circle intersections (module docstring).
     Subclasses give ``chain``, ``formula_of`` (their :class:`~press.mechanism.Formula`), ``links`` (each
     link's joints: ``name -> (first joint, second joint, index of its length)``, the link's axis from the
-    first to the second) and :attr:`dimensions`."""
+    first to the second) and, when the chain reads more than the fields in order, :attr:`dimensions`."""
 
     chain: ClassVar[Chain]
     formula_of: ClassVar[Formula]
     links: ClassVar[dict[str, tuple[str, str, int]]]
-    dimension_names: ClassVar[tuple[str, ...]]  # the dataclass fields, in the case's order
+
+    def __post_init__(self) -> None:
+        self._dead_centres  # noqa: B018 - a geometry that cannot be a press is refused at once
 
     @property
     def dimensions(self) -> tuple[float, ...]:
-        """The numbers the chain reads (before ``phi_TDC`` and ``y_BDC``)."""
-        raise NotImplementedError
+        """The numbers the chain reads (before ``phi_TDC`` and ``y_BDC``): the dataclass fields in order,
+        unless a subclass says otherwise."""
+        return tuple(getattr(self, f.name) for f in fields(self))
 
     @property
     def formula(self) -> Formula:
@@ -346,23 +349,10 @@ class LinkDrive(Linkage):
     chain = staticmethod(link_drive_chain)
     formula_of = LINK_DRIVE
     links = LINK_DRIVE_LINKS
-    dimension_names = (
-        "crank_radius",
-        "ternary_rocker_side",
-        "rocker",
-        "rocker_pivot_x",
-        "rocker_pivot_y",
-        "ternary_angle",
-        "ternary_rod_side",
-        "rod_length",
-        "slide_offset",
-    )
-
-    def __post_init__(self) -> None:
-        self._dead_centres  # noqa: B018 - a geometry that cannot be a press is refused at once
 
     @property
     def dimensions(self) -> tuple[float, ...]:
+        """The fields in order, the ternary angle as its cosine and sine."""
         return (
             self.crank_radius,
             self.ternary_rocker_side,
@@ -396,27 +386,3 @@ class KnuckleJoint(Linkage):
     chain = staticmethod(knuckle_joint_chain)
     formula_of = KNUCKLE_JOINT
     links = KNUCKLE_JOINT_LINKS
-    dimension_names = (
-        "crank_radius",
-        "rod_length",
-        "rocker",
-        "rocker_pivot_x",
-        "rocker_pivot_y",
-        "main_rod",
-        "slide_offset",
-    )
-
-    def __post_init__(self) -> None:
-        self._dead_centres  # noqa: B018 - a geometry that cannot be a press is refused at once
-
-    @property
-    def dimensions(self) -> tuple[float, ...]:
-        return (
-            self.crank_radius,
-            self.rod_length,
-            self.rocker,
-            self.rocker_pivot_x,
-            self.rocker_pivot_y,
-            self.main_rod,
-            self.slide_offset,
-        )

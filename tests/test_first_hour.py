@@ -15,38 +15,44 @@ CASES = ROOT / "cases"
 KEYS = ("closing_deg", "draw_start_deg", "draw_end_deg", "opening_deg")
 
 
-def _with_key_angles(tmp_path: Path, case: str, angles: tuple[float, ...], **fields: float) -> Path:
-    data = yaml.safe_load((CASES / case).read_text())
-    data.pop("published", None)
-    data["key_points"] = dict(zip(KEYS, angles, strict=True))
-    for dotted, value in fields.items():
-        section, key = dotted.split("__")
-        data[section][key] = value
-    path = tmp_path / f"{Path(case).stem}-arc.yaml"
-    path.write_text(yaml.safe_dump(data))
-    return path
-
-
 # Key angles whose robot window (theta4 -> TDC -> theta1) passes BDC: no motion keeps the slide above
 # the safety height there. The first is the radians mistake (1.05 rad meant 60 deg) on a 300/1000 press.
+# name -> (shipped case, key angles as typed [deg], changed fields); benchmarks/bench_refusal.py times them.
 WINDOWS_THROUGH_BDC = {
-    "radians": ("wang2023-side-panel.yaml", (1.05, 2.44, 3.32, 5.24), {"process__safety_height_mm": 400}),
+    "radians": (
+        "wang2023-side-panel.yaml",
+        (1.05, 2.44, 3.32, 5.24),
+        {"process.safety_height_mm": 400, "press.crank_radius_mm": 300, "press.rod_length_mm": 1000},
+    ),
     "crank-slider, all before BDC": (
         "wang2023-side-panel.yaml",
         (20, 40, 60, 80),
-        {"process__safety_height_mm": 300, "limits__die_height_mm": 5},
+        {"process.safety_height_mm": 300, "limits.die_height_mm": 5},
     ),
     "link drive, all after BDC": (
         "link-drive-side-panel.yaml",
         (300, 310, 320, 330),
-        {"process__safety_height_mm": 300, "limits__die_height_mm": 5},
+        {"process.safety_height_mm": 300, "limits.die_height_mm": 5},
     ),
     "knuckle joint, all before BDC": (
         "knuckle-joint-coining.yaml",
         (20, 40, 60, 80),
-        {"process__safety_height_mm": 30, "limits__die_height_mm": 1},
+        {"process.safety_height_mm": 30, "limits.die_height_mm": 1},
     ),
 }
+
+
+def window_case(folder: Path, name: str) -> Path:
+    """The case file of :data:`WINDOWS_THROUGH_BDC` entry ``name``, written in ``folder``."""
+    from planning.model.case_file import with_fields
+
+    case, angles, fields = WINDOWS_THROUGH_BDC[name]
+    data = yaml.safe_load((CASES / case).read_text())
+    data.pop("published", None)
+    data = with_fields(data, {**{f"key_points.{k}": a for k, a in zip(KEYS, angles, strict=True)}, **fields})
+    path = folder / f"{Path(case).stem}-{len(list(folder.iterdir()))}.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path
 
 
 @pytest.mark.parametrize("name", WINDOWS_THROUGH_BDC)
@@ -59,10 +65,8 @@ def test_a_window_through_bdc_is_refused_before_solving(name, tmp_path, capsys, 
         raise AssertionError("an NLP was built for a case the prechecks should refuse")
 
     monkeypatch.setattr(casadi, "nlpsol", no_nlp)
-    case, angles, fields = WINDOWS_THROUGH_BDC[name]
-    if name == "radians":
-        fields = {**fields, "press__crank_radius_mm": 300, "press__rod_length_mm": 1000}
-    path = _with_key_angles(tmp_path, case, angles, **fields)
+    angles = WINDOWS_THROUGH_BDC[name][1]
+    path = window_case(tmp_path, name)
     assert main(["check", str(path)]) == 3
     out = capsys.readouterr().out
     fail = [line for line in out.splitlines() if line.strip().startswith("FAIL")]

@@ -21,7 +21,7 @@ from planning.reports.report import result_dict
 from planning.solver.bound import time_optimal_bound
 from planning.solver.optimize import solve
 
-from .web_page import ARTIFACTS, CASES, chromium, edit, missing_browser, running_server, wait_rendered
+from .web_page import ARTIFACTS, CASES, chromium, edit, missing_browser, pick_case, running_server, wait_rendered
 
 PUBLISHED = CASES / "wang2023-side-panel.yaml"
 LABEL = "cases/wang2023-side-panel.yaml"
@@ -236,9 +236,7 @@ def test_a_drive_case_shows_its_motor(site) -> None:
     tab = context.new_page()
     tab.goto(url)
     wait_rendered(tab)
-    before = int(tab.evaluate("document.body.dataset.rendered"))
-    tab.locator("#case-select").select_option("cup-2000kN-drive.yaml")
-    wait_rendered(tab, before)
+    pick_case(tab, "cup-2000kN-drive.yaml")
     data = load_yaml((CASES / "cup-2000kN-drive.yaml").read_text(encoding="utf-8"))
     expected = cli_numbers(copy.deepcopy(data))
     assert tab.locator("#spm").inner_text() == expected["spm"]
@@ -265,9 +263,7 @@ def test_a_linkage_case_shows_its_mechanism_and_follows_a_geometry_edit(site) ->
     tab = context.new_page()
     tab.goto(url)
     wait_rendered(tab)
-    before = int(tab.evaluate("document.body.dataset.rendered"))
-    tab.locator("#case-select").select_option("link-drive-side-panel.yaml")
-    wait_rendered(tab, before)
+    pick_case(tab, "link-drive-side-panel.yaml")
     data = load_yaml((CASES / "link-drive-side-panel.yaml").read_text(encoding="utf-8"))
     label = "cases/link-drive-side-panel.yaml"
     assert tab.locator("#spm").inner_text() == f"{solve(case_from_data(copy.deepcopy(data), label)).plan.spm:.3f}"
@@ -429,9 +425,7 @@ def test_a_download_is_the_confirmed_plan_on_screen_without_a_solve(monkeypatch)
 def test_the_charts_draw_every_limit_of_the_case_and_the_robot_window(page) -> None:
     """On the servo-limited case (crank speed, acceleration and jerk bind) every limit of the case is a
     named line on the charts (the figures' own lines), the robot window is shaded with its time written."""
-    before = int(page.evaluate("document.body.dataset.rendered"))
-    page.select_option("#case-select", "side-panel-servo-limits.yaml")
-    wait_rendered(page, before)
+    pick_case(page, "side-panel-servo-limits.yaml")
     names = page.evaluate("document.getElementById('motion-chart').data.map((t) => t.name)")
     case = read_case(CASES / "side-panel-servo-limits.yaml")
     set_limits = [f"limits.{k}" for k, v in case.limits.model_dump().items() if v is not None]
@@ -448,9 +442,7 @@ def test_the_charts_draw_every_limit_of_the_case_and_the_robot_window(page) -> N
 def test_the_pin_is_cleared_on_a_case_change(page) -> None:
     page.locator("#pin").click()
     assert page.locator("#pin-line").inner_text().startswith("pinned 12.123 SPM")
-    before = int(page.evaluate("document.body.dataset.rendered"))
-    page.select_option("#case-select", "small-fast-cup.yaml")
-    wait_rendered(page, before)
+    pick_case(page, "small-fast-cup.yaml")
     assert page.locator("#pin-line").inner_text() == ""
     names = page.evaluate("document.getElementById('motion-chart').data.map((t) => t.name)")
     assert not any(str(n).startswith("pinned") for n in names)
@@ -491,9 +483,7 @@ def test_objectives_that_weigh_the_motor_are_offered_only_with_a_drive(page) -> 
     option = 'select[data-field="planner.objective"] option[value="min-energy"]'
     assert page.locator(option).is_disabled()
     assert "needs a drive" in page.locator(option).get_attribute("title")
-    before = int(page.evaluate("document.body.dataset.rendered"))
-    page.select_option("#case-select", "wang2023-side-panel-drive.yaml")
-    wait_rendered(page, before)
+    pick_case(page, "wang2023-side-panel-drive.yaml")
     assert not page.locator(option).is_disabled()
 
 

@@ -79,6 +79,13 @@ def wait_rendered(page, after: int = 0) -> int:  # noqa: ANN001 - a Playwright p
     return int(page.evaluate("document.body.dataset.rendered"))
 
 
+def pick_case(page, name: str) -> int:  # noqa: ANN001 - a Playwright page
+    """Pick case ``name`` in the page's case list; returns the number of its answer."""
+    before = int(page.evaluate("document.body.dataset.rendered"))
+    page.select_option("#case-select", name)
+    return wait_rendered(page, before)
+
+
 def edit(page, field: str, value: str) -> int:  # noqa: ANN001 - a Playwright page
     """Type ``value`` into the form's ``field`` and leave it (a change); returns the number of the answer."""
     before = int(page.evaluate("document.body.dataset.rendered"))

@@ -14,6 +14,19 @@ from typing import Any
 
 import numpy as np
 
+COLOURS = {  # by case field, the figures' and the page's; the curve a limit bounds has its hue
+    "process.safety_height_mm": "#1f77b4",  # matplotlib's tab:blue, as the slide height
+    "limits.die_height_mm": "#5b8cc0",
+    "limits.crank_speed_rpm": "#8b0000",
+    "limits.min_crank_speed_rpm": "#e07070",
+    "limits.crank_accel_rad_s2": "#4b0082",
+    "limits.crank_jerk_rad_s3": "#5c3317",
+    "limits.die_speed_mm_s": "#006400",
+    "limits.slider_speed_mm_s": "#2e8b57",
+    "limits.draw_start_speed_mm_s": "#006400",
+    "limits.slider_accel_mm_s2": "#cc5500",
+}
+
 
 @dataclass(frozen=True)
 class LimitLine:
@@ -27,6 +40,11 @@ class LimitLine:
     upper: np.ndarray
     lower: np.ndarray | None = None
     point: bool = False
+
+    @property
+    def colour(self) -> str:
+        """The line's colour in the figures and on the page."""
+        return COLOURS.get(self.field, "#444444")
 
 
 def robot_windows(result: dict[str, Any], axis: str, x: np.ndarray) -> list[tuple[float, float]]:

@@ -21,6 +21,21 @@ name: {name}
 title: {title}
 """
 
+# the side panel's process and limits (the published case's), for the presses that draw it
+_SIDE_PANEL_PROCESS = """\
+process:
+  safety_height_mm: 700              # the slide stays at or above this while the robot moves a part
+  transfer_time_s: 2.0               # the robot needs at least this long from theta4 to theta1
+"""
+_SIDE_PANEL_LIMITS = """\
+limits:
+  draw_start_speed_mm_s: 300         # the slide's speed when the die meets the blank, at most
+  die_height_mm: 10                  # at and below this height ...
+  die_speed_mm_s: 80                 # ... the slide moves slower than this
+  slider_accel_mm_s2: 3500           # |slide acceleration| everywhere, at most
+"""
+_SIDE_PANEL_FORCE = "  forming_force_kN: [[200, 0], [180, 4500], [60, 6000], [10, 4000], [0, 1500]]"
+
 _PRESS = {
     "crank-slider": """\
 press:
@@ -33,15 +48,11 @@ key_points:                          # crank angle from TDC [deg], in this order
   draw_start_deg: 131.5              # theta2: the upper die meets the blank; the draw starts
   draw_end_deg: 195                  # theta3: the draw ends (BDC is at 180 deg on an in-line press)
   opening_deg: 294                   # theta4: the slide is back above the safety height
-process:
-  safety_height_mm: 700              # the slide stays at or above this while the robot moves a part
-  transfer_time_s: 2.0               # the robot needs at least this long from theta4 to theta1
-  # draw_speed_rpm: 6.7              # a fixed crank speed for the draw; leave out to let the limits choose
-limits:
-  draw_start_speed_mm_s: 300         # the slide's speed when the die meets the blank, at most
-  die_height_mm: 10                  # at and below this height ...
-  die_speed_mm_s: 80                 # ... the slide moves slower than this
-  slider_accel_mm_s2: 3500           # |slide acceleration| everywhere, at most
+"""
+    + _SIDE_PANEL_PROCESS
+    + "  # draw_speed_rpm: 6.7              # a fixed crank speed for the draw; leave out to let the limits choose\n"
+    + _SIDE_PANEL_LIMITS
+    + """\
   # crank_speed_rpm: 30              # optional: the crank's top speed, acceleration, jerk, the slide's top
   # crank_accel_rad_s2: 10           #   speed anywhere (slider_speed_mm_s); the optimal law needs a jerk
   # crank_jerk_rad_s3: 60            #   limit
@@ -64,15 +75,9 @@ key_points:                          # crank angle from this press's TDC [deg] (
   draw_start_deg: 143.5              # theta2: the upper die meets the blank; the draw starts
   draw_end_deg: 233                  # theta3: the draw ends (BDC is at 220.9 deg on this press)
   opening_deg: 316.3                 # theta4: the slide is back above the safety height
-process:
-  safety_height_mm: 700              # the slide stays at or above this while the robot moves a part
-  transfer_time_s: 2.0               # the robot needs at least this long from theta4 to theta1
-limits:
-  draw_start_speed_mm_s: 300         # the slide's speed when the die meets the blank, at most
-  die_height_mm: 10                  # at and below this height ...
-  die_speed_mm_s: 80                 # ... the slide moves slower than this
-  slider_accel_mm_s2: 3500           # |slide acceleration| everywhere, at most
-""",
+"""
+    + _SIDE_PANEL_PROCESS
+    + _SIDE_PANEL_LIMITS,
     "knuckle-joint": """\
 press:
   mechanism: knuckle-joint           # a knuckle-joint (toggle) press; sketch and letters: docs/knuckle-joint.svg
@@ -107,8 +112,8 @@ planner:
 """
 
 _FORCE = {
-    "crank-slider": "  forming_force_kN: [[200, 0], [180, 4500], [60, 6000], [10, 4000], [0, 1500]]",
-    "link-drive": "  forming_force_kN: [[200, 0], [180, 4500], [60, 6000], [10, 4000], [0, 1500]]",
+    "crank-slider": _SIDE_PANEL_FORCE,
+    "link-drive": _SIDE_PANEL_FORCE,
     "knuckle-joint": "  forming_force_kN: [[2.8, 0], [1.5, 800], [0.6, 3000], [0.2, 5200], [0, 6000]]",
 }
 

@@ -128,25 +128,11 @@ def _overlay(ax, x, published: dict[str, np.ndarray] | None, column: str, colour
         ax.plot(x, published[column], color=colour, lw=1.2, ls=":", alpha=alpha, label="published solution (rebuilt)")
 
 
-LIMIT_COLOURS = {  # by case field; the curve a limit bounds has the same hue, lighter or darker
-    "process.safety_height_mm": "tab:blue",
-    "limits.die_height_mm": "#5b8cc0",
-    "limits.crank_speed_rpm": "#8b0000",
-    "limits.min_crank_speed_rpm": "#e07070",
-    "limits.crank_accel_rad_s2": "#4b0082",
-    "limits.crank_jerk_rad_s3": "#5c3317",
-    "limits.die_speed_mm_s": "#006400",
-    "limits.slider_speed_mm_s": "#2e8b57",
-    "limits.draw_start_speed_mm_s": "#006400",
-    "limits.slider_accel_mm_s2": "#cc5500",
-}
-
-
 def _draw_limits(axes_of: dict[str, Any], lines: list[LimitLine]) -> None:
     """Each limit line on the panel of the quantity it bounds (``planning.reports.limit_lines``)."""
     for line in lines:
         ax = axes_of[line.quantity]
-        colour = LIMIT_COLOURS.get(line.field, "#444444")
+        colour = line.colour
         if line.point:
             ys = [*line.upper, *(line.lower if line.lower is not None else [])]
             ax.plot([line.x[0]] * len(ys), ys, ls="none", marker="_", ms=14, mew=2.2, color=colour, label=line.label)

@@ -383,6 +383,7 @@ def chart_limits(result: dict[str, Any], columns: dict[str, np.ndarray]) -> list
     out = []
     for line, timed in zip(limit_lines(result, columns, "angle"), by_time, strict=True):
         item: dict[str, Any] = {"field": line.field, "label": line.label, "quantity": line.quantity}
+        item["colour"] = line.colour
         item["point"] = line.point
         item["upper"] = _finite(_rounded(line.upper))
         item["lower"] = _finite(_rounded(line.lower)) if line.lower is not None else None

@@ -6,12 +6,6 @@ const SECTIONS = ["press", "press.link_drive", "press.knuckle_joint", "key_point
 // the press section's own keys belong to the crank-slider; a linkage's dimensions are in its subsection
 const CRANK_SLIDER_KEYS = ["press.crank_radius_mm", "press.rod_length_mm", "press.offset_mm", "drive.rod_mass_kg", "drive.rod_cg_from_crank_pin_mm"];
 const WINDOW_COLOUR = "#d9ecff", DRAW_COLOUR = "#e2f0d9"; // the robot's window, the draw
-const LIMIT_COLOURS = {
-  "process.safety_height_mm": "#1f77b4", "limits.die_height_mm": "#5b8cc0", "limits.crank_speed_rpm": "#8b0000",
-  "limits.min_crank_speed_rpm": "#e07070", "limits.crank_accel_rad_s2": "#4b0082", "limits.crank_jerk_rad_s3": "#5c3317",
-  "limits.die_speed_mm_s": "#006400", "limits.slider_speed_mm_s": "#2e8b57", "limits.draw_start_speed_mm_s": "#006400",
-  "limits.slider_accel_mm_s2": "#cc5500",
-};
 const KEY_LABELS = { closing: "θ1", draw_start: "θ2", draw_end: "θ3", opening: "θ4" };
 const TYPING_REST_MS = 120; // a pause this long in typing solves (a fast typist's keys come closer)
 const BOUND_REST_MS = 800;
@@ -297,7 +291,7 @@ const LIMIT_AXES = { slider_height_mm: "y", crank_speed_rpm: "y2", crank_accel_r
 function limitTraces(lines, x, axis) {
   const traces = [];
   for (const line of lines || []) {
-    const style = { dash: "dash", width: 1.2, color: LIMIT_COLOURS[line.field] || "#c0392b" };
+    const style = { dash: "dash", width: 1.2, color: line.colour };
     const common = { yaxis: LIMIT_AXES[line.quantity], name: line.label, legendgroup: line.field, hoverinfo: "name" };
     if (line.point) {
       const px = axis === "time" ? line.at.time : line.at.angle;
