@@ -101,8 +101,7 @@ def rate_block(case: Case, placement: Placement | None, fastest: Any, rates: lis
                 neighbour=previous.plan if previous else None,
                 fastest=fastest,
                 neighbour_baseline=previous.at_rate.baseline.plan if previous else None,
-                confirm=False,
-            )
+            )  # the cold solve's plan at this rate, or the neighbour's where it is better
             previous = sol
             row.update(solved_row(sol, at_rate))
         except PlanningError as exc:

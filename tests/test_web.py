@@ -571,3 +571,84 @@ def _state(pid: int) -> str:
         return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
     except OSError:
         return "gone"
+
+
+def test_a_burst_of_other_sessions_never_queues_ahead_of_a_quiet_one() -> None:
+    """The fair queue: while one solve runs, ten busy sessions (each solved before) and a quiet one wait;
+    the quiet one starts next, so a burst delays it by the running solve only. A session's older waiting
+    request is superseded by its newer one."""
+    pytest.importorskip("flask")
+    import threading
+
+    from planning.web.server import SUPERSEDED, FairQueue
+
+    queue = FairQueue(slots=1)
+    started: list[str] = []
+    busy = [f"burst-{k}" for k in range(10)]
+    for name in busy:  # each busy session has had its turn
+        queue.run(name, 0, lambda name=name: started.append(name))
+    release = threading.Event()
+    results: dict[str, object] = {}
+
+    def send(name: str, seq: int, work) -> None:  # noqa: ANN001
+        results[f"{name}#{seq}"] = queue.run(name, seq, work)
+
+    def record(name: str):  # noqa: ANN202
+        return lambda: started.append(name) or name
+
+    running = threading.Thread(target=send, args=("burst-0", 1, lambda: release.wait(30) and started.append("held")))
+    running.start()
+    while "held" not in started and not queue._running:  # noqa: SLF001 - the held solve has started
+        pass
+    threads = [threading.Thread(target=send, args=(name, 1, record(name))) for name in busy[1:]]
+    for t in threads:
+        t.start()
+    while len(queue._waiting) < len(busy) - 1:  # noqa: SLF001
+        pass
+    quiet = threading.Thread(target=send, args=("quiet", 1, record("quiet")))
+    quiet.start()
+    older = threading.Thread(target=send, args=("burst-5", 0, record("never")))  # older than its waiting one
+    older.start()
+    older.join(5)
+    while "quiet" not in queue._waiting:  # noqa: SLF001
+        pass
+    release.set()
+    for t in (running, *threads, quiet):
+        t.join(30)
+    after = started[len(busy) + 1 :]
+    assert after[0] == "quiet", after
+    assert sorted(after[1:]) == sorted(busy[1:])
+    assert results["burst-5#0"] is SUPERSEDED and "never" not in started
+
+
+def test_an_edits_fast_answer_never_waits_behind_cold_solves() -> None:
+    """Both cold slots held by other sessions' solves: a session with a plan still gets its edit's fast
+    answer (the cold queue and the fast queue are apart)."""
+    pytest.importorskip("flask")
+    import threading
+
+    from planning.web.server import SOLVES_AT_ONCE, create_app
+
+    app = create_app(CASES)
+    client = app.test_client()
+    data = published_data()
+    first = client.post("/api/solve", json={"session": "quiet", "seq": 1, "case": data, "confirm": True})
+    assert first.get_json()["status"] == "verified"
+    sessions = app.extensions["pressplan_sessions"]
+    held = [sessions.get(f"busy-{k}") for k in range(SOLVES_AT_ONCE)]
+    threads = []
+    for k, session in enumerate(held):
+        session.lock.acquire()  # its cold solve has its slot and cannot go on
+        body = {"session": f"busy-{k}", "seq": 1, "case": data, "confirm": True}
+        threads.append(threading.Thread(target=client.post, args=("/api/solve",), kwargs={"json": body}))
+        threads[-1].start()
+    cold = app.extensions["pressplan_queues"]["cold"]
+    while len(cold._running) < SOLVES_AT_ONCE:  # noqa: SLF001 - both slots taken
+        pass
+    edited = {**data, "process": {**data["process"], "transfer_time_s": 1.9}}
+    answer = client.post("/api/solve", json={"session": "quiet", "seq": 2, "case": edited}).get_json()
+    for session in held:
+        session.lock.release()
+    for t in threads:
+        t.join(60)
+    assert answer["status"] == "verified" and answer["confirmed"] is False

@@ -161,13 +161,21 @@ def _run_starts(
     confirm: bool,
     to_beat: float = math.inf,
 ) -> None:
-    """A neighbouring rate's plan alone when it leads to a verified plan scoring below ``to_beat`` (a
-    trade-off following its rates, as a sweep does; the objective's ``to_beat`` is the baseline's score:
-    a neighbour's start can end in a local optimum worse than waiting), else the ``starts`` until two
-    agree (``confirm``) or one verifies."""
+    """One answer per case (``confirm``): the ``starts`` until two agree, exactly as with no neighbour (the
+    cold solve), then a start from a neighbouring rate's plan competes with them; the search keeps the
+    best, so the answer is the cold solve's or better. ``confirm`` False (fast, unconfirmed): the
+    neighbour's start alone when it leads to a verified plan scoring below ``to_beat`` (the objective's
+    ``to_beat`` is the baseline's score: a neighbour's start can end in a local optimum worse than
+    waiting), else the ``starts`` until one verifies."""
     fits = neighbour is not None and bool(neighbour.nlp_values)
-    if fits and (placement == "free" or neighbour.placement == placement):
+    fits = fits and (placement == "free" or neighbour.placement == placement)
+    if confirm:
+        search.multi_start(starts, placement, confirm=True)
+        if fits and not search.stopped:
+            search.attempt(neighbour.nlp_values, placement)
+        return
+    if fits:
         found = search.attempt(neighbour.nlp_values, placement)
         if found is not None and found[1] < to_beat:
             return
-    search.multi_start(starts, placement, confirm)
+    search.multi_start(starts, placement, confirm=False)

@@ -10,12 +10,20 @@ case files are offered by name from one folder, and a name is looked up in that 
 to a path; each browser tab sends its own session id, and a session's plan (its warm start) is seen by
 no other session. A solve is superseded by a newer edit of the same session: a request that was
 overtaken while it waited returns at once, so at most one solve runs and one waits per session. The
-number of sessions kept is bounded (:data:`MAX_SESSIONS`, the least recently used is dropped).
+solves of all sessions share two fair queues (:class:`FairQueue`), one for the fast answers (one warm
+start from the session's plan) and one for the cold solves that confirm them: in each at most
+:data:`SOLVES_AT_ONCE` run, and the waiting session served least recently goes first. So one tab's burst
+of edits, or many tabs' cold solves, delay another tab's fast answer to an edit by the fast answers
+already running at most (``benchmarks/bench_web.py`` measures it under a 20-session burst). A confirmed
+answer is kept by its case (:data:`ANSWER_CACHE` of them): the same case again, from any tab, is
+answered without a solve. The number of sessions kept is bounded (:data:`MAX_SESSIONS`, the least
+recently used is dropped).
 """
 
 from __future__ import annotations
 
 import hashlib
+import itertools
 import json
 import math
 import tempfile
@@ -40,6 +48,8 @@ MAX_SESSIONS = 64
 CHART_POINTS = 600  # samples of a plan's curves sent to the page (the files keep the full 1 ms step)
 DRAWING_STEP_DEG = 2.0  # [deg] the mechanism's drawing is sent at every such crank angle from TDC
 BOUND_CACHE = 32
+ANSWER_CACHE = 32  # confirmed answers kept by case (each about 0.2 MB with its curves and solution)
+SOLVES_AT_ONCE = 2  # solves running at once; IPOPT takes one call at a time per process, so two interleave
 DOWNLOADS = ("result.json", "trajectory.csv", "cam_table.csv")
 
 
@@ -52,6 +62,60 @@ class Session:
     newest: int = -1
     plan: Any = None
     shown: tuple[str, Any, Any] | None = None  # the last confirmed plan: (its case's key, case, solution)
+
+
+class FairQueue:
+    """The solves of every session: at most ``slots`` run at once, one per session; a session waits with
+    its newest request only (an older waiting one is superseded), and of the waiting sessions the one
+    whose last solve started earliest (or that never solved) starts first. So a session that keeps
+    sending (or many of them) delays another session's request by the solves already running, never by
+    its own queue."""
+
+    def __init__(self, slots: int = SOLVES_AT_ONCE) -> None:
+        self._cond = threading.Condition()
+        self._slots = slots
+        self._running: set[str] = set()
+        self._waiting: dict[str, list[int]] = {}  # session -> [seq] of its newest waiting request
+        self._last_start: dict[str, int] = {}
+        self._clock = itertools.count()
+
+    def run(self, key: str, seq: int, work: Any) -> Any:
+        """``work()`` when this request's turn comes; :data:`SUPERSEDED` when a newer request of the same
+        session arrives first."""
+        ticket = [seq]
+        with self._cond:
+            waiting = self._waiting.get(key)
+            if waiting is not None:
+                if waiting[0] > seq:
+                    return SUPERSEDED
+                waiting[0] = -1  # overtaken: that request returns at once
+                self._cond.notify_all()
+            self._waiting[key] = ticket
+            while ticket[0] >= 0 and not self._turn(key):
+                self._cond.wait()
+            if ticket[0] < 0:
+                return SUPERSEDED
+            del self._waiting[key]
+            self._running.add(key)
+            self._last_start[key] = next(self._clock)
+            if len(self._last_start) > 4 * MAX_SESSIONS:  # forget sessions long gone
+                keep = self._running | set(self._waiting)
+                self._last_start = {k: v for k, v in self._last_start.items() if k in keep}
+        try:
+            return work()
+        finally:
+            with self._cond:
+                self._running.discard(key)
+                self._cond.notify_all()
+
+    def _turn(self, key: str) -> bool:
+        if len(self._running) >= self._slots or key in self._running:
+            return False
+        ready = [k for k in self._waiting if k not in self._running]  # in order of arrival
+        return min(ready, key=lambda k: self._last_start.get(k, -1)) == key
+
+
+SUPERSEDED = object()
 
 
 class Sessions:
@@ -91,6 +155,10 @@ def create_app(
     app.extensions["pressplan_bound_pool"] = bound_pool  # serve() stops its worker on the way out
     sessions = Sessions()
     app.extensions["pressplan_sessions"] = sessions  # the tests hold a session's lock to see superseding
+    queues = {"fast": FairQueue(), "cold": FairQueue()}  # the edits' fast answers never wait behind cold solves
+    app.extensions["pressplan_queues"] = queues
+    answers: OrderedDict[str, tuple[dict, Any, Any]] = OrderedDict()  # case key -> (answer, case, solution)
+    answers_lock = threading.Lock()
     bounds: OrderedDict[str, dict] = OrderedDict()
     bounds_lock = threading.Lock()
     offered = case_files(cases_dir)
@@ -177,16 +245,41 @@ def create_app(
     @app.post("/api/solve")
     def solve_endpoint() -> Response:
         body = _body()
-        session = sessions.get(str(body.get("session", ""))[:80])
+        key = str(body.get("session", ""))[:80]
+        session = sessions.get(key)
         seq = int(body.get("seq", 0)) if isinstance(body.get("seq", 0), int) else 0
+        label = _label_of(body)
         with session.guard:
             session.newest = max(session.newest, seq)
-        with session.lock:
-            if seq < session.newest:
-                return jsonify({"status": "superseded", "seq": seq})
-            answer = solve_case(body.get("case"), _label_of(body), session, body.get("confirm") is True)
-        answer["seq"] = seq
-        return jsonify(answer)
+
+        def work() -> dict[str, Any]:
+            with session.lock:
+                if seq < session.newest:
+                    return {"status": "superseded"}
+                data = body.get("case")
+                known = case_key({"label": label, "case": data})
+                with answers_lock:
+                    hit = answers.get(known)
+                    if hit is not None:
+                        answers.move_to_end(known)
+                if hit is not None:  # this case's confirmed answer, from any tab: no solve
+                    answer, case, solution = hit
+                    session.plan = solution.plan
+                    with session.guard:
+                        session.shown = (case_key(data), case, solution)
+                    return dict(answer)
+                answer = solve_case(data, label, session, body.get("confirm") is True)
+                if answer.get("confirmed") and answer["status"] == "verified":
+                    with answers_lock:
+                        answers[known] = (answer, *session.shown[1:])
+                        while len(answers) > ANSWER_CACHE:
+                            answers.popitem(last=False)
+                return answer
+
+        fast = body.get("confirm") is not True and session.plan is not None  # else solve_case solves cold
+        answer = queues["fast" if fast else "cold"].run(key, seq, work)
+        answer = {"status": "superseded"} if answer is SUPERSEDED else answer
+        return jsonify({**answer, "seq": seq})
 
     @app.post("/api/bound")
     def bound_endpoint() -> Response:
