@@ -198,6 +198,22 @@ def test_downloads_equal_the_files_of_solve(page, tmp_path: Path) -> None:
         r["solver"] = None
     assert page_result == cli_result
     assert yaml.safe_load(got["case.yaml"])["key_points"]["draw_end_deg"] == 200.0
+    # the stage table: result.json's stages as the page prints them, and the limits that bind over the cycle
+    shown = [[c.inner_text() for c in row.locator("td").all()] for row in page.locator("#stages tbody tr").all()]
+    expected = [
+        [
+            st["name"],
+            f"{st['start_angle_deg']:.2f}",
+            f"{st['end_angle_deg']:.2f}",
+            f"{st['start_time_s']:.4f}",
+            f"{st['duration_s']:.4f}",
+            f"{st['peak_crank_speed_rpm']:.3f}",
+            ", ".join(st["binding"]) or "–",
+        ]
+        for st in cli_result["stages"]
+    ]
+    assert shown[: len(expected)] == expected and len(expected) == 4
+    assert shown[len(expected) :] == [["the cycle", "", ", ".join(cli_result["binding_over_cycle"])]]
 
 
 @browser
@@ -652,3 +668,70 @@ def test_an_edits_fast_answer_never_waits_behind_cold_solves() -> None:
     for t in threads:
         t.join(60)
     assert answer["status"] == "verified" and answer["confirmed"] is False
+
+
+def test_every_field_has_words_a_unit_and_help() -> None:
+    """The form's labels: each field's title (with its unit where the key carries one) and a help text,
+    from the case model; no field shows its raw key."""
+    pytest.importorskip("flask")
+    from planning.web.server import field_specs
+
+    units = {  # the longest suffix first
+        "_mm_s2": "[mm/s²]",
+        "_mm_s": "[mm/s]",
+        "_rad_s2": "[rad/s²]",
+        "_rad_s3": "[rad/s³]",
+        "_kg_m2": "[kg m²]",
+        "_mm": "[mm",
+        "_deg": "[deg",
+        "_s": "[s]",
+        "_rpm": "[rpm]",
+        "_kg": "[kg]",
+        "_Nm": "[N m]",
+        "_kN": "[kN",
+    }
+    for spec in field_specs():
+        leaf = spec["name"].rsplit(".", 1)[-1]
+        assert "_" not in spec["title"] and len(spec["help"]) > 20, spec  # words, not a key
+        unit = next((u for suffix, u in units.items() if leaf.endswith(suffix)), "")
+        assert unit in spec["title"], spec
+
+
+@browser
+def test_a_drive_added_and_its_forming_force_edited_in_the_page(page) -> None:
+    """No drive on the published case: "add a drive" puts in the template press's drive and forming force
+    (``pressplan new --drive``), solved as the CLI solves that case; a cell of the forming-force table edited
+    is solved the same way; a bad cell is named next to the table and marked; "remove the drive" gives the
+    published plan again."""
+    from planning.reports.new_case import drive_template
+
+    data = published_data()
+    template = drive_template("crank-slider")
+    before = int(page.evaluate("document.body.dataset.rendered"))
+    page.locator("#add-drive").click()
+    wait_rendered(page, before)
+    data["drive"], data["process"]["forming_force_kN"] = template["drive"], template["forming_force_kN"]
+    assert shown_numbers(page)["spm"] == cli_numbers(copy.deepcopy(data))["spm"]
+    assert "% of rated" in page.locator("#drive-line").inner_text()
+    cell = page.locator(".force-table tbody tr").nth(2).locator("input").nth(1)
+    before = int(page.evaluate("document.body.dataset.rendered"))
+    cell.fill("7000")
+    cell.dispatch_event("change")
+    wait_rendered(page, before)
+    data["process"]["forming_force_kN"][2][1] = 7000
+    assert shown_numbers(page)["spm"] == cli_numbers(copy.deepcopy(data))["spm"]
+    before = int(page.evaluate("document.body.dataset.rendered"))
+    cell.fill("lots")
+    cell.dispatch_event("change")
+    page.wait_for_function(f"Number(document.body.dataset.rendered) > {before}", timeout=60_000)
+    message = page.locator('.msg[data-for="process.forming_force_kN"]').inner_text()
+    assert message == f"{LABEL}: process.forming_force_kN.2.1: input should be a valid number (got 'lots')"
+    assert "bad" in (cell.get_attribute("class") or "")
+    cell.fill("7000")
+    cell.dispatch_event("change")
+    wait_rendered(page, before)
+    before = int(page.evaluate("document.body.dataset.rendered"))
+    page.locator("#remove-drive").click()
+    wait_rendered(page, before)
+    assert page.locator("#spm").inner_text() == "12.123" and page.locator("#drive-line").inner_text() == ""
+    assert page.locator("#add-drive").count() == 1

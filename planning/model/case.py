@@ -64,15 +64,41 @@ class LinkDriveModel(_Model):
     connecting rod with the angle tht between them, the rocker c pivoting at (-d, -f) from the crank centre,
     the connecting rod g to the slide, the slide's line h to the side; [mm], [deg]."""
 
-    crank_radius_mm: Length  # a
-    ternary_rocker_side_mm: Length  # b
-    rocker_mm: Length  # c
-    rocker_pivot_x_mm: Coordinate  # d
-    rocker_pivot_y_mm: Coordinate  # f
-    ternary_angle_deg: Annotated[float, Field(gt=-360, lt=360)]  # tht
-    ternary_rod_side_mm: Length  # m
-    rod_length_mm: Length  # g
-    slide_offset_mm: Coordinate = 0.0  # h
+    crank_radius_mm: Length = Field(
+        title="crank radius a [mm]",
+        description="The eccentric's radius: the crank pin's distance from the crank axis.",
+    )  # a
+    ternary_rocker_side_mm: Length = Field(
+        title="ternary link, side to the rocker b [mm]",
+        description="The ternary link's side from the crank pin to the rocker's joint.",
+    )  # b
+    rocker_mm: Length = Field(
+        title="rocker c [mm]", description="The rocker's length, from its fixed pivot to the ternary link."
+    )  # c
+    rocker_pivot_x_mm: Coordinate = Field(
+        title="rocker pivot, left of the crank d [mm]",
+        description="The rocker's fixed pivot at (-d, -f) from the crank axis.",
+    )  # d
+    rocker_pivot_y_mm: Coordinate = Field(
+        title="rocker pivot, below the crank f [mm]",
+        description="The rocker's fixed pivot at (-d, -f) from the crank axis.",
+    )  # f
+    ternary_angle_deg: Annotated[float, Field(gt=-360, lt=360)] = Field(
+        title="ternary link's angle tht [deg]",
+        description="The angle between the ternary link's two sides (to the rocker, to the rod).",
+    )  # tht
+    ternary_rod_side_mm: Length = Field(
+        title="ternary link, side to the rod m [mm]",
+        description="The ternary link's side from the crank pin to the connecting rod's joint.",
+    )  # m
+    rod_length_mm: Length = Field(
+        title="connecting rod g [mm]", description="The connecting rod from the ternary link to the slide."
+    )  # g
+    slide_offset_mm: Coordinate = Field(
+        0.0,
+        title="slide's line to the side h [mm]",
+        description="The slide's line of action, to the side of the crank axis (0: through it).",
+    )  # h
 
 
 class KnuckleJointModel(_Model):
@@ -81,13 +107,31 @@ class KnuckleJointModel(_Model):
     (rocker) c pivoting at (d, e) from the crank centre, the main rod g from the knuckle to the slide, the
     slide's line h to the side of the rocker's pivot; [mm]."""
 
-    crank_radius_mm: Length  # a
-    rod_length_mm: Length  # b
-    rocker_mm: Length  # c
-    rocker_pivot_x_mm: Coordinate  # d
-    rocker_pivot_y_mm: Coordinate  # e
-    main_rod_mm: Length  # g
-    slide_offset_mm: Coordinate = 0.0  # h
+    crank_radius_mm: Length = Field(
+        title="crank radius a [mm]", description="The crank pin's distance from the crank axis."
+    )  # a
+    rod_length_mm: Length = Field(
+        title="crank rod b [mm]", description="The rod from the crank pin to the knuckle."
+    )  # b
+    rocker_mm: Length = Field(
+        title="upper link c [mm]", description="The upper link (rocker) from its fixed pivot to the knuckle."
+    )  # c
+    rocker_pivot_x_mm: Coordinate = Field(
+        title="upper link's pivot, across d [mm]",
+        description="The upper link's fixed pivot at (d, e) from the crank axis.",
+    )  # d
+    rocker_pivot_y_mm: Coordinate = Field(
+        title="upper link's pivot, up e [mm]",
+        description="The upper link's fixed pivot at (d, e) from the crank axis.",
+    )  # e
+    main_rod_mm: Length = Field(
+        title="main rod g [mm]", description="The main rod from the knuckle down to the slide."
+    )  # g
+    slide_offset_mm: Coordinate = Field(
+        0.0,
+        title="slide's line to the side h [mm]",
+        description="The slide's line of action, to the side of the upper link's pivot.",
+    )  # h
 
 
 class PressModel(_Model):
@@ -96,10 +140,27 @@ class PressModel(_Model):
     ``press.crank_slider``); a link drive's dimensions in ``link_drive``, a knuckle joint's in
     ``knuckle_joint`` (``press.linkage``)."""
 
-    mechanism: MechanismKind = "crank-slider"
-    crank_radius_mm: Length | None = None
-    rod_length_mm: Length | None = None
-    offset_mm: Offset = 0.0
+    mechanism: MechanismKind = Field(
+        "crank-slider",
+        title="mechanism",
+        description=(
+            "crank-slider, link-drive or knuckle-joint; a case's mechanism comes with its file (each has its own "
+            "dimensions)."
+        ),
+    )
+    crank_radius_mm: Length | None = Field(
+        None, title="crank radius R [mm]", description="Half the stroke of an in-line crank-slider."
+    )
+    rod_length_mm: Length | None = Field(
+        None,
+        title="connecting rod L [mm]",
+        description="From the crank pin to the slide's joint; longer than the crank radius.",
+    )
+    offset_mm: Offset = Field(
+        0.0,
+        title="slide offset e [mm]",
+        description="The slide's line of action to the side of the crank axis (0: in line); |e| < L - R.",
+    )
     link_drive: LinkDriveModel | None = None
     knuckle_joint: KnuckleJointModel | None = None
 
@@ -107,19 +168,45 @@ class PressModel(_Model):
 class KeyPointsModel(_Model):
     """The four key crank angles [deg from TDC]."""
 
-    closing_deg: Angle
-    draw_start_deg: Angle
-    draw_end_deg: Angle
-    opening_deg: Angle
+    closing_deg: Angle = Field(
+        title="θ1 closing [deg from TDC]", description="The slide passes the robot's safety height going down."
+    )
+    draw_start_deg: Angle = Field(
+        title="θ2 draw start [deg from TDC]",
+        description="The slide meets the blank; from here the crank turns at the draw speed.",
+    )
+    draw_end_deg: Angle = Field(
+        title="θ3 draw end [deg from TDC]", description="The end of the draw at constant crank speed."
+    )
+    opening_deg: Angle = Field(
+        title="θ4 opening [deg from TDC]",
+        description="The slide is back above the safety height; the robot's window begins.",
+    )
 
 
 class ProcessModel(_Model):
     """``safety_height_mm`` [mm above BDC], ``transfer_time_s`` [s], ``draw_speed_rpm`` [rpm] or None."""
 
-    safety_height_mm: Annotated[float, Field(gt=0, le=40_000)]
-    transfer_time_s: Seconds
-    draw_speed_rpm: CrankSpeed | None = None
-    forming_force_kN: ForceTable | None = None  # [[height above BDC mm, force kN], ...], linear between points
+    safety_height_mm: Annotated[float, Field(gt=0, le=40_000)] = Field(
+        title="safety height [mm above BDC]",
+        description="The transfer robot's height: the slide stays at or above it from θ4 through TDC to θ1.",
+    )
+    transfer_time_s: Seconds = Field(
+        title="transfer time [s]", description="The least time the robot needs from θ4 to θ1."
+    )
+    draw_speed_rpm: CrankSpeed | None = Field(
+        None,
+        title="draw speed [rpm]",
+        description="The crank's constant speed in the draw; empty: the highest the limits allow.",
+    )
+    forming_force_kN: ForceTable | None = Field(
+        None,
+        title="forming force [kN] against height [mm]",
+        description=(
+            "Rows of height above BDC and force, linear between rows, zero outside; acts while the slide goes down "
+            "from θ2 to BDC. Needs a drive to matter."
+        ),
+    )  # [[height above BDC mm, force kN], ...], linear between points
 
 
 def _limits_model() -> type[_Model]:
@@ -141,10 +228,17 @@ class MotorModel(_Model):
     """All motors together: ``peak_torque_Nm`` up to ``base_speed_rpm``, constant power above it up to
     ``max_speed_rpm``; ``rated_torque_Nm`` the thermal (RMS) limit."""
 
-    peak_torque_Nm: Torque
-    rated_torque_Nm: Torque
-    base_speed_rpm: MotorSpeed
-    max_speed_rpm: MotorSpeed
+    peak_torque_Nm: Torque = Field(
+        title="peak torque [N m]",
+        description="All motors together, up to the base speed; above it the peak power stays constant.",
+    )
+    rated_torque_Nm: Torque = Field(
+        title="rated torque [N m]", description="The thermal limit: the cycle's RMS motor torque stays at or below it."
+    )
+    base_speed_rpm: MotorSpeed = Field(
+        title="base speed [rpm]", description="Up to this motor speed the peak torque is available."
+    )
+    max_speed_rpm: MotorSpeed = Field(title="top speed [rpm]", description="The motor's highest speed.")
 
 
 class LinkMassModel(_Model):
@@ -163,18 +257,44 @@ class DriveSection(_Model):
     rod as two point masses (``rod_mass_kg``, ``rod_cg_from_crank_pin_mm``) or as a rigid link (``links``);
     a linkage's links in ``links`` (massless where not given)."""
 
-    slide_mass_kg: Mass  # slide + upper die
-    rod_mass_kg: Mass | None = None
-    rod_cg_from_crank_pin_mm: Annotated[float, Field(ge=0, le=100_000)] | None = None
+    slide_mass_kg: Mass = Field(
+        title="slide mass [kg]", description="The slide and the upper die."
+    )  # slide + upper die
+    rod_mass_kg: Mass | None = Field(
+        None,
+        title="rod mass [kg]",
+        description="A crank-slider's connecting rod, split between the crank pin and the slide.",
+    )
+    rod_cg_from_crank_pin_mm: Annotated[float, Field(ge=0, le=100_000)] | None = Field(
+        None,
+        title="rod's centre of gravity from the crank pin [mm]",
+        description="Where the rod's mass sits along it.",
+    )
     links: dict[str, LinkMassModel] | None = None
-    crank_inertia_kg_m2: Inertia  # crankshaft, eccentric, bull gears, about the crank axis
-    counterbalance_kN: ForceKN  # constant, upward
-    gear_ratio: Annotated[float, Field(ge=1e-3, le=1e4)]  # motor turns per crank turn
-    gear_efficiency: Annotated[float, Field(gt=0, le=1)]
-    motor_inertia_kg_m2: Inertia  # all motors and pinions, about the motor axis
+    crank_inertia_kg_m2: Inertia = Field(
+        title="crank inertia [kg m²]", description="Crankshaft, eccentric and bull gears, about the crank axis."
+    )  # crankshaft, eccentric, bull gears, about the crank axis
+    counterbalance_kN: ForceKN = Field(
+        title="counterbalance [kN]", description="A constant upward force on the slide."
+    )  # constant, upward
+    gear_ratio: Annotated[float, Field(ge=1e-3, le=1e4)] = Field(
+        title="gear ratio [motor turns per crank turn]",
+        description="The reduction between the motors and the crank.",
+    )  # motor turns per crank turn
+    gear_efficiency: Annotated[float, Field(gt=0, le=1)] = Field(
+        title="gear efficiency",
+        description="Share of the power the gears pass on (0 ... 1].",
+    )
+    motor_inertia_kg_m2: Inertia = Field(
+        title="motor inertia [kg m²]", description="All motors and pinions, about the motor axis."
+    )  # all motors and pinions, about the motor axis
     motor: MotorModel
     # the share of the braking energy the supply takes back: 0 a braking resistor, 1 a perfect store
-    regen_efficiency: Annotated[float, Field(ge=0, le=1)] = 0.0
+    regen_efficiency: Annotated[float, Field(ge=0, le=1)] = Field(
+        0.0,
+        title="regeneration efficiency",
+        description="Share of the braking energy the supply takes back: 0 a braking resistor, 1 a perfect store.",
+    )
 
 
 class PlannerModel(_Model):
@@ -183,11 +303,34 @@ class PlannerModel(_Model):
     ``objective``: the most strokes (``max-spm``), or at ``target_spm`` [strokes/min] the least RMS motor
     torque (``min-rms-torque``) or the least energy drawn from the supply per stroke (``min-energy``)."""
 
-    motion_law: LawName = DEFAULT_LAW
-    placement: Placement = "free"
-    law_parameter: ShapeValue | None = None
-    objective: Objective = "max-spm"
-    target_spm: Annotated[float, Field(gt=0, le=1e4)] | None = None
+    motion_law: LawName = Field(
+        DEFAULT_LAW,
+        title="motion law",
+        description="The law the crank speed follows between the stages; optimal needs a crank jerk limit.",
+    )
+    placement: Placement = Field(
+        "free",
+        title="placement of θ1 and θ4",
+        description="free: anywhere in the transfer stage or its S-curves; published: the paper's structure.",
+    )
+    law_parameter: ShapeValue | None = Field(
+        None,
+        title="law's shape parameter",
+        description="Held fixed: seven-segment jerk share r in [0.01, 1], logistic a in [1.317, 30]; empty: optimised.",
+    )
+    objective: Objective = Field(
+        "max-spm",
+        title="objective",
+        description=(
+            "max-spm: the most strokes; min-rms-torque or min-energy: the gentlest plan at the target rate (needs a "
+            "drive)."
+        ),
+    )
+    target_spm: Annotated[float, Field(gt=0, le=1e4)] | None = Field(
+        None,
+        title="target rate [strokes/min]",
+        description="The line's rate for min-rms-torque and min-energy.",
+    )
 
 
 class PublishedKeyPoint(_Model):

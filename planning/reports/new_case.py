@@ -191,6 +191,16 @@ def new_case_text(name: str, path: str, mechanism: str = "crank-slider", drive: 
     return text + _PLANNER + (_DRIVE[mechanism] if drive else "")
 
 
+def drive_template(mechanism: str) -> dict:
+    """The drive section :func:`new_case_text` writes for ``mechanism``, with its forming force (the page's
+    "add a drive": a press of that size, to be replaced by the user's own figures)."""
+    import yaml
+
+    drive = yaml.safe_load(_DRIVE[mechanism])["drive"]
+    force = yaml.safe_load(_FORCE[mechanism].strip())["forming_force_kN"]
+    return {"drive": drive, "forming_force_kN": force}
+
+
 def write_new_case(path: Path, mechanism: str = "crank-slider", drive: bool = False) -> None:
     """Write :func:`new_case_text` to ``path`` (named after the file); never over an existing file
     (``FileExistsError``)."""

@@ -16,6 +16,7 @@ from planning.model.cycle import HALVES
 from planning.model.laws.improved_scurve import ImprovedSCurve
 from planning.model.limits.slider_accel import SliderAccelLimit
 from planning.model.profile import MAX_STEP_S, Profile
+from planning.reports.stages import stage_table
 from planning.solver.solution import Solution
 from press.dynamics import drive_state
 from press.mechanism import Mechanism
@@ -122,7 +123,7 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
     p = plan.parameters
     ver = solution.verification
     accel = ver.check(SliderAccelLimit.id)
-    return {
+    result = {
         "case": case.name,
         "spm": plan.spm,
         "cycle_time_s": plan.period,
@@ -164,6 +165,13 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
             "status": plan.solver.status,
         },
     }
+    table = stage_table(result, trajectory(solution, case))  # after the segments: the stages they make
+    ordered = {}
+    for key, value in result.items():
+        ordered[key] = value
+        if key == "segments":
+            ordered.update(table)
+    return ordered
 
 
 def drive_block(solution: Solution, case: Case) -> dict[str, Any]:
@@ -223,6 +231,15 @@ def summary_text(result: dict[str, Any]) -> str:
             f"  {k['name']:<11} {k['angle_deg']:9.2f} {k['time_s']:8.4f} {k['height_mm']:9.1f} "
             f"{k['slider_speed_mm_s']:8.1f} {k['direction']:<2} {k['crank_speed_rpm']:9.3f}"
         )
+    if r.get("stages"):
+        lines += ["", f"  {'stage':<11} {'from deg':>9} {'to deg':>8} {'time s':>9} {'peak rpm':>9}  binding there"]
+        for st in r["stages"]:
+            lines.append(
+                f"  {st['name']:<11} {st['start_angle_deg']:9.2f} {st['end_angle_deg']:8.2f} "
+                f"{st['duration_s']:9.4f} {st['peak_crank_speed_rpm']:9.3f}  {', '.join(st['binding']) or '-'}"
+            )
+        if r["binding_over_cycle"]:
+            lines.append(f"  {'the cycle':<11} {'':>9} {'':>8} {'':>9} {'':>9}  {', '.join(r['binding_over_cycle'])}")
     if "drive" in r:
         d = r["drive"]
         lines += [

@@ -41,6 +41,7 @@ from werkzeug.exceptions import HTTPException
 from planning.model.case import OBJECTIVES, Case
 from planning.model.case_file import MAX_BYTES, CaseFileError, case_from_data, load_yaml, read_case
 from planning.model.laws import LAWS
+from planning.reports.new_case import MECHANISMS, drive_template
 
 STATIC = Path(__file__).resolve().parent / "static"
 MAX_REQUEST_BYTES = 2 * MAX_BYTES  # a case as JSON, with the page's own fields
@@ -209,6 +210,7 @@ def create_app(
                 "objectives": list(OBJECTIVES),
                 "placements": ["free", "published"],
                 "fields": field_specs(),
+                "drive_templates": {kind: drive_template(kind) for kind in MECHANISMS},
             }
         )
 
@@ -397,7 +399,8 @@ def _plotly_js() -> Path:
 
 def field_specs() -> list[dict[str, Any]]:
     """The form's fields: dotted name, kind (number | choice | table | label: shown, not edited), optional or
-    not, choices."""
+    not, choices, and the words the page shows: ``title`` (with the unit) and ``help``, the case model's
+    own (``planning.model.case``: each field's title and description)."""
     from planning.sweep import numeric_fields
 
     specs: list[dict[str, Any]] = []
@@ -412,6 +415,10 @@ def field_specs() -> list[dict[str, Any]]:
         {"name": "planner.objective", "kind": "choice", "choices": list(OBJECTIVES)},
         {"name": "process.forming_force_kN", "kind": "table", "optional": True},
     ]
+    for spec in specs:
+        model, leaf = _model_at(spec["name"])
+        info = model.model_fields[leaf]
+        spec["title"], spec["help"] = info.title or leaf, info.description or ""
     return specs
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from pydantic import Field
 
 from planning.model.limits.base import REL_TOL, BoundGrid, Check, Dense, Limit, Row, Transcription
 from planning.model.units import CrankAccel
@@ -19,7 +20,16 @@ class CrankAccelLimit(Limit):
     unit = "rad/s^2"
     field = "limits.crank_accel_rad_s2"
     order = 60
-    section_fields = {"crank_accel_rad_s2": (CrankAccel | None, None)}
+    section_fields = {
+        "crank_accel_rad_s2": (
+            CrankAccel | None,
+            Field(
+                None,
+                title="crank acceleration limit [rad/s²]",
+                description="The drive's |acceleration|, on the crank; empty: none.",
+            ),
+        ),
+    }
     parameters = ("crank_accel_max",)
 
     def applies(self, case: Any) -> bool:

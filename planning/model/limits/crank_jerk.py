@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from pydantic import Field
 
 from planning.model.limits.base import REL_TOL, BoundGrid, Check, Dense, Limit, Row, Transcription, sample_vector
 from planning.model.profile import max_abs_jerk
@@ -22,7 +23,16 @@ class CrankJerkLimit(Limit):
     unit = "rad/s^3"
     field = "limits.crank_jerk_rad_s3"
     order = 70
-    section_fields = {"crank_jerk_rad_s3": (CrankJerk | None, None)}
+    section_fields = {
+        "crank_jerk_rad_s3": (
+            CrankJerk | None,
+            Field(
+                None,
+                title="crank jerk limit [rad/s³]",
+                description="The drive's |jerk|, on the crank; empty: none (the optimal law needs one).",
+            ),
+        ),
+    }
     parameters = ("crank_jerk_max",)
 
     def applies(self, case: Any) -> bool:

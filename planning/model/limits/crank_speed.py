@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from pydantic import Field
 
 from planning.model.errors import CaseError
 from planning.model.limits.base import REL_TOL, BoundGrid, Check, Dense, Draw, Limit, Row, Transcription
@@ -20,7 +21,14 @@ class CrankSpeedLimit(Limit):
     unit = "rpm"
     field = "limits.crank_speed_rpm"
     order = 50
-    section_fields = {"crank_speed_rpm": (CrankSpeed | None, None)}
+    section_fields = {
+        "crank_speed_rpm": (
+            CrankSpeed | None,
+            Field(
+                None, title="crank speed limit [rpm]", description="The drive's top speed, on the crank; empty: none."
+            ),
+        ),
+    }
     parameters = ("crank_speed_max",)
     refined = "crank_speed_max"
 

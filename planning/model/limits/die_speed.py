@@ -6,6 +6,7 @@ import math
 from typing import Any
 
 import numpy as np
+from pydantic import Field
 
 from planning.model.errors import CaseError
 from planning.model.limits.base import (
@@ -35,7 +36,20 @@ class DieSpeedLimit(Limit):
     unit = "mm/s"
     field = "limits.die_speed_mm_s"
     order = 30
-    section_fields = {"die_height_mm": (Height, ...), "die_speed_mm_s": (SliderSpeed, ...)}
+    section_fields = {
+        "die_height_mm": (
+            Height,
+            Field(
+                ...,
+                title="die height [mm above BDC]",
+                description="At and below this height the slide is no faster than the die speed.",
+            ),
+        ),
+        "die_speed_mm_s": (
+            SliderSpeed,
+            Field(..., title="die speed [mm/s]", description="The slide's highest speed at and below the die height."),
+        ),
+    }
     parameters = ("die_speed", "die_height")
     refined = "die_speed"
     refuses_draw_speed_above_bound = True

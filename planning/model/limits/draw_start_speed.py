@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 
+from pydantic import Field
+
 from planning.model.limits.base import REL_TOL, Check, Dense, Draw, Limit
 from planning.model.units import SliderSpeed
 
@@ -17,7 +19,16 @@ class DrawStartSpeedLimit(Limit):
     unit = "mm/s"
     field = "limits.draw_start_speed_mm_s"
     order = 20
-    section_fields = {"draw_start_speed_mm_s": (SliderSpeed, ...)}
+    section_fields = {
+        "draw_start_speed_mm_s": (
+            SliderSpeed,
+            Field(
+                ...,
+                title="draw-start speed [mm/s]",
+                description="The slide's highest speed at θ2, where it meets the blank.",
+            ),
+        ),
+    }
     refuses_draw_speed_above_bound = True
 
     def draw_speed_bound(self, draw: Draw) -> float:

@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from pydantic import Field
 
 from planning.model.limits.base import REL_TOL, BoundGrid, Check, Dense, Draw, Limit, Row, Transcription
 from planning.model.units import RPM, CrankSpeed
@@ -19,7 +20,16 @@ class MinCrankSpeedLimit(Limit):
     unit = "rpm"
     field = "limits.min_crank_speed_rpm"
     order = 45
-    section_fields = {"min_crank_speed_rpm": (CrankSpeed, 1.0)}
+    section_fields = {
+        "min_crank_speed_rpm": (
+            CrankSpeed,
+            Field(
+                1.0,
+                title="least crank speed [rpm]",
+                description="The crank never turns slower (never stops or reverses).",
+            ),
+        ),
+    }
     parameters = ("min_crank_speed",)
     refined = "min_crank_speed"
     refine_upward = True

@@ -6,6 +6,7 @@ import math
 from typing import Any
 
 import numpy as np
+from pydantic import Field
 
 from planning.model.limits.base import (
     REL_TOL,
@@ -34,7 +35,16 @@ class SliderAccelLimit(Limit):
     unit = "mm/s^2"
     field = "limits.slider_accel_mm_s2"
     order = 40
-    section_fields = {"slider_accel_mm_s2": (SliderAccel, ...)}
+    section_fields = {
+        "slider_accel_mm_s2": (
+            SliderAccel,
+            Field(
+                ...,
+                title="slide acceleration limit [mm/s²]",
+                description="The slide's |acceleration| over the whole cycle.",
+            ),
+        ),
+    }
     parameters = ("accel_limit",)
     refined = "accel_limit"
     backoff = ACCEL_BACKOFF

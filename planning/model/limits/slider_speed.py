@@ -6,6 +6,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from pydantic import Field
 
 from planning.model.limits.base import (
     REL_TOL,
@@ -33,7 +34,16 @@ class SliderSpeedLimit(Limit):
     unit = "mm/s"
     field = "limits.slider_speed_mm_s"
     order = 47
-    section_fields = {"slider_speed_mm_s": (SliderSpeed | None, None)}
+    section_fields = {
+        "slider_speed_mm_s": (
+            SliderSpeed | None,
+            Field(
+                None,
+                title="slide speed limit [mm/s]",
+                description="The slide's |speed| anywhere in the cycle; empty: none.",
+            ),
+        ),
+    }
     parameters = ("slider_speed_max",)
     refined = "slider_speed_max"
     backoff = SPEED_BACKOFF

@@ -5,6 +5,7 @@ const SESSION = (crypto.randomUUID ? crypto.randomUUID() : String(Math.random())
 const SECTIONS = ["press", "press.link_drive", "press.knuckle_joint", "key_points", "process", "limits", "drive", "drive.motor", "planner"];
 // the press section's own keys belong to the crank-slider; a linkage's dimensions are in its subsection
 const CRANK_SLIDER_KEYS = ["press.crank_radius_mm", "press.rod_length_mm", "press.offset_mm", "drive.rod_mass_kg", "drive.rod_cg_from_crank_pin_mm"];
+const SECTION_TITLES = { press: "press", "press.link_drive": "link drive", "press.knuckle_joint": "knuckle joint", key_points: "key angles", process: "process", limits: "limits", drive: "drive", "drive.motor": "motor (all motors together)", planner: "planner" };
 const WINDOW_COLOUR = "#d9ecff", DRAW_COLOUR = "#e2f0d9"; // the robot's window, the draw
 const KEY_LABELS = { closing: "θ1", draw_start: "θ2", draw_end: "θ3", opening: "θ4" };
 const TYPING_REST_MS = 120; // a pause this long in typing solves (a fast typist's keys come closer)
@@ -34,14 +35,25 @@ function buildForm(data) {
   const hasDrive = data.drive != null;
   const crankSlider = (getPath(data, "press.mechanism") || "crank-slider") === "crank-slider";
   for (const section of SECTIONS) {
+    if (section === "drive" && !hasDrive) { form.appendChild(addDriveBox()); continue; }
     if (section.startsWith("drive") && !hasDrive) continue;
     if (section.includes(".") && !section.startsWith("drive") && getPath(data, section) == null) continue;
     const fields = specs.filter((f) => f.name.startsWith(section + ".") && !f.name.slice(section.length + 1).includes("."))
       .filter((f) => crankSlider || !CRANK_SLIDER_KEYS.includes(f.name));
     if (!fields.length) continue;
     const fs = document.createElement("fieldset");
-    fs.innerHTML = `<legend>${section}</legend>`;
-    for (const spec of fields) fs.appendChild(fieldRow(spec, getPath(data, spec.name)));
+    fs.dataset.section = section;
+    fs.innerHTML = `<legend>${SECTION_TITLES[section] || section}</legend>`;
+    for (const spec of fields) fs.appendChild(spec.kind === "table" ? forceTable(spec, getPath(data, spec.name)) : fieldRow(spec, getPath(data, spec.name)));
+    if (section === "drive") {
+      const remove = document.createElement("button");
+      remove.type = "button";
+      remove.id = "remove-drive";
+      remove.textContent = "remove the drive";
+      remove.title = "plan the motion alone (no motor limits, no torque or energy)";
+      remove.addEventListener("click", removeDrive);
+      fs.appendChild(remove);
+    }
     form.appendChild(fs);
   }
   const general = document.createElement("div");
@@ -50,11 +62,108 @@ function buildForm(data) {
   form.appendChild(general);
 }
 
+// a drive added in the page: the drive of `pressplan new`'s template press of this mechanism (and its
+// forming force, when the case has none), to be replaced by the press's own figures
+function addDriveBox() {
+  const fs = document.createElement("fieldset");
+  fs.dataset.section = "drive";
+  fs.innerHTML = `<legend>drive</legend><p class="help-text">No drive: the plan keeps the motion's limits only. ` +
+    `A drive adds the motor's torque, RMS and speed limits, the energy, and the objectives at the line's rate.</p>`;
+  const add = document.createElement("button");
+  add.type = "button";
+  add.id = "add-drive";
+  add.textContent = "add a drive";
+  add.title = "starts from the drive of a template press of this mechanism (pressplan new --drive): enter your press's figures";
+  add.addEventListener("click", addDrive);
+  fs.appendChild(add);
+  return fs;
+}
+
+function addDrive() {
+  const data = caseFromForm();
+  const kind = getPath(data, "press.mechanism") || "crank-slider";
+  const template = structuredClone(state.meta.drive_templates[kind]);
+  data.drive = template.drive;
+  if (data.process.forming_force_kN == null) data.process.forming_force_kN = template.forming_force_kN;
+  state.data = data;
+  buildForm(data);
+  setStatus("a drive added: the template press's figures; enter your press's", "busy");
+  solveNow();
+}
+
+function removeDrive() {
+  const data = caseFromForm();
+  delete data.drive;
+  if (data.planner && data.planner.objective && data.planner.objective !== "max-spm") data.planner.objective = "max-spm"; // the objectives weigh the motor
+  state.data = data;
+  buildForm(data);
+  solveNow();
+}
+
+// the forming force as rows of (height above BDC [mm], force [kN]), rows added and removed in place
+function forceTable(spec, value) {
+  const row = document.createElement("div");
+  row.className = "field table-field";
+  const id = "f-" + spec.name.replaceAll(".", "-");
+  row.innerHTML = `<label title="${spec.name}: ${spec.help}">${spec.title}</label><small class="help">${spec.help}</small>`;
+  const table = document.createElement("table");
+  table.className = "force-table";
+  table.id = id;
+  table.dataset.field = spec.name;
+  table.dataset.kind = "table";
+  table.innerHTML = "<thead><tr><th>height mm</th><th>force kN</th><th></th></tr></thead><tbody></tbody>";
+  const body = table.querySelector("tbody");
+  const addRow = (pair) => {
+    const tr = document.createElement("tr");
+    for (let k = 0; k < 2; k++) {
+      const cell = document.createElement("input");
+      cell.type = "text";
+      cell.inputMode = "decimal";
+      cell.className = "cell";
+      cell.value = pair && pair[k] != null ? String(pair[k]) : "";
+      cell.addEventListener("change", onEdit);
+      cell.addEventListener("input", typed);
+      const td = document.createElement("td");
+      td.appendChild(cell);
+      tr.appendChild(td);
+    }
+    const drop = document.createElement("button");
+    drop.type = "button";
+    drop.className = "drop-row";
+    drop.textContent = "×";
+    drop.title = "remove this row";
+    drop.addEventListener("click", () => { tr.remove(); onEdit(); });
+    const td = document.createElement("td");
+    td.appendChild(drop);
+    tr.appendChild(td);
+    body.appendChild(tr);
+  };
+  for (const pair of value || []) addRow(pair);
+  row.appendChild(table);
+  const more = document.createElement("button");
+  more.type = "button";
+  more.className = "add-row";
+  more.textContent = "add a row";
+  more.addEventListener("click", () => { addRow(null); body.lastChild.querySelector("input").focus(); });
+  row.appendChild(more);
+  const msg = document.createElement("span");
+  msg.className = "msg";
+  msg.dataset.for = spec.name;
+  row.appendChild(msg);
+  return row;
+}
+
+function typed() {
+  window.lastInputAt = performance.now(); // the typing benchmark reads it
+  clearTimeout(editTimer);
+  editTimer = setTimeout(onEdit, TYPING_REST_MS);
+  setStatus("editing… the plan follows when the typing pauses", "busy"); // pending from the first key
+}
+
 function fieldRow(spec, value) {
   const row = document.createElement("div");
   row.className = "field";
   const id = "f-" + spec.name.replaceAll(".", "-");
-  const leaf = spec.name.split(".").pop();
   let input;
   if (spec.kind === "label") {
     input = document.createElement("input");
@@ -77,36 +186,42 @@ function fieldRow(spec, value) {
     input = document.createElement("input");
     input.type = "text";
     input.inputMode = "decimal";
-    if (spec.kind === "table") input.value = value == null ? "" : JSON.stringify(value);
-    else input.value = value == null ? "" : String(value);
+    input.value = value == null ? "" : String(value);
     if (spec.optional) input.placeholder = "none";
   }
   input.id = id;
   input.dataset.field = spec.name;
   input.dataset.kind = spec.kind;
-  row.innerHTML = `<label for="${id}" title="${spec.name}">${leaf}</label>`;
+  row.innerHTML = `<label for="${id}" title="${spec.name}: ${spec.help}">${spec.title}</label>`;
+  input.title = `${spec.name}: ${spec.help}`;
   row.appendChild(input);
+  const help = document.createElement("small");
+  help.className = "help";
+  help.textContent = spec.help;
+  row.appendChild(help);
   const msg = document.createElement("span");
   msg.className = "msg";
   msg.dataset.for = spec.name;
   row.appendChild(msg);
   if (spec.kind !== "label") input.addEventListener("change", onEdit);
-  if (spec.kind !== "choice" && spec.kind !== "label") {  // typing: solve once the keys rest (a change solves at once)
-    input.addEventListener("input", () => {
-      window.lastInputAt = performance.now(); // the typing benchmark reads it
-      clearTimeout(editTimer);
-      editTimer = setTimeout(onEdit, TYPING_REST_MS);
-      setStatus("editing… the plan follows when the typing pauses", "busy"); // pending from the first key
-    });
-  }
+  if (spec.kind !== "choice" && spec.kind !== "label") input.addEventListener("input", typed); // typing: solve once the keys rest (a change solves at once)
   return row;
 }
 
 function formValue(input) {
+  if (input.dataset.kind === "table") { // rows of numbers; a row left blank is no row; no rows: omitted
+    const rows = [...input.querySelectorAll("tbody tr")].map((tr) => [...tr.querySelectorAll("input")].map((c) => c.value.trim()))
+      .filter((pair) => pair.some((v) => v !== "")).map((pair) => pair.map(numberOf));
+    return rows.length ? rows : undefined;
+  }
   const text = input.value.trim();
   if (input.dataset.kind === "choice" || input.dataset.kind === "label") return text || undefined;
   if (text === "") return undefined;
-  if (input.dataset.kind === "table") { try { return JSON.parse(text); } catch (e) { return text; } }
+  return numberOf(text);
+}
+
+// a number as typed, or the text itself (the server then says what is wrong with it)
+function numberOf(text) {
   const number = Number(text);
   return Number.isFinite(number) && /^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$/.test(text) ? number : text;
 }
@@ -191,6 +306,7 @@ function clearPlan() {
   for (const id of ["#spm", "#cycle", "#binding", "#bound-share"]) $(id).textContent = "–";
   for (const id of ["#drive-line", "#objective-line", "#pin-line", "#summary"]) $(id).textContent = "";
   $("#key-points tbody").innerHTML = "";
+  $("#stages tbody").innerHTML = "";
   Plotly.purge("motion-chart");
   Plotly.purge("drive-chart");
   $("#drive-chart").style.display = "none";
@@ -211,11 +327,23 @@ function clearMessages() {
 }
 
 function showMessage(field, message) {
-  let target = document.querySelector(`.msg[data-for="${CSS.escape(field)}"]`);
-  const input = document.querySelector(`[data-field="${CSS.escape(field)}"]`);
-  if (!target) target = document.querySelector('.msg[data-for=""]');
+  // the field's own message place, or its table's (``process.forming_force_kN.2.1``: row 3, force)
+  const parts = field.split(".");
+  let name = field, rest = [];
+  while (parts.length && !document.querySelector(`.msg[data-for="${CSS.escape(parts.join("."))}"]`)) rest.unshift(parts.pop());
+  if (parts.length) name = parts.join(".");
+  let target = document.querySelector(`.msg[data-for="${CSS.escape(name)}"]`);
+  if (!target || !field) target = document.querySelector('.msg[data-for=""]');
   target.textContent = message;
-  if (input) input.classList.add("bad");
+  const input = field ? document.querySelector(`[data-field="${CSS.escape(name)}"]`) : null;
+  if (!input) return;
+  input.classList.add("bad");
+  if (input.dataset.kind === "table" && rest.length) {
+    const filled = [...input.querySelectorAll("tbody tr")].filter((tr) => [...tr.querySelectorAll("input")].some((c) => c.value.trim() !== ""));
+    const row = filled[Number(rest[0])]; // the rows sent: the blank ones are left out
+    const cells = row ? row.querySelectorAll("input") : [];
+    for (const [k, cell] of [...cells].entries()) if (rest.length < 2 || Number(rest[1]) === k) cell.classList.add("bad");
+  }
 }
 
 function setStatus(text, kind) {
@@ -256,6 +384,19 @@ function render(answer, seq, confirmed) {
     tr.innerHTML = `<td>${k.name}</td><td>${k.angle_deg.toFixed(2)}</td><td>${k.time_s.toFixed(4)}</td><td>${k.height_mm.toFixed(1)}</td>` +
       `<td>${k.slider_speed_mm_s.toFixed(1)} ${k.direction}</td><td>${k.crank_speed_rpm.toFixed(3)}</td>`;
     body.appendChild(tr);
+  }
+  const stages = $("#stages tbody");
+  stages.innerHTML = "";
+  for (const st of r.stages || []) {
+    const tr = document.createElement("tr");
+    tr.innerHTML = `<td>${st.name}</td><td>${st.start_angle_deg.toFixed(2)}</td><td>${st.end_angle_deg.toFixed(2)}</td>` +
+      `<td>${st.start_time_s.toFixed(4)}</td><td>${st.duration_s.toFixed(4)}</td><td>${st.peak_crank_speed_rpm.toFixed(3)}</td><td class="binds">${st.binding.join(", ") || "–"}</td>`;
+    stages.appendChild(tr);
+  }
+  if ((r.binding_over_cycle || []).length) {
+    const tr = document.createElement("tr");
+    tr.innerHTML = `<td>the cycle</td><td colspan="5"></td><td class="binds">${r.binding_over_cycle.join(", ")}</td>`;
+    stages.appendChild(tr);
   }
   drawCharts();
   drawMechanism();
