@@ -126,7 +126,7 @@ def main() -> None:
             before = int(page.evaluate("document.body.dataset.rendered"))
             box.click()
             box.press("Control+A")
-            box.type(f"{133.5 - 0.1 * k:.1f}", delay=KEY_DELAY_MS)
+            box.type(f"{133.55 - 0.1 * k:.2f}", delay=KEY_DELAY_MS)  # values not solved before (a kept answer would come at once)
             wait_rendered(page, before)
             last_key = page.evaluate("window.lastInputAt")
             typed_first.append(page.evaluate("window.firstRenderedAt") - last_key)
