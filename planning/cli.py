@@ -102,6 +102,19 @@ def _parser() -> argparse.ArgumentParser:
     b.add_argument(
         "--points", type=_whole(2, 1_000_000), default=1440, metavar="N", help="grid intervals (default 1440)"
     )
+    b.add_argument(
+        "--certified",
+        action="store_true",
+        help="also the certified upper bound: strokes/min no motion within the limits can exceed (a convex "
+        "relaxation; the grid bound approaches the optimum from below and is no upper bound)",
+    )
+    b.add_argument(
+        "--upper-points",
+        type=_whole(2, 1_000_000),
+        default=None,
+        metavar="N",
+        help="the certified bound's grid intervals (default 2880; 3 pieces each)",
+    )
     b.add_argument("--json", action="store_true", help="print JSON")
     lw = sub.add_parser("laws", help="every motion law on the case, beside the time-optimal bound")
     _case_argument(lw)
@@ -456,15 +469,28 @@ def _bound(case, args) -> int:
 
     bound = time_optimal_bound(case, args.points)
     data = {"case": case.name, **bound.as_dict()}
+    upper = None
+    if args.certified or args.upper_points is not None:
+        from planning.solver.upper_bound import UPPER_POINTS, upper_bound
+
+        upper = upper_bound(case, args.upper_points or UPPER_POINTS)
+        data["upper_bound"] = upper.as_dict()
     if args.json:
         print(json.dumps(data, indent=2))
-    else:
+        return EXIT_OK
+    print(
+        f"{case.name}: time-optimal bound {bound.spm:.3f} strokes/min, cycle {bound.cycle_time_s:.4f} s "
+        f"({bound.points} intervals{_more_than_asked(bound.points, args.points)}; peak crank speed "
+        f"{data['peak_crank_speed_rpm']:.2f} rpm, draw {bound.draw_speed_rpm:.3f} rpm, "
+        f"idle time in the robot's window {bound.window_slack_s:.3f} s"
+        + (f"; crank jerk <= {bound.crank_jerk_limit_rad_s3:g} rad/s^3)" if bound.crank_jerk_limit_rad_s3 else ")")
+    )
+    if upper is not None:
+        left = f"; left out: {', '.join(upper.left_out)}" if upper.left_out else ""
         print(
-            f"{case.name}: time-optimal bound {bound.spm:.3f} strokes/min, cycle {bound.cycle_time_s:.4f} s "
-            f"({bound.points} intervals{_more_than_asked(bound.points, args.points)}; peak crank speed "
-            f"{data['peak_crank_speed_rpm']:.2f} rpm, draw {bound.draw_speed_rpm:.3f} rpm, "
-            f"idle time in the robot's window {bound.window_slack_s:.3f} s"
-            + (f"; crank jerk <= {bound.crank_jerk_limit_rad_s3:g} rad/s^3)" if bound.crank_jerk_limit_rad_s3 else ")")
+            f"  certified upper bound {upper.spm:.3f} strokes/min, cycle at least {upper.cycle_time_s:.4f} s: no "
+            f"motion within the limits makes more (convex relaxation, {upper.points} intervals x {upper.pieces} "
+            f"pieces{left})"
         )
     return EXIT_OK
 

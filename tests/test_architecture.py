@@ -170,6 +170,7 @@ CASADI_MODULES = {  # the wrapper and the modules that build expressions for it
     "planning.solver.halves_nlp",
     "planning.solver.free_nlp",
     "planning.solver.bound",
+    "planning.solver.upper_bound",
 }
 
 

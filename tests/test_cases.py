@@ -9,6 +9,7 @@ import pytest
 from planning.model.case_file import read_case
 from planning.reports.report import trajectory
 from planning.solver.optimize import solve
+from planning.solver.upper_bound import upper_bound
 
 CASES = sorted((Path(__file__).resolve().parents[1] / "cases").glob("*.yaml"))
 
@@ -23,3 +24,4 @@ def test_case_solves_and_verifies(path):
     tab = trajectory(free, case)
     assert abs(tab["slider_accel_mm_s2"]).max() <= case.limits.slider_accel_mm_s2 * (1 + 1e-6)
     assert free.plan.transfer_window() >= case.process.transfer_time_s - 1e-6
+    assert upper_bound(case, 180, 2).spm >= free.plan.spm  # certified: no verified motion above it

@@ -19,12 +19,14 @@ from planning.reports.outputs import solution_writers
 from planning.reports.report import result_dict, trajectory
 from planning.solver.optimize import solve
 from planning.solver.outcomes import PlanningError
+from planning.solver.upper_bound import upper_bound
 
 from .random_cases import CASES, build_case, seeded_case, seeded_offset_case
 
 RANDOM_SET = 100  # presses of each kind (draw speed given, or left to the planner) in the normal run
 VERIFIED_SHARE = 0.9  # of them at least this share end in a verified plan
 OFFSET_SET = 40  # offset crank-sliders in the normal run
+UPPER_BOUND_SET = 15  # verified presses of each kind checked against the certified upper bound
 SLOW_CASES = 2000
 SLOW_CHUNK = 100
 RELAXATION_EXAMPLES = 16
@@ -40,8 +42,11 @@ PROFILE = settings(
 CASE_FIELD = re.compile(r"\b(?:limits|process|drive|key_points|planner|press)\.[a-z_.]+[a-zA-Z]|\bkey_points\b")
 
 
-def outcome(data: dict) -> str:
-    """Run one case through the API the CLI uses; assert the properties; return the outcome."""
+def outcome(data: dict, spms: list[float] | None = None) -> str:
+    """Run one case through the API the CLI uses; assert the properties; return the outcome (``spms``:
+    appended the verified plan's strokes/min, or 0.0)."""
+    if spms is not None:
+        spms.append(0.0)
     try:
         case = case_from_data(data, data["name"])
     except CaseFileError as exc:
@@ -60,6 +65,8 @@ def outcome(data: dict) -> str:
     assert np.max(np.abs(tab["slider_accel_mm_s2"])) <= case.limits.slider_accel_mm_s2 * (1 + 1e-6)
     assert tab["crank_angle_deg"][-1] - tab["crank_angle_deg"][0] == pytest.approx(360.0, abs=1e-7)
     assert 0 < sol.plan.spm < math.inf
+    if spms is not None:
+        spms[-1] = sol.plan.spm
     return "verified"
 
 
@@ -75,10 +82,16 @@ def random_set(draw_speed_given: bool) -> list[dict]:
 @pytest.mark.parametrize("draw_speed_given", [True, False], ids=["draw speed given", "draw speed free"])
 def test_random_presses_end_verified(draw_speed_given):
     """Every press ends verified or clean (the properties of :func:`outcome`), and most end verified: a
-    planner that failed every case would fail here."""
-    outcomes = [outcome(data) for data in random_set(draw_speed_given)]
+    planner that failed every case would fail here. On the first :data:`UPPER_BOUND_SET` verified presses
+    the certified upper bound (coarse grid, still an upper bound) is above the verified plan."""
+    spms: list[float] = []
+    outcomes = [outcome(data, spms) for data in random_set(draw_speed_given)]
     verified = outcomes.count("verified")
     assert verified >= VERIFIED_SHARE * len(outcomes), sorted(set(outcomes))
+    checked = [(data, spm) for data, spm in zip(random_set(draw_speed_given), spms, strict=True) if spm]
+    for data, spm in checked[:UPPER_BOUND_SET]:
+        assert upper_bound(case_from_data(data), 180, 2).spm >= spm, data["name"]
+    assert len(checked) >= UPPER_BOUND_SET
 
 
 def test_random_offset_presses_end_verified():

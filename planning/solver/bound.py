@@ -76,14 +76,14 @@ class Bound:
         }
 
 
-def angle_grid(case: Case, points: int) -> np.ndarray:
+def angle_grid(case: Case, points: int, extra: tuple[float, ...] = ()) -> np.ndarray:
     """Nodes [rad] from theta1 over one revolution, ``points`` intervals in all (more only when ``points`` is
     below :data:`MIN_INTERVALS_PER_ARC` per arc). Among them: the key angles,
     TDC, and the angles where the slide passes the die height, so that the die-height speed limit holds
-    exactly where it starts and ends (between nodes it would be missed)."""
+    exactly where it starts and ends (between nodes it would be missed); and the ``extra`` angles [rad]."""
     th1, th2, th3, th4 = case.key_angles
     two_pi = 2 * math.pi
-    breaks = {th2, th3, th4, two_pi}
+    breaks = {th2, th3, th4, two_pi, *(a % two_pi for a in extra)}
     die = case.limits.die_height_mm
     if 0 < die < case.machine.stroke:
         breaks |= {float(a) for a in case.machine.angles_at_height(die)}

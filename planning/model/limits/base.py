@@ -201,6 +201,39 @@ class BoundGrid:
 
 
 @dataclass
+class RelaxedGrid:
+    """The certified upper bound's grid (``planning.solver.upper_bound``): nodes as :class:`BoundGrid`
+    (``theta``, ``h``, ``d1``, ``d2``, ``dtheta``, ``window``), on which ``h`` is monotone and ``d1^2``
+    monotone over every interval; each interval cut into pieces: ``cell`` (the interval of each piece),
+    ``a``, ``b`` [rad] (its ends), ``h_a``, ``h_b`` [mm] (heights there), ``slope2_min`` [mm^2/rad^2] (the
+    least ``d1^2`` over the piece). Symbols: ``s`` / ``s_next`` (crank speed squared [rad^2/s^2] at each
+    interval's start / end node, the values of any motion there), ``mean_alpha`` (each interval's mean
+    crank acceleration over angle [rad/s^2]), ``tau`` / ``tau_next`` (each interval's time [s]), and per
+    piece ``s_a`` / ``s_b`` (``s`` at its interval's start / end node)."""
+
+    case: Any
+    theta: np.ndarray
+    h: np.ndarray
+    d1: np.ndarray
+    d2: np.ndarray
+    dtheta: np.ndarray
+    window: np.ndarray
+    cell: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+    h_a: np.ndarray
+    h_b: np.ndarray
+    slope2_min: np.ndarray
+    s: Any = None
+    s_next: Any = None
+    mean_alpha: Any = None
+    tau: Any = None
+    tau_next: Any = None
+    s_a: Any = None
+    s_b: Any = None
+
+
+@dataclass
 class Draw:
     """The draw at constant crank speed, theta2 -> theta3: ``theta`` [rad] on :data:`DRAW_GRID` angles and
     the mechanism's ``h`` [mm], ``d1`` [mm/rad], ``d2`` [mm/rad^2] there; the ``case``."""
@@ -320,6 +353,25 @@ class Limit:
 
     def bound_rows(self, grid: BoundGrid) -> list[tuple[Any, Any, Any]]:
         """The limit's rows ``(expr, lo, hi)`` over the bound's intervals."""
+        return []
+
+    def relaxed_rows(self, grid: RelaxedGrid) -> list[tuple[Any, Any, Any]] | None:
+        """The limit's rows ``(expr, lo, hi)`` in the certified upper bound: conditions every motion that
+        meets the limit meets at the grid's nodes and over its intervals (never a restriction). None: the
+        limit has no such form and is left out of the upper bound (which stays an upper bound, looser).
+        By default: none needed when the limit has no rows in the grid bound (its speed bounds at the
+        nodes, :meth:`bound_speeds`, hold at any angle), else None."""
+        return [] if type(self).bound_rows is Limit.bound_rows else None
+
+    def relaxed_caps(self, grid: RelaxedGrid) -> np.ndarray | None:
+        """An upper bound on the crank speed squared [rad^2/s^2] valid over each whole piece (numbers;
+        None: none), the largest the limit allows anywhere in the piece."""
+        return None
+
+    def relaxed_envelopes(self, grid: RelaxedGrid) -> list[tuple[Any, np.ndarray]]:
+        """``(expression, where)`` pairs: the expression, one value per piece and affine in the node values,
+        bounds the crank speed squared [rad^2/s^2] from above over the whole piece for every motion that
+        meets the limit, on the pieces ``where`` is True."""
         return []
 
     def __repr__(self) -> str:

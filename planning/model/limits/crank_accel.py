@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 from pydantic import Field
 
-from planning.model.limits.base import REL_TOL, BoundGrid, Check, Dense, Limit, Row, Transcription
+from planning.model.limits.base import REL_TOL, BoundGrid, Check, Dense, Limit, RelaxedGrid, Row, Transcription
 from planning.model.units import CrankAccel
 
 
@@ -52,3 +52,17 @@ class CrankAccelLimit(Limit):
         limit = grid.case.limits.crank_accel_rad_s2
         n = grid.dtheta.size
         return [(grid.alpha, -limit * np.ones(n), limit * np.ones(n))]
+
+    def relaxed_rows(self, grid: RelaxedGrid) -> list[tuple[Any, Any, Any]]:
+        """Each interval's mean acceleration over angle lies within the limit as every value does."""
+        limit = grid.case.limits.crank_accel_rad_s2
+        n = grid.dtheta.size
+        return [(grid.mean_alpha, -limit * np.ones(n), limit * np.ones(n))]
+
+    def relaxed_envelopes(self, grid: RelaxedGrid) -> list[tuple[Any, np.ndarray]]:
+        """``ds/dtheta = 2 alpha``: over a piece [a, b] of interval i, ``s <= s_i + 2 A_c (b - theta_i)`` and
+        ``s <= s_(i+1) + 2 A_c (theta_(i+1) - a)``."""
+        limit = grid.case.limits.crank_accel_rad_s2
+        every = np.ones(grid.cell.size, dtype=bool)
+        start, end = grid.theta[grid.cell], grid.theta[grid.cell + 1]
+        return [(grid.s_a + 2 * limit * (grid.b - start), every), (grid.s_b + 2 * limit * (end - grid.a), every)]

@@ -7,7 +7,17 @@ from typing import Any
 import numpy as np
 from pydantic import Field
 
-from planning.model.limits.base import REL_TOL, BoundGrid, Check, Dense, Limit, Row, Transcription, sample_vector
+from planning.model.limits.base import (
+    REL_TOL,
+    BoundGrid,
+    Check,
+    Dense,
+    Limit,
+    RelaxedGrid,
+    Row,
+    Transcription,
+    sample_vector,
+)
 from planning.model.profile import max_abs_jerk
 from planning.model.units import CrankJerk
 
@@ -60,4 +70,17 @@ class CrankJerkLimit(Limit):
         return [
             (alpha_next - grid.alpha - room, np.full(n, -np.inf), np.zeros(n)),
             (alpha_next - grid.alpha + room, np.zeros(n), np.full(n, np.inf)),
+        ]
+
+    def relaxed_rows(self, grid: RelaxedGrid) -> list[tuple[Any, Any, Any]]:
+        """The mean accelerations of two neighbouring intervals are values the acceleration takes within
+        their joint time, so they differ by at most ``J (tau_i + tau_(i+1))`` (the grid bound's half is an
+        estimate, not a bound)."""
+        J = grid.case.limits.crank_jerk_rad_s3
+        alpha_next = sample_vector([grid.mean_alpha[1:], grid.mean_alpha[0]])
+        room = J * (grid.tau + grid.tau_next)
+        n = grid.dtheta.size
+        return [
+            (alpha_next - grid.mean_alpha - room, np.full(n, -np.inf), np.zeros(n)),
+            (alpha_next - grid.mean_alpha + room, np.zeros(n), np.full(n, np.inf)),
         ]

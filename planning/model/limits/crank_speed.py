@@ -8,7 +8,7 @@ import numpy as np
 from pydantic import Field
 
 from planning.model.errors import CaseError
-from planning.model.limits.base import REL_TOL, BoundGrid, Check, Dense, Draw, Limit, Row, Transcription
+from planning.model.limits.base import REL_TOL, BoundGrid, Check, Dense, Draw, Limit, RelaxedGrid, Row, Transcription
 from planning.model.units import RPM, CrankSpeed
 
 
@@ -62,3 +62,6 @@ class CrankSpeedLimit(Limit):
     def bound_speeds(self, grid: BoundGrid) -> tuple[np.ndarray | None, np.ndarray | None]:
         top = grid.case.limits.crank_speed_rpm * RPM
         return None, np.full(grid.dtheta.size, top**2)
+
+    def relaxed_caps(self, grid: RelaxedGrid) -> np.ndarray:
+        return np.full(grid.cell.size, (grid.case.limits.crank_speed_rpm * RPM) ** 2)

@@ -16,6 +16,7 @@ from planning.model.limits.base import (
     Dense,
     Draw,
     Limit,
+    RelaxedGrid,
     Row,
     Transcription,
     sample_vector,
@@ -125,3 +126,11 @@ class DieSpeedLimit(Limit):
         upper = np.full(h.shape, np.inf)
         upper[low] = (lim.die_speed_mm_s / np.abs(d1[low])) ** 2
         return None, upper
+
+    def relaxed_caps(self, grid: RelaxedGrid) -> np.ndarray:
+        """On a piece wholly at or below the die height: ``(v_die / min |h'|)^2``."""
+        lim = grid.case.limits
+        inside = (np.maximum(grid.h_a, grid.h_b) <= lim.die_height_mm) & (grid.slope2_min > 0)
+        caps = np.full(grid.cell.size, np.inf)
+        caps[inside] = lim.die_speed_mm_s**2 / grid.slope2_min[inside]
+        return caps

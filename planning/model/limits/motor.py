@@ -16,6 +16,7 @@ from planning.model.limits.base import (
     Dense,
     Impossible,
     Limit,
+    RelaxedGrid,
     Row,
     Transcription,
     trapezoid,
@@ -75,6 +76,9 @@ class MotorSpeedLimit(Limit):
 
     def bound_speeds(self, grid: BoundGrid) -> tuple[np.ndarray | None, np.ndarray | None]:
         return None, np.full(grid.dtheta.size, _top_crank_speed(grid.case) ** 2)
+
+    def relaxed_caps(self, grid: RelaxedGrid) -> np.ndarray:
+        return np.full(grid.cell.size, _top_crank_speed(grid.case) ** 2)
 
 
 def _top_crank_speed(case: Any) -> float:
@@ -215,6 +219,10 @@ class MotorRMSTorqueLimit(Limit):
         rated = dense.case.drive.motor.rated_torque_Nm
         rms = dense.integrals["rms_motor_torque_Nm"]
         return [Check.of(self.id, self.name, rms, rated, self.unit, "max", REL_TOL * rated)]
+
+    def relaxed_rows(self, grid: RelaxedGrid) -> None:
+        """Not in the upper bound (the RMS of a cycle is no condition at an angle): left out."""
+        return None
 
 
 def _draw_state(case: Any, w2: float) -> tuple[np.ndarray, dict]:

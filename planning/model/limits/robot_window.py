@@ -18,6 +18,7 @@ from planning.model.limits.base import (
     Draw,
     Impossible,
     Limit,
+    RelaxedGrid,
     Row,
     Transcription,
     total,
@@ -65,6 +66,10 @@ class TransferTimeLimit(Limit):
     def bound_rows(self, grid: BoundGrid) -> list[tuple[Any, Any, Any]]:
         window = np.flatnonzero(grid.window).tolist()
         return [(total(grid.tau[window]), grid.case.process.transfer_time_s, np.inf)]
+
+    def relaxed_rows(self, grid: RelaxedGrid) -> list[tuple[Any, Any, Any]]:
+        """The window's intervals' times add up as in the grid bound (each at least the motion's)."""
+        return self.bound_rows(grid)  # type: ignore[arg-type] - the same fields
 
 
 class SafetyHeightLimit(Limit):

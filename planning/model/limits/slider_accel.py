@@ -16,10 +16,13 @@ from planning.model.limits.base import (
     Draw,
     Impossible,
     Limit,
+    RelaxedGrid,
     Row,
     Transcription,
 )
 from planning.model.units import SliderAccel
+
+DEAD_CENTRE_SLOPE = 1e-9  # relative to the largest |h'|: a node where the slide stands (a dead centre)
 
 ACCEL_BACKOFF = 5e-4  # the NLPs hold |slider acceleration| <= (1 - backoff) * limit at their samples
 HARDER_BACKOFF = 5e-3  # the back-off of a second round when no start verified
@@ -93,3 +96,27 @@ class SliderAccelLimit(Limit):
         end = grid.d2[1:] * grid.s_next + grid.d1[1:] * grid.alpha
         n = grid.dtheta.size
         return [(start, -A * np.ones(n), A * np.ones(n)), (end, -A * np.ones(n), A * np.ones(n))]
+
+    def relaxed_rows(self, grid: RelaxedGrid) -> list[tuple[Any, Any, Any]]:
+        """The slide's own kinematics, exact for any motion: ``d(v^2)/dtheta = 2 h' a`` with ``v = h' omega``,
+        so over an interval where h is monotone ``|h'_(i+1)^2 s_(i+1) - h'_i^2 s_i| <= 2 A |h_(i+1) - h_i|``; at
+        a dead centre (h' = 0) ``|h'' s| <= A``."""
+        A = grid.case.limits.slider_accel_mm_s2
+        w, w_next = grid.d1[:-1] ** 2 * grid.s, grid.d1[1:] ** 2 * grid.s_next
+        room = 2 * A * np.abs(np.diff(grid.h))
+        rows = [(w_next - w, -room, room)]
+        dead = np.flatnonzero(np.abs(grid.d1[:-1]) <= DEAD_CENTRE_SLOPE * np.max(np.abs(grid.d1)))
+        if dead.size:
+            rows.append((grid.d2[dead] * grid.s[dead.tolist()], -A * np.ones(dead.size), A * np.ones(dead.size)))
+        return rows
+
+    def relaxed_envelopes(self, grid: RelaxedGrid) -> list[tuple[Any, np.ndarray]]:
+        """Over a piece [a, b] of interval i: ``v^2 <= v_i^2 + 2 A |h(b) - h_i|`` and ``<= v_(i+1)^2 + 2 A |h_(i+1) -
+        h(a)|``, so ``s <= that / min h'^2`` over the piece (pieces where h' vanishes: none)."""
+        A = grid.case.limits.slider_accel_mm_s2
+        moving = grid.slope2_min > 0
+        m = np.where(moving, grid.slope2_min, 1.0)
+        start, end = grid.cell, grid.cell + 1
+        from_start = (grid.d1[start] ** 2 * grid.s_a + 2 * A * np.abs(grid.h_b - grid.h[start])) / m
+        from_end = (grid.d1[end] ** 2 * grid.s_b + 2 * A * np.abs(grid.h[end] - grid.h_a)) / m
+        return [(from_start, moving), (from_end, moving)]

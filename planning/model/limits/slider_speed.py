@@ -16,6 +16,7 @@ from planning.model.limits.base import (
     Draw,
     Impossible,
     Limit,
+    RelaxedGrid,
     Row,
     Transcription,
 )
@@ -103,3 +104,9 @@ class SliderSpeedLimit(Limit):
         moving = d1 > 0
         upper[moving] = (grid.case.limits.slider_speed_mm_s / d1[moving]) ** 2
         return None, upper
+
+    def relaxed_caps(self, grid: RelaxedGrid) -> np.ndarray:
+        caps = np.full(grid.cell.size, np.inf)
+        moving = grid.slope2_min > 0
+        caps[moving] = grid.case.limits.slider_speed_mm_s**2 / grid.slope2_min[moving]
+        return caps

@@ -1,0 +1,215 @@
+"""The certified upper bound: strokes/min that no crank motion meeting the case's limits can exceed.
+
+The grid bound (``planning.solver.bound``) restricts the motion (constant crank acceleration on each
+interval, the slider's limit at the interval's ends): it approaches the true optimum from below and is
+not an upper bound. Here the same question is relaxed instead: every motion that meets the limits also
+meets the relaxed problem, so the relaxed optimum is an upper bound on its strokes/min.
+
+Variables: ``s_i`` [rad^2/s^2] the crank speed squared at the nodes (any motion's own values there) and
+``tau_p`` [s] the time spent on each piece of each interval (pieces cut each interval; any motion's own
+times satisfy every row below, so it is a feasible point). Rows, each true for every motion that meets
+the limits (the limits state their own, ``Limit.relaxed_rows`` / ``relaxed_caps`` /
+``relaxed_envelopes``):
+
+- at the nodes, every limit's bound on the speed (a condition at an angle holds at the node's angle);
+- the slide's kinematics, exact for any motion: with ``v = h' omega``, ``d(v^2)/dtheta = 2 h' a``, so
+  where h is monotone (the dead centres are nodes) ``|h'_(i+1)^2 s_(i+1) - h'_i^2 s_i| <= 2 A |h_(i+1) -
+  h_i|`` (A the slider-acceleration limit), and ``|h'' s| <= A`` at a dead centre;
+- the draw at one speed: ``s`` equal on the draw's nodes, within the draw-speed range;
+- the mean crank acceleration of an interval (``(s_(i+1) - s_i) / (2 dtheta)``) within the crank's
+  acceleration limit; two neighbouring means differ by at most ``J (tau_i + tau_(i+1))`` (crank jerk);
+- the robot's window: the times of its intervals add up to at least the transfer time;
+- each piece's time at least its angle over the largest crank speed any such motion can have on it:
+  ``tau_p >= (b - a) / sqrt(E)`` for each envelope E of ``s`` over the piece: a speed limit's largest
+  value on the piece (crank, motor, slider, die speed), ``(h'_i^2 s_i + 2 A |h(b) - h_i|) / min h'^2`` and
+  its mirror from the interval's end (the slide cannot gain speed faster than A allows), ``s_i + 2 A_c
+  (b - theta_i)`` and its mirror (the crank acceleration limit A_c), and ``s_i`` on the draw. On a piece
+  where h' vanishes (the first sliver next to a dead centre, :data:`DEAD_CENTRE_SLIVER` of its
+  interval) no envelope holds and its time is bounded by 0 only. Every interval has h and h'^2
+  monotone (the inflection points of h are nodes too), so the least h'^2 of a piece is at one of its
+  ends.
+
+``1 / sqrt`` of an affine function is convex, so the relaxed problem is convex and IPOPT's optimum is its
+global one; the upper bound is ``60 / (sum tau)`` at that optimum, up to IPOPT's tolerance (1e-10). A
+limit with no relaxed form (the motor's peak torque, the RMS torque) is left out (named in the answer):
+the number stays an upper bound, looser. The relaxation tightens as the grid refines: the piece envelopes
+differ from the motion's speed by O(piece) (:func:`upper_bound`'s ``points`` and ``pieces``).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from planning.model.case import RPM, Case
+from planning.model.limits import limits_of
+from planning.model.limits.base import BoundGrid, RelaxedGrid
+from planning.solver.bound import BOUND_OPTIONS, _speed_bounds, angle_grid
+from planning.solver.ipopt import NLPSolver
+from planning.solver.outcomes import NoPlanFound
+from planning.solver.precheck import precheck
+
+UPPER_POINTS = 2880  # intervals of the grid by default
+UPPER_PIECES = 3  # pieces per interval (the time rows)
+DEAD_CENTRE_SLIVER = 1.0 / 1024  # share of an interval next to a dead centre whose time is bounded by 0 only
+INFLECTION_GRID = 7200  # angles on which the sign changes of h'' are looked for
+
+
+@dataclass(frozen=True)
+class UpperBound:
+    """The certified upper bound: ``spm`` (no motion meeting the limits makes more), ``cycle_time_s`` [s]
+    (no motion's cycle is shorter), ``points`` (intervals) and ``pieces`` (per interval) of the grid,
+    ``left_out`` (limits of the case without a relaxed form: not in the bound, which stays an upper bound),
+    ``wall_time_s`` [s]."""
+
+    spm: float
+    cycle_time_s: float
+    points: int
+    pieces: int
+    left_out: tuple[str, ...]
+    wall_time_s: float
+
+    def as_dict(self) -> dict:
+        return {
+            "spm": self.spm,
+            "cycle_time_s": self.cycle_time_s,
+            "points": self.points,
+            "pieces": self.pieces,
+            "left_out": list(self.left_out),
+            "wall_time_s": self.wall_time_s,
+            "method": "convex relaxation over crank angle (every motion meeting the limits meets it)",
+        }
+
+
+def inflections(case: Case) -> list[float]:
+    """Crank angles [rad] where h'' changes sign (h'^2 has its interior extremes only there and at the dead
+    centres), by bisection on a grid of :data:`INFLECTION_GRID` angles."""
+    grid = np.linspace(0.0, 2 * math.pi, INFLECTION_GRID + 1)
+    d2 = case.machine.jets(grid)[2]
+    k = np.flatnonzero(np.sign(d2[:-1]) * np.sign(d2[1:]) < 0)
+    lo, hi = grid[k], grid[k + 1]
+    sign_lo = np.sign(d2[k])
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        same = np.sign(case.machine.jets(mid)[2]) == sign_lo
+        lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
+    return (0.5 * (lo + hi)).tolist()
+
+
+def _pieces(theta: np.ndarray, d1: np.ndarray, pieces: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Each interval cut into ``pieces`` equal pieces, a sliver split off next to a dead centre: (interval
+    of each piece, its start, its end [rad], whether it touches a dead centre)."""
+    scale = np.max(np.abs(d1))
+    cells, starts, ends, dead = [], [], [], []
+    for i in range(theta.size - 1):
+        a, b = theta[i], theta[i + 1]
+        cuts = list(np.linspace(a, b, pieces + 1))
+        dead_start = abs(d1[i]) <= 1e-9 * scale
+        dead_end = abs(d1[i + 1]) <= 1e-9 * scale
+        if dead_start:
+            cuts.insert(1, a + DEAD_CENTRE_SLIVER * (b - a))
+        if dead_end:
+            cuts.insert(len(cuts) - 1, b - DEAD_CENTRE_SLIVER * (b - a))
+        for k in range(len(cuts) - 1):
+            cells.append(i)
+            starts.append(cuts[k])
+            ends.append(cuts[k + 1])
+            dead.append((dead_start and k == 0) or (dead_end and k == len(cuts) - 2))
+    return np.array(cells), np.array(starts), np.array(ends), np.array(dead)
+
+
+def upper_bound(case: Case, points: int = UPPER_POINTS, pieces: int = UPPER_PIECES) -> UpperBound:
+    """The certified upper bound of ``case`` (module docstring) on a grid of about ``points`` intervals,
+    each in ``pieces`` pieces; raises a :class:`~planning.solver.outcomes.PlanningError` if there is none."""
+    t_start = time.perf_counter()
+    w2_lo, w2_hi = precheck(case)
+    m = case.machine
+    th = angle_grid(case, points, (0.0, m.bdc_angle, *inflections(case)))
+    n = th.size - 1
+    dth = np.diff(th)
+    h, d1, d2, _ = m.jets(th)
+    th1, th2, th3, th4 = case.key_angles
+    limits = limits_of(case)
+    draw = np.flatnonzero((th[:-1] >= th2 - 1e-12) & (th[:-1] <= th3 + 1e-12))
+    window = th[:-1] >= th4 - 1e-12
+    lbx_s, ubx_s = _speed_bounds(BoundGrid(case, th, h, d1, d2, dth, window), limits, draw, w2_lo, w2_hi)
+
+    cell, a, b, dead = _pieces(th, d1, pieces)
+    h_a, d1_a = m.jets(a)[:2]
+    h_b, d1_b = m.jets(b)[:2]
+    slope2_min = np.where(dead, 0.0, np.minimum(d1_a**2, d1_b**2))
+    grid = RelaxedGrid(case, th, h, d1, d2, dth, window, cell, a, b, h_a, h_b, slope2_min)
+
+    w_acc2 = case.limits.slider_accel_mm_s2 / m.peak_curvature  # scales, as the grid bound's
+    s_unit = np.clip(np.full(n, w_acc2), lbx_s, ubx_s)
+    tau_unit = (b - a) / np.sqrt(s_unit[cell])
+    x_s = ca.SX.sym("s", n)  # scalar operations only: SX evaluates them fastest
+    x_tau = ca.SX.sym("tau", cell.size)
+    s = ca.DM(s_unit) * x_s
+    tau_piece = ca.DM(tau_unit) * x_tau
+    grid.s = s
+    grid.s_next = ca.vertcat(s[1:], s[0])
+    grid.mean_alpha = (grid.s_next - grid.s) / (2 * dth)
+    # each interval's time: the sum of its pieces' (a sparse 0/1 matrix)
+    to_cell = ca.DM(ca.Sparsity.triplet(n, cell.size, cell.tolist(), list(range(cell.size))), 1.0)
+    grid.tau = ca.mtimes(to_cell, tau_piece)
+    grid.tau_next = ca.vertcat(grid.tau[1:], grid.tau[0])
+    grid.s_a = s[cell.tolist()]
+    grid.s_b = grid.s_next[cell.tolist()]
+
+    g, lbg, ubg = [], [], []
+    left_out = []
+    caps = np.full(cell.size, np.inf)
+    envelopes: list[tuple[object, np.ndarray]] = []
+    for limit in limits:
+        rows = limit.relaxed_rows(grid)
+        if rows is None:
+            left_out.append(limit.field)
+            continue
+        for expr, lo, hi in rows:
+            g.append(expr)
+            lbg.append(np.broadcast_to(lo, (expr.shape[0],)))
+            ubg.append(np.broadcast_to(hi, (expr.shape[0],)))
+        cap = limit.relaxed_caps(grid)
+        if cap is not None:
+            caps = np.minimum(caps, cap)
+        envelopes += limit.relaxed_envelopes(grid)
+    in_draw = np.isin(cell, draw)
+    envelopes.append((grid.s_a, in_draw))  # the draw at one speed: s is its node value on the whole piece
+    if draw.size > 1:
+        g.append(s[draw[1:].tolist()] - s[draw[:-1].tolist()])
+        lbg.append(np.zeros(draw.size - 1))
+        ubg.append(np.zeros(draw.size - 1))
+    width = b - a
+    for expr, where in envelopes:
+        k = np.flatnonzero(where & ~dead)
+        if k.size:
+            g.append(tau_piece[k.tolist()] - ca.DM(width[k]) / ca.sqrt(expr[k.tolist()]))
+            lbg.append(np.zeros(k.size))
+            ubg.append(np.full(k.size, np.inf))
+    tau_floor = np.where(dead | ~np.isfinite(caps), 0.0, width / np.sqrt(np.where(np.isfinite(caps), caps, 1.0)))
+
+    nlp = {"x": ca.vertcat(x_s, x_tau), "f": ca.sum1(tau_piece), "g": ca.vertcat(*g)}
+    solver = NLPSolver("upper_bound", nlp, BOUND_OPTIONS, fixed_scale=np.concatenate([s_unit, tau_unit]))
+    x0 = np.concatenate([s_unit, np.maximum(width / np.sqrt(s_unit[cell]), tau_floor)])
+    lbx = np.concatenate([lbx_s, tau_floor])
+    ubx = np.concatenate([ubx_s, np.full(cell.size, np.inf)])
+    res = solver.solve(x0, lbx, ubx, np.concatenate(lbg), np.concatenate(ubg), clip_to_bounds=False)
+    if not res.success:
+        raise NoPlanFound(f"the upper bound did not converge ({res.return_status})")
+    period = float(np.sum(res.x[n:]))
+    return UpperBound(
+        spm=60.0 / period,
+        cycle_time_s=period,
+        points=n,
+        pieces=pieces,
+        left_out=tuple(dict.fromkeys(left_out)),
+        wall_time_s=time.perf_counter() - t_start,
+    )
+
+
+__all__ = ["RPM", "UpperBound", "upper_bound"]
