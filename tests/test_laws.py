@@ -160,12 +160,15 @@ def test_laws_command_and_the_readme_table(tmp_path, capsys):
     assert {p.name for p in tmp_path.iterdir()} == {"laws.json", "laws.md", "laws_overlay.png"}
     rows = {r["law"]: r for r in data["laws"]}
     assert set(rows) == set(LAWS) and all(r["status"] == "verified" for r in rows.values())
-    assert all(r["spm"] <= data["bound"]["spm"] for r in rows.values())
+    assert all(r["spm"] <= data["upper_bound"]["spm"] for r in rows.values())  # certified: no motion above
+    assert all(0 < r["share_of_upper_bound_pct"] <= 100.0 for r in rows.values())
+    best = max(rows.values(), key=lambda r: r["spm"])
+    assert data["bracket"]["verified_spm"] == best["spm"] and data["bracket"]["gap_pct"] >= 0
     readme = (ROOT / "docs" / "results.md").read_text(encoding="utf-8")
     block = readme.split("<!-- laws:begin -->")[1].split("<!-- laws:end -->")[0]
     printed = {cells[0]: cells for cells in _table_rows(block)}
     fresh = {cells[0]: cells for cells in _table_rows((tmp_path / "laws.md").read_text(encoding="utf-8"))}
-    assert printed.keys() == fresh.keys() and len(printed) == len(LAWS) + 1
+    assert printed.keys() == fresh.keys() and len(printed) == len(LAWS) + 2  # the grid and the upper bound
     for name, cells in fresh.items():
         for a, b in zip(cells[1:], printed[name][1:], strict=True):
             if a.replace(".", "").isdigit():
@@ -228,4 +231,4 @@ def test_laws_go_on_when_the_bound_has_no_answer(monkeypatch, tmp_path, capsys):
     data = json.loads((out / "laws.json").read_text())
     assert data["bound"] is None and "did not converge" in data["bound_failure"]
     assert all(r["status"] == "verified" and r["share_of_bound_pct"] is None for r in data["laws"])
-    assert "| – |" in (out / "laws.md").read_text()
+    assert "time-optimal bound (grid)" not in (out / "laws.md").read_text()

@@ -17,9 +17,10 @@ import pytest
 import yaml
 
 from planning.model.case_file import case_from_data, load_yaml, read_case
+from planning.reports.law_comparison import LAWS_UPPER_PIECES, LAWS_UPPER_POINTS
 from planning.reports.report import result_dict
-from planning.solver.bound import time_optimal_bound
 from planning.solver.optimize import solve
+from planning.solver.upper_bound import upper_bound
 
 from .web_page import ARTIFACTS, CASES, chromium, edit, missing_browser, pick_case, running_server, wait_rendered
 
@@ -97,10 +98,10 @@ def screenshot(tab, name: str) -> None:  # noqa: ANN001
 def test_page_shows_what_the_cli_gives_and_follows_an_edit(page) -> None:
     assert page.locator("#case-label").inner_text() == LABEL
     assert shown_numbers(page) == cli_numbers(published_data())
-    # the share of the bound follows once the edits rest, as `pressplan bound` computes it
+    # the share of the certified upper bound follows once the edits rest, as `pressplan laws` computes it
     page.wait_for_function("document.querySelector('#bound-share').textContent.endsWith('%')", timeout=60_000)
     case = case_from_data(published_data(), LABEL)
-    share = 100 * solve(case).plan.spm / time_optimal_bound(case).spm
+    share = 100 * solve(case).plan.spm / upper_bound(case, LAWS_UPPER_POINTS, LAWS_UPPER_PIECES).spm
     assert page.locator("#bound-share").inner_text() == f"{share:.1f} %"
     screenshot(page, "web-published")
     edit(page, "key_points.draw_start_deg", "133")

@@ -543,16 +543,20 @@ class _BoundPool:
 
 
 def bound_of(data: Any, label: str) -> dict[str, Any]:
-    """The time-optimal bound of the case (``pressplan bound``), or why there is none."""
+    """The case's certified upper bound (as ``pressplan laws`` computes it) and its grid bound, or why
+    there is none."""
+    from planning.reports.law_comparison import LAWS_UPPER_PIECES, LAWS_UPPER_POINTS
     from planning.solver.bound import time_optimal_bound
     from planning.solver.outcomes import PlanningError
+    from planning.solver.upper_bound import upper_bound
 
     try:
         case = case_from_data(data, label)
-        bound = time_optimal_bound(case)
+        upper = upper_bound(case, LAWS_UPPER_POINTS, LAWS_UPPER_PIECES)
+        grid = time_optimal_bound(case)
     except (CaseFileError, PlanningError) as exc:
         return {"status": "none", "message": str(exc)}
-    return {"status": "ok", "spm": bound.spm}
+    return {"status": "ok", "spm": grid.spm, "upper_spm": upper.spm, "left_out": list(upper.left_out)}
 
 
 def case_key(data: Any) -> str:

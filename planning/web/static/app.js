@@ -317,8 +317,12 @@ async function requestBound(data, seq) {
   const answer = await readJson(post("/api/bound", { label: state.label, case: data }));
   if (seq !== state.shownSeq) return;
   const spm = state.last.result.spm;
-  $("#bound-share").textContent = answer.status === "ok" ? (100 * spm / answer.spm).toFixed(1) + " %" : "no bound";
-  $("#bound-share").title = answer.status === "ok" ? `bound ${answer.spm.toFixed(3)} strokes/min` : answer.message;
+  // the share of the certified upper bound (no motion within the limits makes more: never above 100 %)
+  $("#bound-share").textContent = answer.status === "ok" ? (100 * spm / answer.upper_spm).toFixed(1) + " %" : "no bound";
+  $("#bound-share").title = answer.status === "ok"
+    ? `bracket: ${spm.toFixed(3)} strokes/min verified … ${answer.upper_spm.toFixed(3)} certified upper bound (no motion within the limits makes more` +
+      (answer.left_out.length ? `; left out: ${answer.left_out.join(", ")}` : "") + `); the grid bound ${answer.spm.toFixed(3)}`
+    : answer.message;
 }
 
 function clearMessages() {
