@@ -222,13 +222,17 @@ def test_laws_go_on_when_the_bound_has_no_answer(monkeypatch, tmp_path, capsys):
 
     from .conftest import PUBLISHED_CASE
 
-    def no_bound(case, points=1440):
+    def no_bound(case, points=1440, pieces=2):
         raise NoPlanFound("the time-optimal bound did not converge (Maximum_Iterations_Exceeded)")
 
     monkeypatch.setattr(comparison, "time_optimal_bound", no_bound)
+    monkeypatch.setattr(comparison, "upper_bound", no_bound)
     out = tmp_path / "laws"
     assert main(["laws", str(PUBLISHED_CASE), "--out", str(out), "--json"]) == 0
     data = json.loads((out / "laws.json").read_text())
     assert data["bound"] is None and "did not converge" in data["bound_failure"]
     assert all(r["status"] == "verified" and r["share_of_bound_pct"] is None for r in data["laws"])
-    assert "time-optimal bound (grid)" not in (out / "laws.md").read_text()
+    assert data["upper_bound"] is None and data["bracket"] is None
+    assert all(r["share_of_upper_bound_pct"] is None for r in data["laws"])
+    text = (out / "laws.md").read_text()
+    assert "| – |" in text and "time-optimal bound (grid)" not in text and "certified upper bound" not in text

@@ -82,23 +82,6 @@ def test_a_sweep_point_is_its_cold_solve_or_better(tmp_path, capsys):
         assert float(row["spm"]) >= solve(point).plan.spm * (1 - SAME), row
 
 
-def test_a_tradeoff_rate_is_its_cold_solve_or_better():
-    """Each rate of a 5-rate trade-off against a cold ``solve`` of the case at that rate: the same energy
-    per stroke or less. Each rate once followed the faster rate's plan alone and ended 0.02 ... 0.8 %
-    above the cold plan's energy at 20 ... 27 strokes/min here."""
-    from planning.solver.objectives import solve_at_rate
-    from planning.tradeoff import parse_rates, run_tradeoff
-
-    case = read_case(ROOT / "cases" / "cup-2000kN-drive.yaml").with_objective("min-energy", 20.0)
-    result = run_tradeoff(case, parse_rates("20:34:5"), workers=1)
-    for row in result.rows:
-        assert row["status"] == "verified", row
-        # cold: no neighbour; its fastest plan is the trade-off's (a cold max-SPM solve, the same every time)
-        cold = solve_at_rate(case.with_objective("min-energy", row["target_spm"]), fastest=result.fastest)
-        assert row["supply_energy_kJ"] <= cold.drive.supply_energy_kJ * (1 + SAME), row["target_spm"]
-        assert row["baseline_transfer_window_s"] >= cold.at_rate.baseline.plan.transfer_window() * (1 - SAME)
-
-
 @pytest.mark.parametrize("law", ("improved-s-curve", "optimal"))
 def test_a_neighbour_never_makes_it_worse_than_cold(law):
     """Every law: the answer from a neighbour is the cold one or better (the optimal law too)."""
