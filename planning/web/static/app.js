@@ -358,7 +358,7 @@ function setStatus(text, kind) {
 
 // ---- rendering --------------------------------------------------------------------------------------
 function render(answer, seq, confirmed) {
-  if (seq !== state.shownSeq) $("#bound-share").textContent = "…";
+  if (seq !== state.shownSeq) { $("#bound-share").textContent = "…"; $("#bound-share").title = "the bound follows once the edits rest"; } // never the last plan's bracket
   state.last = answer;
   state.shownSeq = seq;
   state.newCase = false;
