@@ -5,7 +5,8 @@ drive cases' solves, whose times it divides), a cold ``pressplan solve``
 process beside a process that only imports casadi, numpy, matplotlib and yaml, and the NLP build
 alone; (b) a 41-point transfer-time sweep with 1 and 2 workers (whole process, points per second);
 (c) a 7-point trade-off (``pressplan tradeoff``) on both drive cases with 2 workers; (d) the SPM of
-every motion law and its share of the time-optimal bound, with each law's NLP build and solve time
+every motion law and its share of the certified upper bound and the grid bound, with each law's NLP build
+and solve time
 (``pressplan laws``). Medians; run with ``python benchmarks/bench_solve.py`` from the project root
 where pressplan is installed.
 """
@@ -150,13 +151,16 @@ def main() -> None:
         "|---|---:|",
         *[f"| {name} | {value:.3f} |" for name, value in rows],
         "",
-        "Motion laws on the same case (free placement), against the time-optimal bound "
-        f"({law_rows[0]['bound']:.3f} SPM, {law_rows[0]['bound_time']:.2f} s to compute):",
+        "Motion laws on the same case (free placement), against the certified upper bound "
+        f"({law_rows[0]['upper']:.3f} SPM on `bound --certified`'s default grid, {law_rows[0]['upper_time']:.2f} s "
+        f"to compute; on `laws`' grid {law_rows[0]['laws_upper']:.3f} SPM, {law_rows[0]['laws_upper_time']:.2f} s) "
+        f"and the time-optimal grid bound ({law_rows[0]['bound']:.3f} SPM, {law_rows[0]['bound_time']:.2f} s):",
         "",
-        "| law | SPM | % of bound | NLP build [s] | solve [s] |",
-        "|---|---:|---:|---:|---:|",
+        "| law | SPM | % of the certified upper bound | % of the grid bound | NLP build [s] | solve [s] |",
+        "|---|---:|---:|---:|---:|---:|",
         *[
-            f"| {r['law']} | {r['spm']:.3f} | {r['share']:.1f} | {r['build']:.2f} | {r['solve']:.2f} |"
+            f"| {r['law']} | {r['spm']:.3f} | {r['upper_share']:.1f} | {r['share']:.1f} | {r['build']:.2f} | "
+            f"{r['solve']:.2f} |"
             for r in law_rows
         ],
         "",
@@ -272,9 +276,18 @@ def _laws(case) -> list[dict]:
     from planning.solver.halves_nlp import fresh_build
     from planning.solver.optimize import solve
 
+    from planning.reports.law_comparison import LAWS_UPPER_PIECES, LAWS_UPPER_POINTS
+    from planning.solver.upper_bound import upper_bound
+
     t = time.perf_counter()
     bound = time_optimal_bound(case)
     bound_time = time.perf_counter() - t
+    t = time.perf_counter()
+    upper = upper_bound(case)
+    upper_time = time.perf_counter() - t
+    t = time.perf_counter()
+    laws_upper = upper_bound(case, LAWS_UPPER_POINTS, LAWS_UPPER_PIECES)
+    laws_upper_time = time.perf_counter() - t
     rows = []
     for law in SHAPED_LAWS:  # the optimal law has rows of its own (it needs a jerk limit)
         variant = case.with_law(law)
@@ -290,6 +303,11 @@ def _laws(case) -> list[dict]:
                 "law": law,
                 "spm": sol.plan.spm,
                 "share": 100 * sol.plan.spm / bound.spm,
+                "upper_share": 100 * sol.plan.spm / upper.spm,
+                "upper": upper.spm,
+                "upper_time": upper_time,
+                "laws_upper": laws_upper.spm,
+                "laws_upper_time": laws_upper_time,
                 "build": build,
                 "solve": elapsed,
                 "bound": bound.spm,
