@@ -272,11 +272,10 @@ def _interleaved(cases: list, solve) -> list[tuple[list[float], object]]:
 def _laws(case) -> list[dict]:
     """(c): every law's SPM, share of the bound, NLP build time and (warm) solve time."""
     from planning.model.laws import SHAPED_LAWS
+    from planning.reports.law_comparison import LAWS_UPPER_PIECES, LAWS_UPPER_POINTS
     from planning.solver.bound import time_optimal_bound
     from planning.solver.halves_nlp import fresh_build
     from planning.solver.optimize import solve
-
-    from planning.reports.law_comparison import LAWS_UPPER_PIECES, LAWS_UPPER_POINTS
     from planning.solver.upper_bound import upper_bound
 
     t = time.perf_counter()

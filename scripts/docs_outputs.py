@@ -159,15 +159,17 @@ def fresh_outputs(pages: tuple[Path, ...] = PAGES) -> list[tuple[Block, str]]:
         return [(block, run(block.command)) for block in blocks(pages)]
 
 
-def fresh_values(pages: tuple[Path, ...] = PAGES) -> list[tuple[Value, str]]:
-    """Each inline value as its command gives it now, written with the decimals shown (each command
-    run once)."""
+def fresh_values(pages: tuple[Path, ...] = PAGES, commands: set[str] | None = None) -> list[tuple[Value, str]]:
+    """Each inline value (of ``commands`` only, when given) as its command gives it now, written with the
+    decimals shown (each command run once)."""
     import json
 
     outputs: dict[str, object] = {}
     found = []
     with scratch():
         for value in values(pages):
+            if commands is not None and value.command not in commands:
+                continue
             if value.command not in outputs:
                 outputs[value.command] = json.loads(run(value.command))
             found.append((value, shown_like(evaluate(outputs[value.command], value.path), value.shown)))

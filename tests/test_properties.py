@@ -26,7 +26,8 @@ from .random_cases import CASES, build_case, seeded_case, seeded_offset_case
 RANDOM_SET = 100  # presses of each kind (draw speed given, or left to the planner) in the normal run
 VERIFIED_SHARE = 0.9  # of them at least this share end in a verified plan
 OFFSET_SET = 40  # offset crank-sliders in the normal run
-UPPER_BOUND_SET = 8  # verified presses of each half checked against the certified upper bound (32 in all)
+RANDOM_PARTS = 4  # each set in parts of 25 presses (tests the workers share)
+UPPER_BOUND_SET = 4  # verified presses of each part checked against the certified upper bound (32 in all)
 SLOW_CASES = 2000
 SLOW_CHUNK = 100
 RELAXATION_EXAMPLES = 16
@@ -79,13 +80,14 @@ def random_set(draw_speed_given: bool) -> list[dict]:
     ]
 
 
-@pytest.mark.parametrize("half", [0, 1], ids=["first half", "second half"])  # two tests: the workers share them
+@pytest.mark.parametrize("part", range(RANDOM_PARTS), ids=lambda k: f"part {k + 1}")  # the workers share them
 @pytest.mark.parametrize("draw_speed_given", [True, False], ids=["draw speed given", "draw speed free"])
-def test_random_presses_end_verified(draw_speed_given, half):
+def test_random_presses_end_verified(draw_speed_given, part):
     """Every press ends verified or clean (the properties of :func:`outcome`), and most end verified: a
     planner that failed every case would fail here. On the first :data:`UPPER_BOUND_SET` verified presses
-    of each half the certified upper bound (coarse grid, still an upper bound) is above the verified plan."""
-    presses = random_set(draw_speed_given)[half * RANDOM_SET // 2 : (half + 1) * RANDOM_SET // 2]
+    of each part the certified upper bound (coarse grid, still an upper bound) is above the verified plan."""
+    size = RANDOM_SET // RANDOM_PARTS
+    presses = random_set(draw_speed_given)[part * size : (part + 1) * size]
     spms: list[float] = []
     outcomes = [outcome(data, spms) for data in presses]
     verified = outcomes.count("verified")
