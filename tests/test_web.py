@@ -452,6 +452,7 @@ def test_the_charts_draw_every_limit_of_the_case_and_the_robot_window(page) -> N
     assert "crank jerk [rad/s³]" in names
     notes = page.evaluate("document.getElementById('motion-chart').layout.annotations.map((a) => a.text)")
     assert any(n.startswith("robot window θ4 → θ1: 2.000 s") for n in notes), notes
+    assert "draw θ2 → θ3" in notes  # the draw's shading named too
     screenshot(page, "web-limits")
 
 

@@ -426,7 +426,11 @@ function cycleShapes(r, x, axis) {
     shapes.push({ type: "line", xref: "x", yref: "paper", x0: kx, x1: kx, y0: 0, y1: 1, line: { dash: "dot", width: 1, color: "#555" } });
   }
   const window = `robot window θ4 → θ1: ${r.transfer_window_s.toFixed(3)} s (≥ ${r.process.transfer_time_s} s)`;
-  const annotations = [{ xref: "x", yref: "paper", x: x[0], y: 1.0, xanchor: "left", yanchor: "bottom", text: window, showarrow: false, font: { size: 11, color: "#1f4e79" } }];
+  const annotations = [
+    { xref: "x", yref: "paper", x: x[0], y: 1.0, xanchor: "left", yanchor: "bottom", text: window, showarrow: false, font: { size: 11, color: "#1f4e79" } },
+    // the shaded stages named on the chart: the draw (green) beside the robot's window (blue)
+    { xref: "x", yref: "paper", x: (at("draw_start") + at("draw_end")) / 2, y: 1.0, xanchor: "center", yanchor: "bottom", text: "draw θ2 → θ3", showarrow: false, font: { size: 11, color: "#3b6e22" } },
+  ];
   return { shapes, annotations };
 }
 
