@@ -1,8 +1,8 @@
 """The motor-sizing curve: at each line rate the gentlest verified plan beside the baseline it beats.
 
 The fastest plan (max-SPM) is solved once, in this process, and the rate NLP is built before the
-workers fork; then the rates are cut into contiguous blocks, one per worker, and each rate is solved
-cold from the fastest plan (``planning.solver.objectives.solve_at_rate``): the same answer as
+workers fork; then each rate, a task of its own, goes to the next free worker and is solved cold from
+the fastest plan (``planning.solver.objectives.solve_at_rate``): the same answer as
 ``pressplan solve`` at that rate. The blocks run on local worker processes or a Dask
 cluster through the sweep's machinery (``planning.sweep.execute``).
 A rate above what the limits allow becomes a row that says why.
@@ -162,9 +162,10 @@ def run_tradeoff(
     fastest = solve(case.with_objective("max-spm"), placement)
     halves_nlp_for(case, drive=True, rate=True)  # built once here, inherited by forked workers
     values = rates.values(fastest.plan.spm)
-    order = list(enumerate(values.tolist()))[::-1]  # from the fastest rate down (each rate solved cold)
-    size = max(1, math.ceil(len(order) / max(1, workers)))  # one contiguous block per worker
-    work = [(case, placement, fastest, order[k : k + size]) for k in range(0, len(order), size)]
+    order = list(enumerate(values.tolist()))[::-1]  # from the fastest rate down
+    # each rate a task of its own (each is solved cold, independent of the others): the workers take the
+    # next rate as they finish, so none idles while another holds several
+    work = [(case, placement, fastest, [rate]) for rate in order]
     rows: dict[int, dict[str, Any]] = {}
     for block in execute(rate_block, work, workers, scheduler, meanwhile):
         for row in block:
