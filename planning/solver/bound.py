@@ -1,4 +1,7 @@
-"""The time-optimal bound: the shortest cycle any crank motion can make under the case's limits.
+"""The time-optimal bound on a grid: the shortest cycle of a crank motion with constant acceleration on
+each interval of a grid over crank angle, under the case's limits. It approaches the true optimum from
+below as the grid refines (a restriction of the motions, not an upper bound: ``planning.solver.upper_bound``
+gives the certified one).
 
 No motion law: the crank speed is free except for the limits (acceleration-limited; the acceleration
 may jump). Direct transcription over crank angle in the phase plane: on a grid theta_0 < ... <
@@ -17,8 +20,10 @@ Each limit of the case states its own part (``planning.model.limits``: ``bound_s
 the RMS torque takes none (it is not a limit at a crank angle). Every constraint set is convex and the
 objective linear, so IPOPT's optimum is the global one: a local solution cannot be mistaken for the
 bound. Where ``tau_i`` exceeds the interval's time (only
-useful inside the robot window), the problem is a relaxation and the bound is still valid (never below
-the best SPM any motion reaches); ``window_slack_s`` reports how much was used. The drive's speed and
+useful inside the robot window), the window's time is relaxed (``window_slack_s`` reports how much was
+used); the constant acceleration per interval and the slider's limit at the interval's ends restrict the
+motions, so the number is not certified to bound every motion (on the published case 13.038 at 1440
+intervals, where a motion meeting every limit makes 13.0405). The drive's speed and
 acceleration limits enter as bounds on s and alpha. A crank-jerk limit J enters between neighbouring
 intervals as ``|alpha_{i+1} - alpha_i| <= J (tau_i + tau_{i+1}) / 2`` (``planning.model.limits.crank_jerk``).
 Without a crank
@@ -72,7 +77,9 @@ class Bound:
             "peak_crank_speed_rpm": float(np.max(self.crank_speed_rpm)),
             "wall_time_s": self.wall_time_s,
             "crank_jerk_limit_rad_s3": self.crank_jerk_limit_rad_s3,
-            "method": "phase-plane direct transcription over crank angle, convex (global optimum)",
+            "method": "phase-plane direct transcription over crank angle, convex (the grid's global optimum: "
+            "constant crank acceleration per interval, a restriction that approaches the optimum from below; "
+            "the certified upper bound: --certified)",
         }
 
 
