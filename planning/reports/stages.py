@@ -79,9 +79,8 @@ def stage_table(result: dict[str, Any], columns: dict[str, np.ndarray]) -> dict[
     stages = []
     for k, (run, mask) in enumerate(zip(runs, masks, strict=True)):
         if not mask.any():  # a stage shorter than a step: the sample nearest its start
-            mask = np.abs((angle - run["start_angle_deg"] + 180.0) % 360.0 - 180.0) == np.min(
-                np.abs((angle - run["start_angle_deg"] + 180.0) % 360.0 - 180.0)
-            )
+            distance = np.abs((angle - run["start_angle_deg"] + 180.0) % 360.0 - 180.0)
+            mask = distance == np.min(distance)
         peak = float(np.max(speed[mask]))
         stages.append({**run, "peak_crank_speed_rpm": peak, "binding": placed[k]})
     return {"stages": stages, "binding_over_cycle": over_cycle}

@@ -144,7 +144,7 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
     draw = np.flatnonzero((th[:-1] >= th2 - 1e-12) & (th[:-1] <= th3 + 1e-12))
     window = th[:-1] >= th4 - 1e-12  # the grid starts at theta1: the robot window is [theta4, theta1 + 2 pi)
     grid = BoundGrid(case, th, h, d1, d2, dth, window)
-    lbx_s, ubx_s = _speed_bounds(grid, limits, draw, w2_lo, w2_hi)
+    lbx_s, ubx_s = node_speed_bounds(grid, limits, draw, w2_lo, w2_hi)
     # scales: each node's speed^2 near the speed the slider-acceleration limit allows at constant speed,
     # within the node's bounds; each interval's time accordingly. A draw at 0.001 rpm and a stroke at
     # 30 rpm then both solve with variables of order one.
@@ -197,7 +197,7 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
     )
 
 
-def _speed_bounds(
+def node_speed_bounds(
     grid: BoundGrid, limits: tuple, draw: np.ndarray, w2_lo: float, w2_hi: float
 ) -> tuple[np.ndarray, np.ndarray]:
     """The bounds on the speed squared at the nodes: every limit's, the draw's range on the draw's nodes.

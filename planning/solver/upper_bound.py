@@ -48,7 +48,7 @@ import numpy as np
 from planning.model.case import RPM, Case
 from planning.model.limits import limits_of
 from planning.model.limits.base import BoundGrid, RelaxedGrid
-from planning.solver.bound import BOUND_OPTIONS, _speed_bounds, angle_grid
+from planning.solver.bound import BOUND_OPTIONS, angle_grid, node_speed_bounds
 from planning.solver.ipopt import NLPSolver
 from planning.solver.outcomes import NoPlanFound
 from planning.solver.precheck import precheck
@@ -136,13 +136,15 @@ def upper_bound(case: Case, points: int = UPPER_POINTS, pieces: int = UPPER_PIEC
     limits = limits_of(case)
     draw = np.flatnonzero((th[:-1] >= th2 - 1e-12) & (th[:-1] <= th3 + 1e-12))
     window = th[:-1] >= th4 - 1e-12
-    lbx_s, ubx_s = _speed_bounds(BoundGrid(case, th, h, d1, d2, dth, window), limits, draw, w2_lo, w2_hi)
+    lbx_s, ubx_s = node_speed_bounds(BoundGrid(case, th, h, d1, d2, dth, window), limits, draw, w2_lo, w2_hi)
 
     cell, a, b, dead = _pieces(th, d1, pieces)
     h_a, d1_a = m.jets(a)[:2]
     h_b, d1_b = m.jets(b)[:2]
     slope2_min = np.where(dead, 0.0, np.minimum(d1_a**2, d1_b**2))
-    grid = RelaxedGrid(case, th, h, d1, d2, dth, window, cell, a, b, h_a, h_b, slope2_min)
+    grid = RelaxedGrid(
+        case, th, h, d1, d2, dth, window, cell=cell, a=a, b=b, h_a=h_a, h_b=h_b, slope2_min=slope2_min
+    )
 
     w_acc2 = case.limits.slider_accel_mm_s2 / m.peak_curvature  # scales, as the grid bound's
     s_unit = np.clip(np.full(n, w_acc2), lbx_s, ubx_s)
@@ -153,7 +155,7 @@ def upper_bound(case: Case, points: int = UPPER_POINTS, pieces: int = UPPER_PIEC
     tau_piece = ca.DM(tau_unit) * x_tau
     grid.s = s
     grid.s_next = ca.vertcat(s[1:], s[0])
-    grid.mean_alpha = (grid.s_next - grid.s) / (2 * dth)
+    grid.alpha = (grid.s_next - grid.s) / (2 * dth)  # each interval's mean acceleration over angle
     # each interval's time: the sum of its pieces' (a sparse 0/1 matrix)
     to_cell = ca.DM(ca.Sparsity.triplet(n, cell.size, cell.tolist(), list(range(cell.size))), 1.0)
     grid.tau = ca.mtimes(to_cell, tau_piece)

@@ -201,34 +201,20 @@ class BoundGrid:
 
 
 @dataclass
-class RelaxedGrid:
-    """The certified upper bound's grid (``planning.solver.upper_bound``): nodes as :class:`BoundGrid`
-    (``theta``, ``h``, ``d1``, ``d2``, ``dtheta``, ``window``), on which ``h`` is monotone and ``d1^2``
-    monotone over every interval; each interval cut into pieces: ``cell`` (the interval of each piece),
-    ``a``, ``b`` [rad] (its ends), ``h_a``, ``h_b`` [mm] (heights there), ``slope2_min`` [mm^2/rad^2] (the
-    least ``d1^2`` over the piece). Symbols: ``s`` / ``s_next`` (crank speed squared [rad^2/s^2] at each
-    interval's start / end node, the values of any motion there), ``mean_alpha`` (each interval's mean
-    crank acceleration over angle [rad/s^2]), ``tau`` / ``tau_next`` (each interval's time [s]), and per
-    piece ``s_a`` / ``s_b`` (``s`` at its interval's start / end node)."""
+class RelaxedGrid(BoundGrid):
+    """The certified upper bound's grid (``planning.solver.upper_bound``): the nodes and symbols of
+    :class:`BoundGrid` (``alpha``: each interval's mean crank acceleration over angle, whatever the motion
+    does within it), on nodes where ``h`` is monotone and ``d1^2`` monotone over every interval; each
+    interval cut into pieces: ``cell`` (the interval of each piece), ``a``, ``b`` [rad] (its ends), ``h_a``,
+    ``h_b`` [mm] (heights there), ``slope2_min`` [mm^2/rad^2] (the least ``d1^2`` over the piece); per piece
+    the symbols ``s_a`` / ``s_b`` (``s`` at its interval's start / end node)."""
 
-    case: Any
-    theta: np.ndarray
-    h: np.ndarray
-    d1: np.ndarray
-    d2: np.ndarray
-    dtheta: np.ndarray
-    window: np.ndarray
-    cell: np.ndarray
-    a: np.ndarray
-    b: np.ndarray
-    h_a: np.ndarray
-    h_b: np.ndarray
-    slope2_min: np.ndarray
-    s: Any = None
-    s_next: Any = None
-    mean_alpha: Any = None
-    tau: Any = None
-    tau_next: Any = None
+    cell: np.ndarray = field(kw_only=True)
+    a: np.ndarray = field(kw_only=True)
+    b: np.ndarray = field(kw_only=True)
+    h_a: np.ndarray = field(kw_only=True)
+    h_b: np.ndarray = field(kw_only=True)
+    slope2_min: np.ndarray = field(kw_only=True)
     s_a: Any = None
     s_b: Any = None
 

@@ -54,10 +54,9 @@ class CrankAccelLimit(Limit):
         return [(grid.alpha, -limit * np.ones(n), limit * np.ones(n))]
 
     def relaxed_rows(self, grid: RelaxedGrid) -> list[tuple[Any, Any, Any]]:
-        """Each interval's mean acceleration over angle lies within the limit as every value does."""
-        limit = grid.case.limits.crank_accel_rad_s2
-        n = grid.dtheta.size
-        return [(grid.mean_alpha, -limit * np.ones(n), limit * np.ones(n))]
+        """Each interval's mean acceleration over angle lies within the limit as every value does: the grid
+        bound's rows on the means."""
+        return self.bound_rows(grid)
 
     def relaxed_envelopes(self, grid: RelaxedGrid) -> list[tuple[Any, np.ndarray]]:
         """``ds/dtheta = 2 alpha``: over a piece [a, b] of interval i, ``s <= s_i + 2 A_c (b - theta_i)`` and

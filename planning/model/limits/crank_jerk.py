@@ -63,24 +63,23 @@ class CrankJerkLimit(Limit):
         return [Check.of(self.id, self.name, peak, limit, self.unit, "max", REL_TOL * limit)]
 
     def bound_rows(self, grid: BoundGrid) -> list[tuple[Any, Any, Any]]:
-        J = grid.case.limits.crank_jerk_rad_s3
-        alpha_next = sample_vector([grid.alpha[1:], grid.alpha[0]])
-        room = J * (grid.tau + grid.tau_next) / 2
-        n = grid.dtheta.size
-        return [
-            (alpha_next - grid.alpha - room, np.full(n, -np.inf), np.zeros(n)),
-            (alpha_next - grid.alpha + room, np.zeros(n), np.full(n, np.inf)),
-        ]
+        """Neighbouring intervals' accelerations differ by at most J times half their joint time."""
+        return _jerk_rows(grid, 0.5)
 
     def relaxed_rows(self, grid: RelaxedGrid) -> list[tuple[Any, Any, Any]]:
         """The mean accelerations of two neighbouring intervals are values the acceleration takes within
         their joint time, so they differ by at most ``J (tau_i + tau_(i+1))`` (the grid bound's half is an
         estimate, not a bound)."""
-        J = grid.case.limits.crank_jerk_rad_s3
-        alpha_next = sample_vector([grid.mean_alpha[1:], grid.mean_alpha[0]])
-        room = J * (grid.tau + grid.tau_next)
-        n = grid.dtheta.size
-        return [
-            (alpha_next - grid.mean_alpha - room, np.full(n, -np.inf), np.zeros(n)),
-            (alpha_next - grid.mean_alpha + room, np.zeros(n), np.full(n, np.inf)),
-        ]
+        return _jerk_rows(grid, 1.0)
+
+
+def _jerk_rows(grid: BoundGrid, share: float) -> list[tuple[Any, Any, Any]]:
+    """``|alpha_(i+1) - alpha_i| <= J share (tau_i + tau_(i+1))`` over every pair of neighbouring intervals."""
+    J = grid.case.limits.crank_jerk_rad_s3
+    alpha_next = sample_vector([grid.alpha[1:], grid.alpha[0]])
+    room = J * share * (grid.tau + grid.tau_next)
+    n = grid.dtheta.size
+    return [
+        (alpha_next - grid.alpha - room, np.full(n, -np.inf), np.zeros(n)),
+        (alpha_next - grid.alpha + room, np.zeros(n), np.full(n, np.inf)),
+    ]

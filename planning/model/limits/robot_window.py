@@ -69,7 +69,7 @@ class TransferTimeLimit(Limit):
 
     def relaxed_rows(self, grid: RelaxedGrid) -> list[tuple[Any, Any, Any]]:
         """The window's intervals' times add up as in the grid bound (each at least the motion's)."""
-        return self.bound_rows(grid)  # type: ignore[arg-type] - the same fields
+        return self.bound_rows(grid)
 
 
 class SafetyHeightLimit(Limit):

@@ -46,13 +46,7 @@ function buildForm(data) {
     fs.innerHTML = `<legend>${SECTION_TITLES[section] || section}</legend>`;
     for (const spec of fields) fs.appendChild(spec.kind === "table" ? forceTable(spec, getPath(data, spec.name)) : fieldRow(spec, getPath(data, spec.name)));
     if (section === "drive") {
-      const remove = document.createElement("button");
-      remove.type = "button";
-      remove.id = "remove-drive";
-      remove.textContent = "remove the drive";
-      remove.title = "plan the motion alone (no motor limits, no torque or energy)";
-      remove.addEventListener("click", removeDrive);
-      fs.appendChild(remove);
+      fs.appendChild(button({ id: "remove-drive" }, "remove the drive", "plan the motion alone (no motor limits, no torque or energy)", removeDrive));
     }
     form.appendChild(fs);
   }
@@ -62,6 +56,13 @@ function buildForm(data) {
   form.appendChild(general);
 }
 
+// a button of the form: ``props`` (id or className), its text, its tooltip, what a click does
+function button(props, text, title, onClick) {
+  const b = Object.assign(document.createElement("button"), { type: "button", textContent: text, title, ...props });
+  b.addEventListener("click", onClick);
+  return b;
+}
+
 // a drive added in the page: the drive of `pressplan new`'s template press of this mechanism (and its
 // forming force, when the case has none), to be replaced by the press's own figures
 function addDriveBox() {
@@ -69,13 +70,7 @@ function addDriveBox() {
   fs.dataset.section = "drive";
   fs.innerHTML = `<legend>drive</legend><p class="help-text">No drive: the plan keeps the motion's limits only. ` +
     `A drive adds the motor's torque, RMS and speed limits, the energy, and the objectives at the line's rate.</p>`;
-  const add = document.createElement("button");
-  add.type = "button";
-  add.id = "add-drive";
-  add.textContent = "add a drive";
-  add.title = "starts from the drive of a template press of this mechanism (pressplan new --drive): enter your press's figures";
-  add.addEventListener("click", addDrive);
-  fs.appendChild(add);
+  fs.appendChild(button({ id: "add-drive" }, "add a drive", "starts from the drive of a template press of this mechanism (pressplan new --drive): enter your press's figures", addDrive));
   return fs;
 }
 
@@ -127,12 +122,7 @@ function forceTable(spec, value) {
       td.appendChild(cell);
       tr.appendChild(td);
     }
-    const drop = document.createElement("button");
-    drop.type = "button";
-    drop.className = "drop-row";
-    drop.textContent = "×";
-    drop.title = "remove this row";
-    drop.addEventListener("click", () => { tr.remove(); onEdit(); });
+    const drop = button({ className: "drop-row" }, "×", "remove this row", () => { tr.remove(); onEdit(); });
     const td = document.createElement("td");
     td.appendChild(drop);
     tr.appendChild(td);
@@ -140,12 +130,7 @@ function forceTable(spec, value) {
   };
   for (const pair of value || []) addRow(pair);
   row.appendChild(table);
-  const more = document.createElement("button");
-  more.type = "button";
-  more.className = "add-row";
-  more.textContent = "add a row";
-  more.addEventListener("click", () => { addRow(null); body.lastChild.querySelector("input").focus(); });
-  row.appendChild(more);
+  row.appendChild(button({ className: "add-row" }, "add a row", "", () => { addRow(null); body.lastChild.querySelector("input").focus(); }));
   const msg = document.createElement("span");
   msg.className = "msg";
   msg.dataset.for = spec.name;
