@@ -239,6 +239,11 @@ class MotorModel(_Model):
         title="base speed [rpm]", description="Up to this motor speed the peak torque is available."
     )
     max_speed_rpm: MotorSpeed = Field(title="top speed [rpm]", description="The motor's highest speed.")
+    copper_loss_at_rated_kW: Annotated[float, Field(ge=0, le=1e5)] = Field(
+        0.0,
+        title="copper loss at the rated torque [kW]",
+        description="All motors together; the loss grows with the torque squared (P_cu = this x (T / rated)²).",
+    )
 
 
 class LinkMassModel(_Model):
@@ -250,6 +255,31 @@ class LinkMassModel(_Model):
     cg_along_mm: Coordinate = 0.0
     cg_across_mm: Coordinate = 0.0
     inertia_kg_m2: Inertia = 0.0
+
+
+class StorageModel(_Model):
+    """Energy storage on the DC bus (capacitors or a flywheel): ``usable_energy_kJ`` between its voltage (or
+    speed) limits, ``efficiency`` per direction, optionally ``max_power_kW`` in either direction."""
+
+    usable_energy_kJ: Annotated[float, Field(ge=0, le=1e7)] = Field(
+        title="usable energy [kJ]", description="The energy the storage holds between its lower and upper limits."
+    )
+    efficiency: Annotated[float, Field(gt=0, le=1)] = Field(
+        1.0,
+        title="storage efficiency",
+        description="Per direction: charging stores this share of the power in, discharging takes power out / it.",
+    )
+    max_power_kW: Annotated[float, Field(gt=0, le=1e6)] | None = Field(
+        None, title="storage power limit [kW]", description="The most the storage takes or gives; empty: no limit."
+    )
+
+
+class GridModel(_Model):
+    """The plant's connection: ``peak_power_kW`` the most the press may draw from the grid."""
+
+    peak_power_kW: Annotated[float, Field(gt=0, le=1e6)] | None = Field(
+        None, title="grid peak power [kW]", description="The most the press may draw from the plant; empty: no limit."
+    )
 
 
 class DriveSection(_Model):
@@ -295,6 +325,22 @@ class DriveSection(_Model):
         title="regeneration efficiency",
         description="Share of the braking energy the supply takes back: 0 a braking resistor, 1 a perfect store.",
     )
+    converter_efficiency: Annotated[float, Field(gt=0, le=1)] = Field(
+        1.0,
+        title="converter efficiency",
+        description="Between the DC bus and the motors, in both directions (0 ... 1].",
+    )
+    storage: StorageModel | None = Field(None, title="DC-bus storage", description="Capacitors or a flywheel.")
+    grid: GridModel | None = Field(None, title="grid", description="The plant's connection.")
+
+    @property
+    def electrical(self) -> bool:
+        """The case states the drive's electrical side (losses, converter, storage or grid): the outputs then
+        carry the power chain from the motors to the grid."""
+        return bool(
+            {"converter_efficiency", "storage", "grid"} & self.model_fields_set
+            or "copper_loss_at_rated_kW" in self.motor.model_fields_set
+        )
 
 
 class PlannerModel(_Model):

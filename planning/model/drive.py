@@ -15,7 +15,8 @@ changes sign; there the quadrature is accurate to the piece length squared.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -49,9 +50,47 @@ class DriveFigures:
     crank_work_abs_kJ: float  # integral of |T_c omega|: the scale of the energy balance
     peak_torque_use_pct: float  # largest |T_m| / envelope at that speed
     rms_torque_use_pct: float  # RMS / rated
+    power: PowerFigures | None = field(default=None, compare=False)  # the chain to the grid (drive.electrical)
 
     def as_dict(self) -> dict[str, float]:
-        return dict(self.__dict__)
+        """The figures as ``result.json``'s ``drive`` block writes them (the power chain apart)."""
+        return {k: v for k, v in self.__dict__.items() if k != "power"}
+
+
+@dataclass(frozen=True)
+class PowerFigures:
+    """One cycle of the power chain from the motors to the grid (``press.power``; computed by
+    ``planning.solver.grid``): energies per stroke [kJ], powers [kW], the storage's state [kJ]. Over the
+    cycle ``grid_energy = forming work + gear + copper + converter + storage + resistor losses +
+    storage_change`` (the storage's schedule is periodic: its change is zero to the programme's tolerance)."""
+
+    copper_loss_kJ: float
+    converter_loss_kJ: float
+    gear_loss_kJ: float
+    storage_loss_kJ: float
+    resistor_loss_kJ: float
+    storage_change_kJ: float  # stored energy at the cycle's end minus at its start
+    bus_energy_kJ: float
+    grid_energy_kJ: float
+    grid_energy_kWh_per_1000_strokes: float
+    mean_bus_power_kW: float
+    mean_grid_power_kW: float
+    bus_peak_kW: float  # the grid's peak without storage
+    grid_peak_kW: float  # with the case's storage and its schedule (dense)
+    grid_peak_angle_deg: float
+    grid_peak_sampled_kW: float  # the peak-shaving programme's, on its samples
+    storage_usable_kJ: float
+    storage_swing_kJ: float
+    storage_start_kJ: float
+    storage_min_kJ: float
+    storage_max_kJ: float
+    storage_peak_power_kW: float
+    grid_limit_kW: float | None
+    schedule: Any = field(default=None, compare=False, repr=False)  # planning.solver.grid.Schedule
+
+    def as_dict(self) -> dict[str, Any]:
+        """The figures as ``result.json``'s ``power`` block writes them (the schedule apart)."""
+        return {k: v for k, v in self.__dict__.items() if k != "schedule"}
 
 
 def _breakpoints(profile: Profile, case: Case) -> np.ndarray:
@@ -74,9 +113,13 @@ def _breakpoints(profile: Profile, case: Case) -> np.ndarray:
     return np.unique(np.clip(np.asarray(times, dtype=float), profile.t0, profile.t0 + profile.duration))
 
 
-def quadrature(profile: Profile, case: Case) -> tuple[np.ndarray, np.ndarray]:
-    """Nodes [s] and weights [s] of the cycle's quadrature (see the module docstring)."""
+def quadrature(profile: Profile, case: Case, extra_edges: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes [s] and weights [s] of the cycle's quadrature (see the module docstring); ``extra_edges`` [s]:
+    more breakpoints (the storage schedule's, where its power jumps)."""
     edges = _breakpoints(profile, case)
+    if extra_edges is not None:
+        edges = np.unique(np.concatenate([edges, np.clip(extra_edges, profile.t0, profile.t0 + profile.duration)]))
+        edges = edges[np.concatenate([[True], np.diff(edges) > 1e-12])]
     span = np.diff(edges)
     step = max(MAX_PIECE_S, profile.duration / MAX_PIECES)
     counts = np.maximum(MIN_PIECES, np.ceil(span / step).astype(int))

@@ -17,6 +17,7 @@ from planning.model.laws.improved_scurve import ImprovedSCurve
 from planning.model.limits.slider_accel import SliderAccelLimit
 from planning.model.profile import MAX_STEP_S, Profile
 from planning.reports.stages import stage_table
+from planning.solver.grid import Schedule, power_columns, schedule_of
 from planning.solver.solution import Solution
 from press.dynamics import drive_state
 from press.mechanism import Mechanism
@@ -32,16 +33,22 @@ TRAJECTORY_COLUMNS = (
     "slider_accel_mm_s2",
 )
 DRIVE_COLUMNS = ("crank_torque_Nm", "motor_speed_rpm", "motor_torque_Nm", "motor_power_kW")  # with a drive
+POWER_COLUMNS = ("copper_loss_kW", "bus_power_kW", "grid_power_kW", "storage_energy_kJ")  # drive.electrical
 MAX_ROWS = 200_000  # trajectory rows at most: a cycle longer than 200 s gets a step of period / MAX_ROWS
 
 
 def sample_profile(
-    profile: Profile, machine: Mechanism, max_step: float = MAX_STEP_S, case: Case | None = None
+    profile: Profile,
+    machine: Mechanism,
+    max_step: float = MAX_STEP_S,
+    case: Case | None = None,
+    schedule: Schedule | None = None,
 ) -> np.ndarray:
     """``profile`` over its whole duration on a uniform time grid with step <= ``max_step`` [s] (at most
     :data:`MAX_ROWS` + 1 rows: a coarser uniform step for a long cycle); columns as
-    :data:`TRAJECTORY_COLUMNS`, then :data:`DRIVE_COLUMNS` when ``case`` has a drive; the first and last
-    rows are the profile's ends."""
+    :data:`TRAJECTORY_COLUMNS`, then :data:`DRIVE_COLUMNS` when ``case`` has a drive and
+    :data:`POWER_COLUMNS` when it states the drive's electrical side (the storage's ``schedule``, computed
+    here when not given: ``planning.solver.grid``); the first and last rows are the profile's ends."""
     n = min(int(math.ceil(profile.duration / max_step)), MAX_ROWS)
     t = np.linspace(0.0, profile.duration, n + 1)
     th, om, al, je = profile.at_time(profile.t0 + t)
@@ -50,19 +57,27 @@ def sample_profile(
     if case is not None and case.drive is not None:
         s = drive_state(th, om, al, case.machine, case.drive_model)
         columns += [s["crank_torque_Nm"], s["motor_speed_rad_s"] / RPM, s["motor_torque_Nm"], s["motor_power_W"] / 1e3]
+        if case.drive.electrical:
+            schedule = schedule if schedule is not None else schedule_of(profile, case)
+            c = power_columns(schedule, s, t, case)
+            columns += [c["copper_loss_W"] / 1e3, c["bus_power_W"] / 1e3, c["grid_power_W"] / 1e3]
+            columns.append(c["storage_energy_J"] / 1e3)
     return np.column_stack(columns)
 
 
 def trajectory_columns(case: Case) -> tuple[str, ...]:
     """The columns of ``trajectory.csv`` for ``case``."""
-    return TRAJECTORY_COLUMNS + (DRIVE_COLUMNS if case.drive is not None else ())
+    if case.drive is None:
+        return TRAJECTORY_COLUMNS
+    return TRAJECTORY_COLUMNS + DRIVE_COLUMNS + (POWER_COLUMNS if case.drive.electrical else ())
 
 
 def trajectory(solution: Solution, case: Case, max_step: float = MAX_STEP_S) -> dict[str, np.ndarray]:
     """One full cycle of the plan from TDC (see :func:`sample_profile`), one array per column of
     ``trajectory.csv`` (:func:`trajectory_columns`: ``time_s``, ``crank_angle_deg``, ...,
     ``slider_accel_mm_s2``, and the drive's with a drive); the first and last samples are one period apart."""
-    table = sample_profile(solution.plan.profile, case.machine, max_step, case)
+    power = solution.drive.power if solution.drive is not None else None
+    table = sample_profile(solution.plan.profile, case.machine, max_step, case, power and power.schedule)
     return dict(zip(trajectory_columns(case), table.T, strict=True))
 
 
@@ -151,6 +166,7 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
         "segments": segments(solution),
         "paper_solution": plan.paper_solution() if plan.motion_law == ImprovedSCurve.name else None,
         **({"drive": drive_block(solution, case)} if case.drive is not None else {}),
+        **({"power": solution.drive.power.as_dict()} if solution.drive and solution.drive.power else {}),
         **objective_block(solution, case),
         "verification": {
             "passed": ver.passed,
@@ -252,6 +268,24 @@ def summary_text(result: dict[str, Any]) -> str:
             f"  energy per stroke: drawn {d['energy_drawn_kJ']:.1f} kJ, returned {d['energy_returned_kJ']:.1f} kJ, "
             f"net {d['energy_net_kJ']:.1f} kJ; forming work {d['forming_work_kJ']:.1f} kJ "
             f"(crank work {d['crank_work_kJ']:.1f} kJ)",
+        ]
+    if "power" in r:
+        p = r["power"]
+        shaved = (
+            f", with the storage {p['grid_peak_kW']:.0f} kW (it swings {p['storage_swing_kJ']:.1f} of "
+            f"{p['storage_usable_kJ']:.1f} kJ)"
+            if p["storage_usable_kJ"] > 0
+            else ""
+        )
+        limit = f"; grid limit {p['grid_limit_kW']:g} kW" if p["grid_limit_kW"] is not None else ""
+        lines += [
+            f"  grid: {p['grid_energy_kJ']:.1f} kJ per stroke ({p['grid_energy_kWh_per_1000_strokes']:.1f} kWh per "
+            f"1000 strokes), mean {p['mean_grid_power_kW']:.0f} kW; peak without storage {p['bus_peak_kW']:.0f} kW"
+            + shaved
+            + limit,
+            f"  losses per stroke: copper {p['copper_loss_kJ']:.1f}, converter {p['converter_loss_kJ']:.1f}, gear "
+            f"{p['gear_loss_kJ']:.1f}, storage {p['storage_loss_kJ']:.1f}, braking resistor "
+            f"{p['resistor_loss_kJ']:.1f} kJ",
         ]
     if r.get("baseline"):
         b, saving, d = r["baseline"], r["saving_pct"], r["drive"]

@@ -12,16 +12,17 @@ from __future__ import annotations
 
 import enum
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from planning.model.case import RPM, Case
-from planning.model.drive import DriveFigures, cycle_integrals, drive_figures
+from planning.model.drive import DriveFigures, PowerFigures, cycle_integrals, drive_figures
 from planning.model.limits import field_of, limits_of
 from planning.model.limits.base import BINDING_SHARE, Check, Dense
 from planning.model.plan import Plan
 from planning.model.profile import dense_times, max_abs_jerk
+from planning.solver.grid import power_figures
 from press.dynamics import drive_state
 
 ANGLE_TOL = 1e-6  # [rad] key angles and cycle closure
@@ -44,8 +45,14 @@ class CheckId(str, enum.Enum):
     KEY_ANGLES = "key_angles"
     DRAW_CONSTANT = "draw_constant_speed"
     ENERGY_BALANCE = "energy_balance"
+    GRID_BALANCE = "grid_energy_balance"
+    STORAGE_EMPTY = "storage_above_empty"
+    STORAGE_FULL = "storage_below_full"
+    STORAGE_CLOSES = "storage_closes"
 
 
+SCHEDULE_CHECKS = frozenset({CheckId.STORAGE_EMPTY, CheckId.STORAGE_FULL})  # the storage schedule's own bounds:
+# at them the storage is used to the full, which binds no limit of the plan (not in the binding list)
 CYCLE_FIELDS = {CheckId.KEY_ANGLES: "key_points"}  # the case field behind a cycle check, where one is
 
 
@@ -70,8 +77,8 @@ class Verification:
         return [c for c in self.checks if not c.passed]
 
     def binding(self) -> list[Check]:
-        """The checks at their limits (:attr:`Check.binds`)."""
-        return [c for c in self.checks if c.binds]
+        """The checks at their limits (:attr:`Check.binds`), the storage schedule's bounds apart."""
+        return [c for c in self.checks if c.binds and c.id not in SCHEDULE_CHECKS]
 
     def check(self, check_id: str) -> Check | None:
         """The check with id ``check_id`` (a limit's id or a :class:`CheckId`), None when the plan has none."""
@@ -94,16 +101,51 @@ def assess(plan: Plan, case: Case) -> tuple[Verification, DriveFigures | None]:
     if case.drive is not None:
         dense.drive_state = drive_state(th, om, al, case.machine, case.drive_model)
         dense.integrals = cycle_integrals(prof, case)
+        if case.drive.electrical:
+            dense.power = power_figures(prof, case, t, dense.drive_state)
     checks = _cycle_checks(dense)
     for limit in limits_of(case):
         checks += limit.check(dense)
     if case.drive is not None:
         checks.append(_energy_balance(dense.integrals))
+    if dense.power is not None:
+        checks += _power_checks(dense.power, dense.integrals)
     verification = Verification(tuple(checks), float(np.max(np.diff(t))), int(t.size))
     figures = None
     if case.drive is not None:
         figures = drive_figures(prof, case, dense.integrals, (th, dense.drive_state))
+        figures = replace(figures, power=dense.power)
     return verification, figures
+
+
+def _power_checks(power: PowerFigures, integrals: dict) -> list[Check]:
+    """The power chain over the cycle: the grid's energy is the forming work and every loss (the kinetic
+    energies return to their start), and the storage stays within its usable energy and ends where it
+    started."""
+    losses = (
+        power.gear_loss_kJ
+        + power.copper_loss_kJ
+        + power.converter_loss_kJ
+        + power.storage_loss_kJ
+        + power.resistor_loss_kJ
+    )
+    scale = max(abs(integrals["forming_work_kJ"]), integrals["crank_work_abs_kJ"], abs(power.grid_energy_kJ))
+    usable = power.storage_usable_kJ
+    room = ENERGY_REL_TOL * max(usable, scale)
+    return [
+        Check.of(
+            CheckId.GRID_BALANCE,
+            "energy balance: grid = forming work + losses + storage change",
+            power.grid_energy_kJ,
+            integrals["forming_work_kJ"] + losses + power.storage_change_kJ,
+            "kJ",
+            "equal",
+            ENERGY_REL_TOL * scale,
+        ),
+        Check.of(CheckId.STORAGE_EMPTY, "storage above empty", power.storage_min_kJ, 0.0, "kJ", "min", room),
+        Check.of(CheckId.STORAGE_FULL, "storage below full", power.storage_max_kJ, usable, "kJ", "max", room),
+        Check.of(CheckId.STORAGE_CLOSES, "storage closes", power.storage_change_kJ, 0.0, "kJ", "equal", room),
+    ]
 
 
 def _cycle_checks(d: Dense) -> list[Check]:

@@ -459,7 +459,8 @@ def solve_case(data: Any, label: str, session: Session, confirm: bool = True) ->
             session.shown = (case_key(data), case, solution)
     result = result_dict(solution, case)
     plan = solution.plan
-    table = sample_profile(plan.profile, case.machine, plan.period / CHART_POINTS, case)
+    power = solution.drive.power if solution.drive is not None else None
+    table = sample_profile(plan.profile, case.machine, plan.period / CHART_POINTS, case, power and power.schedule)
     columns = dict(zip(trajectory_columns(case), table.T, strict=True))
     curves = {name: _rounded(col) for name, col in columns.items()}
     return {

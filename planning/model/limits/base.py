@@ -160,7 +160,7 @@ class Dense:
     ``theta``, ``omega``, ``alpha``, ``jerk``, the slide's ``h``, ``v``, ``a`` there; the key points'
     times ``key_times`` [s]; the ``plan`` and the ``case``; with a drive, the drive's state on the grid
     (``drive_state``, ``press.dynamics.drive_state``) and the cycle's integrals (``integrals``,
-    ``planning.model.drive.cycle_integrals``)."""
+    ``planning.model.drive.cycle_integrals``); with the drive's electrical side, its power chain (``power``)."""
 
     case: Any
     plan: Any
@@ -175,6 +175,7 @@ class Dense:
     key_times: np.ndarray
     drive_state: dict | None = None
     integrals: dict | None = None
+    power: Any = None  # the power chain to the grid (planning.model.drive.PowerFigures), drive.electrical
 
 
 @dataclass

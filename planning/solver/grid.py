@@ -1,0 +1,267 @@
+"""From the motor to the grid: the power chain of a planned cycle, and the storage schedule that shaves the
+grid's peak (the model and its signs: ``press.power``; the README's "From the motor to the grid").
+
+**Peak shaving.** The cycle is cut into ``N`` equal intervals (edges ``t_0 = 0 .. t_N = T``, at most
+:data:`SHAVING_STEP_S` long, :data:`SHAVING_MIN_INTERVALS` .. :data:`SHAVING_MAX_INTERVALS` of them); the storage
+takes ``c_k`` from the bus or gives it ``d_k`` on interval ``k`` (constant there). The linear programme
+
+    min z   s.t.  z >= P_bus(t_k) + c_k - d_k,  z >= P_bus(t_k+1) + c_k - d_k          (the grid at both ends)
+                  E_k+1 = E_k + (eta_s c_k - d_k / eta_s) (t_k+1 - t_k),  E_N = E_0     (periodic)
+                  0 <= E_k <= usable,  0 <= c_k, d_k <= max power
+
+gives the lowest grid peak any schedule of the storage reaches on those samples (a periodic cycle: the storage
+starts where it ends, the start free). Among the schedules with that peak (within :data:`PEAK_SLACK`), a second
+programme takes the one that draws the least energy from the grid (``r x + (1 - r) max(x, 0)``, the interval's
+mean ``x``), so that the storage does not cycle for nothing. Both are solved by HiGHS through CasADi
+(``casadi.conic``). Without storage the schedule is zero and the grid sees the bus.
+
+**Energies per stroke** integrate the chain by the drive's Gauss-Legendre quadrature
+(``planning.model.drive.quadrature``) with the schedule's edges among its breakpoints (the storage's power jumps
+there); the storage's own terms are exact sums over the intervals. Over a cycle
+``grid energy = forming work + gear + copper + converter + storage + resistor losses + storage change`` (the kinetic
+energies return to their start; the verification checks it). Peaks are taken on the verification's dense grid and
+on the edges together.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from planning.model.case import Case
+from planning.model.drive import PowerFigures, quadrature
+from planning.model.profile import Profile
+from press.dynamics import drive_state
+from press.power import (
+    bus_power,
+    copper_loss,
+    electrical_power,
+    grid_power,
+    resistor_power,
+    storage_loss,
+    storage_rate,
+)
+
+SHAVING_STEP_S = 5e-3  # [s] the peak-shaving intervals are at most this long ...
+SHAVING_MIN_INTERVALS = 400  # ... and at least this many ...
+SHAVING_MAX_INTERVALS = 4000  # ... and at most this many per cycle
+PEAK_SLACK = 1e-9  # relative: the second programme keeps the grid peak within this share of the first's
+SCALE_W = 1e3  # the programmes in kW and kJ (HiGHS's tolerances are absolute)
+_HIGHS = {"highs": {"output_flag": False, "log_to_console": False}}
+
+
+@dataclass(frozen=True)
+class Storage:
+    """A DC-bus storage in inside units: ``usable`` [J], ``efficiency`` per direction, ``max_power`` [W]
+    (``inf``: none)."""
+
+    usable: float
+    efficiency: float
+    max_power: float = math.inf
+
+    @classmethod
+    def of(cls, case: Case) -> Storage | None:
+        s = case.drive.storage
+        if s is None:
+            return None
+        top = math.inf if s.max_power_kW is None else s.max_power_kW * 1e3
+        return cls(s.usable_energy_kJ * 1e3, s.efficiency, top)
+
+
+@dataclass(frozen=True)
+class Schedule:
+    """The storage's schedule on intervals between ``edges`` [s] (from the cycle's start): it takes
+    ``charge`` [W] from the bus and gives ``discharge`` [W] on each; ``energy`` [J] at the edges;
+    ``peak`` [W] the programme's grid peak on the edges."""
+
+    edges: np.ndarray
+    charge: np.ndarray
+    discharge: np.ndarray
+    energy: np.ndarray
+    peak: float
+
+    def interval(self, t: np.ndarray) -> np.ndarray:
+        """The interval of each time ``t`` [s] (an edge belongs to the interval it starts)."""
+        return np.clip(np.searchsorted(self.edges, t, side="right") - 1, 0, self.charge.size - 1)
+
+    def offset(self, t: np.ndarray) -> np.ndarray:
+        """The storage's draw on the bus at ``t`` [W]: charging minus discharging."""
+        k = self.interval(t)
+        return self.charge[k] - self.discharge[k]
+
+    def energy_at(self, t: np.ndarray) -> np.ndarray:
+        """The stored energy at ``t`` [J] (linear on each interval)."""
+        return np.interp(t, self.edges, self.energy)
+
+
+def shaving_edges(period: float) -> np.ndarray:
+    """The peak-shaving intervals' edges over a cycle of ``period`` [s] (module docstring)."""
+    n = int(np.clip(math.ceil(period / SHAVING_STEP_S), SHAVING_MIN_INTERVALS, SHAVING_MAX_INTERVALS))
+    return np.linspace(0.0, period, n + 1)
+
+
+def shave(edges: np.ndarray, bus_W: np.ndarray, storage: Storage, regen_efficiency: float) -> Schedule:
+    """The storage schedule with the lowest grid peak on the samples ``bus_W`` [W] at ``edges`` [s], then the
+    least grid energy (module docstring)."""
+    n = edges.size - 1
+    dt = np.diff(edges)
+    p = np.asarray(bus_W, dtype=float) / SCALE_W
+    eta, r = storage.efficiency, regen_efficiency
+    usable = storage.usable / SCALE_W
+    top = storage.max_power / SCALE_W if math.isfinite(storage.max_power) else ca.inf
+    # variables: z, c (n), d (n), E (n; E_n = E_0), w (n; w >= 0, w >= the interval's mean net power)
+    iz, ic, id_, ie, iw = 0, 1, 1 + n, 1 + 2 * n, 1 + 3 * n
+    nv = 1 + 4 * n
+    k = np.arange(n)
+    rows, cols, vals, lo, hi = [], [], [], [], []
+
+    def block(start: int, entries: list[tuple[np.ndarray, float | np.ndarray]], low: np.ndarray, high: np.ndarray):
+        for col, val in entries:
+            rows.append(start + k)
+            cols.append(col)
+            vals.append(np.broadcast_to(val, (n,)).astype(float))
+        lo.append(low)
+        hi.append(high)
+
+    inf = np.full(n, np.inf)
+    block(0, [(np.full(n, iz), 1.0), (ic + k, -1.0), (id_ + k, 1.0)], p[:-1], inf)  # z - c + d >= P(t_k)
+    block(n, [(np.full(n, iz), 1.0), (ic + k, -1.0), (id_ + k, 1.0)], p[1:], inf)  # ... >= P(t_k+1)
+    block(2 * n, [(ie + (k + 1) % n, 1.0), (ie + k, -1.0), (ic + k, -eta * dt), (id_ + k, dt / eta)], 0 * dt, 0 * dt)
+    mean = (p[:-1] + p[1:]) / 2
+    block(3 * n, [(iw + k, 1.0), (ic + k, -1.0), (id_ + k, 1.0)], mean, inf)  # w - c + d >= mean P
+    A = ca.DM.triplet(
+        np.concatenate(rows).tolist(), np.concatenate(cols).tolist(), ca.DM(np.concatenate(vals)), 4 * n, nv
+    )
+    solver = ca.conic("shaving", "highs", {"a": A.sparsity(), "h": ca.Sparsity(nv, nv)}, _HIGHS)
+    lbx = np.concatenate([[-np.inf], np.zeros(3 * n), np.zeros(n)])
+    ubx = np.concatenate([[np.inf], np.full(2 * n, top if top != ca.inf else np.inf), np.full(n, usable), inf])
+    args = {"a": A, "lba": np.concatenate(lo), "uba": np.concatenate(hi), "lbx": lbx}
+    g = np.zeros(nv)
+    g[iz] = 1.0
+    first = solver(g=g, ubx=ubx, **args)
+    _solved(solver, "peak")
+    peak = float(first["cost"])
+    g = np.zeros(nv)  # the least grid energy at that peak: sum dt (r (w - wbar) + ...) with x = mean + c - d
+    g[ic:id_] = r * dt
+    g[id_:ie] = -r * dt
+    g[iw:] = (1 - r) * dt
+    ubx[iz] = peak + PEAK_SLACK * max(abs(peak), 1.0)
+    second = solver(g=g, ubx=ubx, **args, x0=first["x"])
+    _solved(solver, "grid energy")
+    x = np.asarray(second["x"]).ravel()
+    energy = np.append(x[ie:iw], x[ie]) * SCALE_W
+    return Schedule(edges, x[ic:id_] * SCALE_W, x[id_:ie] * SCALE_W, energy, float(np.max(x[iz])) * SCALE_W)
+
+
+def _solved(solver: ca.Function, what: str) -> None:
+    stats = solver.stats()
+    if not stats.get("success", False):
+        raise ArithmeticError(f"the peak-shaving programme ({what}) failed: {stats.get('return_status')}")
+
+
+def no_schedule(edges: np.ndarray, bus_W: np.ndarray) -> Schedule:
+    """Without storage: nothing taken or given; the grid peak is the bus's."""
+    zero = np.zeros(edges.size - 1)
+    return Schedule(edges, zero, zero, np.zeros(edges.size), float(np.max(bus_W)))
+
+
+def chain(state: dict, case: Case) -> dict[str, np.ndarray]:
+    """The power chain [W] at drive states (``press.dynamics.drive_state``): ``copper_loss_W``,
+    ``electrical_power_W``, ``bus_power_W``."""
+    d = case.drive
+    cu = copper_loss(state["motor_torque_Nm"], d.motor.rated_torque_Nm, d.motor.copper_loss_at_rated_kW * 1e3)
+    el = electrical_power(state["motor_power_W"], cu)
+    return {"copper_loss_W": cu, "electrical_power_W": el, "bus_power_W": bus_power(el, d.converter_efficiency)}
+
+
+def _state(profile: Profile, case: Case, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict]:
+    th, om, al, _ = profile.at_time(profile.t0 + t)
+    s = drive_state(th, om, al, case.machine, case.drive_model)
+    return th, om, al, {**s, **chain(s, case)}
+
+
+def schedule_of(profile: Profile, case: Case) -> Schedule:
+    """The storage schedule of a plan's cycle (``profile`` from TDC): :func:`shave` on the bus power at
+    :func:`shaving_edges`, or :func:`no_schedule` without storage."""
+    edges = shaving_edges(profile.duration)
+    bus = _state(profile, case, edges)[3]["bus_power_W"]
+    storage = Storage.of(case)
+    if storage is None:
+        return no_schedule(edges, bus)
+    return shave(edges, bus, storage, case.drive.regen_efficiency)
+
+
+def power_columns(schedule: Schedule, state: dict, t: np.ndarray, case: Case) -> dict[str, np.ndarray]:
+    """The chain at times ``t`` [s] from the cycle's start with drive states ``state`` there [W, J]:
+    ``copper_loss_W``, ``bus_power_W``, ``grid_power_W``, ``resistor_W``, ``storage_energy_J``."""
+    c = chain(state, case)
+    net = c["bus_power_W"] + schedule.offset(t)
+    r = case.drive.regen_efficiency
+    return {
+        "copper_loss_W": c["copper_loss_W"],
+        "bus_power_W": c["bus_power_W"],
+        "grid_power_W": grid_power(net, r),
+        "resistor_W": resistor_power(net, r),
+        "storage_energy_J": schedule.energy_at(t),
+    }
+
+
+def power_figures(profile: Profile, case: Case, dense_t: np.ndarray, dense_state: dict) -> PowerFigures:
+    """The power chain of a plan's cycle (``profile`` from TDC) per stroke, with the storage's schedule;
+    peaks on the dense grid ``dense_t`` [s from the start] (drive states ``dense_state`` there) and on the
+    schedule's edges."""
+    d = case.drive
+    schedule = schedule_of(profile, case)
+    storage = Storage.of(case)
+    nodes, weights = quadrature(profile, case, extra_edges=profile.t0 + schedule.edges)
+    t = nodes - profile.t0
+    _, om, al, s = _state(profile, case, t)
+    cols = power_columns(schedule, s, t, case)
+    i = case.drive_model.i
+
+    def integral(values: np.ndarray) -> float:
+        return float(np.sum(weights * values)) / 1e3  # [kJ]
+
+    shaft = s["motor_power_W"]
+    crank = s["crank_torque_Nm"] * om
+    motor_kinetic = d.motor_inertia_kg_m2 * i * i * al * om  # d/dt of 1/2 J_m omega_m^2
+    dt = np.diff(schedule.edges)
+    eta_s = storage.efficiency if storage is not None else 1.0
+    stored = storage_rate(schedule.charge, schedule.discharge, eta_s)
+    edge_cols = power_columns(schedule, _state(profile, case, schedule.edges)[3], schedule.edges, case)
+    dense_cols = power_columns(schedule, {**dense_state, **chain(dense_state, case)}, dense_t, case)
+    bus_peak = max(float(np.max(dense_cols["bus_power_W"])), float(np.max(edge_cols["bus_power_W"])))
+    grid = np.concatenate([dense_cols["grid_power_W"], edge_cols["grid_power_W"]])
+    times = np.concatenate([dense_t, schedule.edges])
+    k = int(np.argmax(grid))
+    th_peak = profile.at_time(profile.t0 + np.array([times[k]]))[0][0]
+    grid_energy = integral(cols["grid_power_W"])
+    limit = d.grid.peak_power_kW if d.grid is not None else None
+    return PowerFigures(
+        copper_loss_kJ=integral(cols["copper_loss_W"]),
+        converter_loss_kJ=integral(cols["bus_power_W"] - (shaft + cols["copper_loss_W"])),
+        gear_loss_kJ=integral(shaft - crank - motor_kinetic),
+        storage_loss_kJ=float(np.sum(dt * storage_loss(schedule.charge, schedule.discharge, eta_s))) / 1e3,
+        resistor_loss_kJ=integral(cols["resistor_W"]),
+        storage_change_kJ=float(np.sum(dt * stored)) / 1e3,
+        bus_energy_kJ=integral(cols["bus_power_W"]),
+        grid_energy_kJ=grid_energy,
+        grid_energy_kWh_per_1000_strokes=grid_energy / 3.6,
+        mean_bus_power_kW=integral(cols["bus_power_W"]) / profile.duration,
+        mean_grid_power_kW=grid_energy / profile.duration,
+        bus_peak_kW=bus_peak / 1e3,
+        grid_peak_kW=float(grid[k]) / 1e3,
+        grid_peak_angle_deg=float(math.degrees(th_peak) % 360.0),
+        grid_peak_sampled_kW=schedule.peak / 1e3,
+        storage_usable_kJ=storage.usable / 1e3 if storage is not None else 0.0,
+        storage_swing_kJ=float(np.ptp(schedule.energy)) / 1e3,
+        storage_start_kJ=float(schedule.energy[0]) / 1e3,
+        storage_min_kJ=float(np.min(schedule.energy)) / 1e3,
+        storage_max_kJ=float(np.max(schedule.energy)) / 1e3,
+        storage_peak_power_kW=float(max(np.max(schedule.charge), np.max(schedule.discharge), 0.0)) / 1e3,
+        grid_limit_kW=limit,
+        schedule=schedule,
+    )

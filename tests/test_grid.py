@@ -1,0 +1,253 @@
+"""From the motor to the grid (``press.power``, ``planning.solver.grid``): the energy balance with every loss,
+the peak-shaving programme against an independent LP (SciPy's HiGHS through ``linprog``), its limits (no storage:
+the bus's peak; unbounded storage: the mean), the sizing curve, and the outputs against an independent
+integration of ``trajectory.csv``."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import linprog
+
+from planning.cli import main
+from planning.model.case_file import case_from_data, load_yaml, read_case
+from planning.model.profile import Profile, Segment
+from planning.solver.grid import Storage, chain, power_figures, shave, shaving_edges
+from press.crank_slider import CrankSlider
+from press.dynamics import drive_state, forming_work
+
+from .conftest import ROOT
+from .random_cases import build_case
+
+DRIVE_CASES = [
+    ROOT / "cases" / "wang2023-side-panel-drive.yaml",
+    ROOT / "cases" / "cup-2000kN-drive.yaml",
+    ROOT / "cases" / "link-drive-side-panel.yaml",
+    ROOT / "cases" / "knuckle-joint-coining.yaml",
+]
+BALANCE_TOL = 1e-6  # relative, the issue's
+LP_TOL = 1e-6  # relative: two LP solvers on the same samples
+INTEGRATION_TOL = 1e-3  # relative: trapezoids on the 1 ms trajectory against the quadrature
+ELECTRICAL = {
+    "converter_efficiency": 0.96,
+    "regen_efficiency": 0.3,
+    "storage": {"usable_energy_kJ": 40.0, "efficiency": 0.93, "max_power_kW": 900.0},
+}
+
+
+def bumpy_cycle(omega: float, rise: float) -> Profile:
+    """A periodic crank motion from TDC (no optimiser): constant speed ``omega`` [rad/s], then a speed bump
+    of constant-jerk pieces (jerk j for tau, -j for 2 tau, j for tau: the speed rises by the share ``rise``
+    and comes back) over about a fifth of the turn; the constant part's length closes the turn exactly."""
+    tau = 0.05 * 2 * math.pi / omega
+    jerk = rise * omega / tau**2
+    bump = (Segment("up", tau, jerk, 0.0), Segment("over", 2 * tau, -jerk, 0.0), Segment("back", tau, jerk, 0.0))
+    swept = Profile(bump, 0.0, omega).knots()[-1, 0]
+    assert swept < 2 * math.pi
+    return Profile((Segment("steady", (2 * math.pi - swept) / omega, 0.0, 0.0), *bump), 0.0, omega)
+
+
+def electrical(data: dict, extra: dict | None = None) -> dict:
+    drive = {**data["drive"], **ELECTRICAL, **(extra or {})}
+    drive["motor"] = {**drive["motor"], "copper_loss_at_rated_kW": 0.02 * drive["motor"]["rated_torque_Nm"]}
+    return {**data, "drive": drive}
+
+
+def figures_on(case, profile: Profile):
+    from planning.model.profile import dense_times
+
+    t = dense_times(profile.duration, profile.knot_times - profile.t0)
+    th, om, al, _ = profile.at_time(t)
+    return power_figures(profile, case, t, drive_state(th, om, al, case.machine, case.drive_model))
+
+
+def balance_error(p, forming_kJ: float) -> float:
+    losses = p.gear_loss_kJ + p.copper_loss_kJ + p.converter_loss_kJ + p.storage_loss_kJ + p.resistor_loss_kJ
+    return abs(p.grid_energy_kJ - (forming_kJ + losses + p.storage_change_kJ)) / abs(p.grid_energy_kJ)
+
+
+def random_drive_case(seed: int) -> dict:
+    """A random press (the property tests' generator) with a drive scaled to it: slide mass, inertias and
+    forming force from the crank radius, a motor large enough, every electrical key."""
+    rng = np.random.default_rng(seed)
+    data = build_case(list(rng.random(14)), name=f"random-drive-{seed}")
+    R = data["press"]["crank_radius_mm"]
+    press = CrankSlider(R, data["press"]["rod_length_mm"])
+    h2 = round(float(press.height(math.radians(data["key_points"]["draw_start_deg"]))), 3)  # contact at theta2
+    force = float(rng.uniform(50, 2000)) * R / 100  # [kN]
+    data["process"]["forming_force_kN"] = [[h2, 0.0], [0.8 * h2, force], [0.2 * h2, 0.7 * force], [0.0, 0.3 * force]]
+    data["drive"] = {
+        "slide_mass_kg": float(rng.uniform(10, 100)) * R,
+        "rod_mass_kg": float(rng.uniform(1, 10)) * R,
+        "rod_cg_from_crank_pin_mm": 0.4 * data["press"]["rod_length_mm"],
+        "crank_inertia_kg_m2": float(rng.uniform(0.5, 50)) * R,
+        "counterbalance_kN": float(rng.uniform(0, 1)) * R,
+        "gear_ratio": float(rng.uniform(5, 40)),
+        "gear_efficiency": float(rng.uniform(0.85, 1.0)),
+        "motor_inertia_kg_m2": float(rng.uniform(0.01, 5)),
+        "motor": {"peak_torque_Nm": 1e7, "rated_torque_Nm": 1e6, "base_speed_rpm": 1e4, "max_speed_rpm": 2e4},
+        "regen_efficiency": float(rng.uniform(0, 1)),
+        "converter_efficiency": float(rng.uniform(0.9, 1.0)),
+        "storage": {"usable_energy_kJ": float(rng.uniform(0, 50)) * R / 100, "efficiency": float(rng.uniform(0.8, 1))},
+    }
+    data["drive"]["motor"]["copper_loss_at_rated_kW"] = float(rng.uniform(0, 100))
+    return data
+
+
+@pytest.mark.parametrize("path", DRIVE_CASES, ids=lambda p: p.stem)
+def test_energy_balance_with_every_loss_on_every_drive_case(path):
+    """Grid energy = forming work + gear, copper, converter, storage and resistor losses + storage change (the
+    kinetic energies return to their start), each term computed apart, on a cycle with accelerations."""
+    case = case_from_data(electrical(load_yaml(path.read_text())))
+    p = figures_on(case, bumpy_cycle(1.0, 0.8))
+    forming = forming_work(float(case.machine.height(case.key_angles[1])), 0.0, case.drive_model) / 1e3
+    assert forming > 0 and p.copper_loss_kJ > 0 and p.converter_loss_kJ > 0 and p.gear_loss_kJ > 0
+    assert balance_error(p, forming) <= BALANCE_TOL
+    assert abs(p.storage_change_kJ) <= BALANCE_TOL * p.storage_usable_kJ + 1e-9
+
+
+@pytest.mark.parametrize("part", range(2))
+def test_energy_balance_on_random_drive_presses(part):
+    """20 random presses with random drives, every electrical key: the balance to 1e-6, the storage within
+    its bounds, every loss non-negative."""
+    for seed in range(10 * part, 10 * part + 10):
+        case = case_from_data(random_drive_case(seed))
+        p = figures_on(case, bumpy_cycle(float(np.random.default_rng(seed).uniform(0.5, 3.0)), 0.6))
+        forming = forming_work(float(case.machine.height(case.key_angles[1])), 0.0, case.drive_model) / 1e3
+        assert balance_error(p, forming) <= BALANCE_TOL, seed
+        for loss in (p.copper_loss_kJ, p.converter_loss_kJ, p.gear_loss_kJ, p.storage_loss_kJ, p.resistor_loss_kJ):
+            assert loss >= -1e-9 * abs(p.grid_energy_kJ), seed
+        assert p.storage_min_kJ >= -1e-6 and p.storage_max_kJ <= p.storage_usable_kJ * (1 + 1e-6) + 1e-6, seed
+
+
+def linprog_peak(edges: np.ndarray, bus_W: np.ndarray, storage: Storage) -> float:
+    """The same programme written apart for SciPy: variables z, c, d, E (E_n = E_0)."""
+    n = edges.size - 1
+    dt = np.diff(edges)
+    p = bus_W / 1e3
+    nv = 1 + 3 * n
+    cost = np.zeros(nv)
+    cost[0] = 1.0
+    A_ub = np.zeros((2 * n, nv))
+    b_ub = np.zeros(2 * n)
+    for k in range(n):
+        for row, sample in ((k, p[k]), (n + k, p[k + 1])):  # sample + c - d <= z
+            A_ub[row, 0], A_ub[row, 1 + k], A_ub[row, 1 + n + k] = -1.0, 1.0, -1.0
+            b_ub[row] = -sample
+    A_eq = np.zeros((n, nv))
+    eta = storage.efficiency
+    for k in range(n):
+        A_eq[k, 1 + 2 * n + (k + 1) % n] += 1.0
+        A_eq[k, 1 + 2 * n + k] -= 1.0
+        A_eq[k, 1 + k] = -eta * dt[k]
+        A_eq[k, 1 + n + k] = dt[k] / eta
+    top = storage.max_power / 1e3 if math.isfinite(storage.max_power) else None
+    bounds = [(None, None)] + [(0, top)] * (2 * n) + [(0, storage.usable / 1e3)] * n
+    res = linprog(cost, A_ub=A_ub, b_ub=b_ub, A_eq=A_eq, b_eq=np.zeros(n), bounds=bounds, method="highs")
+    assert res.status == 0
+    return float(res.fun) * 1e3
+
+
+def bus_samples(path, profile: Profile, extra: dict | None = None):
+    case = case_from_data(electrical(load_yaml(path.read_text()), extra))
+    edges = shaving_edges(profile.duration)
+    th, om, al, _ = profile.at_time(edges)
+    s = drive_state(th, om, al, case.machine, case.drive_model)
+    return case, edges, chain(s, case)["bus_power_W"]
+
+
+@pytest.mark.parametrize("usable_kJ, power_kW", [(40.0, 900.0), (5.0, None), (300.0, 200.0)])
+def test_peak_shaving_equals_an_independent_lp(usable_kJ, power_kW):
+    profile = bumpy_cycle(1.2, 0.8)
+    case, edges, bus = bus_samples(DRIVE_CASES[1], profile)
+    storage = Storage(usable_kJ * 1e3, 0.9, math.inf if power_kW is None else power_kW * 1e3)
+    ours = shave(edges, bus, storage, case.drive.regen_efficiency)
+    theirs = linprog_peak(edges, bus, storage)
+    assert ours.peak == pytest.approx(theirs, rel=LP_TOL)
+    assert ours.peak < float(np.max(bus))  # the storage shaves
+    assert float(np.min(ours.energy)) >= -1e-6 and float(np.max(ours.energy)) <= storage.usable * (1 + 1e-9)
+
+
+def test_no_storage_gives_the_bus_peak_and_unbounded_storage_the_mean():
+    profile = bumpy_cycle(1.2, 0.8)
+    case, edges, bus = bus_samples(DRIVE_CASES[1], profile)
+    none = shave(edges, bus, Storage(0.0, 0.95), 0.0)
+    assert none.peak == pytest.approx(float(np.max(bus)), rel=1e-8)  # HiGHS's feasibility tolerance
+    mean = float(np.sum(np.diff(edges) * (bus[1:] + bus[:-1]) / 2)) / profile.duration
+    endless = shave(edges, bus, Storage(1e12, 1.0), 0.0)
+    # the programme holds the grid at both ends of each interval: with unbounded storage its peak is the mean
+    # of each interval's larger end, which is the mean power within half the total variation per interval
+    larger_ends = float(np.sum(np.diff(edges) * np.maximum(bus[1:], bus[:-1]))) / profile.duration
+    assert endless.peak == pytest.approx(larger_ends, rel=LP_TOL)
+    assert abs(endless.peak - mean) <= float(np.sum(np.abs(np.diff(bus)))) / (2 * (edges.size - 1)) * (1 + LP_TOL)
+    assert endless.peak < 0.5 * float(np.max(bus))
+
+
+def test_sizing_curve_is_non_increasing():
+    profile = bumpy_cycle(1.2, 0.8)
+    case, edges, bus = bus_samples(DRIVE_CASES[1], profile)
+    peaks = [shave(edges, bus, Storage(size * 1e3, 0.9), 0.0).peak for size in np.linspace(0, 200, 6)]
+    assert all(b <= a * (1 + 1e-9) for a, b in zip(peaks, peaks[1:], strict=False))
+    assert peaks[-1] < 0.8 * peaks[0]
+
+
+def test_outputs_carry_the_chain_and_the_trajectory_gives_them(tmp_path):
+    """A solved drive case with every electrical key: ``result.json``'s ``power`` block, the trajectory's new
+    columns integrated apart (trapezoids) give the energies and peaks to 0.1 %, and the checks pass."""
+    data = electrical(load_yaml(DRIVE_CASES[1].read_text()))
+    path = tmp_path / "case.yaml"
+    path.write_text(json.dumps(data))
+    out = tmp_path / "out"
+    assert main(["solve", str(path), "--out", str(out), "--no-plots"]) == 0
+    result = json.loads((out / "result.json").read_text())
+    p = result["power"]
+    checks = {c["id"]: c for c in result["verification"]["checks"]}
+    for key in ("grid_energy_balance", "storage_above_empty", "storage_below_full", "storage_closes"):
+        assert checks[key]["passed"], key
+    rows = np.genfromtxt(out / "trajectory.csv", delimiter=",", names=True)
+    t = rows["time_s"]
+
+    def integral(y):
+        return float(np.sum(np.diff(t) * (y[1:] + y[:-1]) / 2))
+
+    assert integral(rows["copper_loss_kW"]) == pytest.approx(p["copper_loss_kJ"], rel=INTEGRATION_TOL)
+    assert integral(rows["bus_power_kW"]) == pytest.approx(p["bus_energy_kJ"], rel=INTEGRATION_TOL)
+    assert integral(rows["grid_power_kW"]) == pytest.approx(p["grid_energy_kJ"], rel=INTEGRATION_TOL)
+    assert float(np.max(rows["bus_power_kW"])) == pytest.approx(p["bus_peak_kW"], rel=INTEGRATION_TOL)
+    assert float(np.max(rows["grid_power_kW"])) == pytest.approx(p["grid_peak_kW"], rel=INTEGRATION_TOL)
+    assert float(np.ptp(rows["storage_energy_kJ"])) == pytest.approx(p["storage_swing_kJ"], rel=INTEGRATION_TOL)
+    assert p["grid_peak_kW"] < p["bus_peak_kW"]
+    summary = (out / "summary.txt").read_text()
+    assert "grid:" in summary and "losses per stroke" in summary
+
+
+@pytest.mark.parametrize(
+    "key, value, field",
+    [
+        ("drive.storage.usable_energy_kJ", -5, "drive.storage.usable_energy_kJ"),
+        ("drive.storage.efficiency", 1.2, "drive.storage.efficiency"),
+        ("drive.converter_efficiency", 1.5, "drive.converter_efficiency"),
+        ("drive.motor.copper_loss_at_rated_kW", -1, "drive.motor.copper_loss_at_rated_kW"),
+        ("drive.grid.peak_power_kW", 0, "drive.grid.peak_power_kW"),
+    ],
+)
+def test_bad_electrical_values_are_exit_2_naming_the_field(key, value, field, tmp_path, capsys):
+    out = tmp_path / "out"
+    storage = [] if key == "drive.storage.usable_energy_kJ" else ["--set", "drive.storage.usable_energy_kJ=10"]
+    code = main(["solve", str(DRIVE_CASES[1]), *storage, "--set", f"{key}={value}", "--out", str(out)])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and field in err, err
+    assert not out.exists()
+
+
+def test_without_the_new_keys_the_outputs_are_todays():
+    """No electrical key: no ``power`` block, the trajectory's columns as before (the golden outputs'
+    shape; their values are checked by the drive tests)."""
+    from planning.reports.report import DRIVE_COLUMNS, TRAJECTORY_COLUMNS, trajectory_columns
+
+    case = read_case(DRIVE_CASES[1])
+    assert not case.drive.electrical
+    assert trajectory_columns(case) == TRAJECTORY_COLUMNS + DRIVE_COLUMNS
