@@ -40,6 +40,9 @@ DRIVE_ROW_FIELDS = (
     "energy_drawn_kJ",
     "energy_net_kJ",
 )
+# with the drive's electrical side (losses, storage, grid): what the plant must give at each point
+POWER_ROW_FIELDS = ("grid_peak_kW", "bus_peak_kW", "mean_bus_power_kW", "grid_energy_kJ", "storage_swing_kJ")
+ELECTRICAL_FIELDS = ("drive.storage.", "drive.grid.", "drive.converter_efficiency", "drive.motor.copper_loss")
 
 
 class SweepError(ValueError):
@@ -160,7 +163,20 @@ def _solved_row(sol, case) -> dict[str, Any]:  # noqa: ANN001 - a Solution and i
     if sol.drive is not None:
         figures = sol.drive.as_dict()
         row.update({k: figures[k] for k in DRIVE_ROW_FIELDS})
+        if sol.drive.power is not None:
+            power = sol.drive.power.as_dict()
+            row.update({k: power[k] for k in POWER_ROW_FIELDS})
     return row
+
+
+def _electrical(base: dict[str, Any], fields: list[str]) -> bool:
+    """The sweep's cases state the drive's electrical side (the base case does, or a swept field is one of
+    its keys)."""
+    drive = base.get("drive") or {}
+    stated = {"storage", "grid", "converter_efficiency"} & set(drive) or "copper_loss_at_rated_kW" in drive.get(
+        "motor", {}
+    )
+    return bool(drive) and bool(stated or any(f.startswith(ELECTRICAL_FIELDS) for f in fields))
 
 
 def neighbours(index: int, shape: tuple[int, ...]) -> list[int]:
@@ -317,6 +333,7 @@ def run_sweep(
     done = set(earlier)
     pending = [i for i in range(len(points)) if i not in done]
     columns = ["index", *fields, *ROW_FIELDS, *(DRIVE_ROW_FIELDS if base.get("drive") else ())]
+    columns += POWER_ROW_FIELDS if _electrical(base, fields) else ()
     new_file = not csv_path.exists() or csv_path.stat().st_size == 0
     failed = sum(1 for r in earlier.values() if r["status"] != "verified")
     finished = len(done)

@@ -251,3 +251,43 @@ def test_without_the_new_keys_the_outputs_are_todays():
     case = read_case(DRIVE_CASES[1])
     assert not case.drive.electrical
     assert trajectory_columns(case) == TRAJECTORY_COLUMNS + DRIVE_COLUMNS
+
+
+CUP = DRIVE_CASES[1]
+
+
+def cup_with(**fields) -> dict:
+    from planning.solver.optimize import solve
+
+    case = read_case(CUP, fields)
+    sol = solve(case)
+    assert sol.verification.passed
+    return {"spm": sol.plan.spm, "power": sol.drive.power, "verification": sol.verification}
+
+
+def test_a_grid_limit_slows_the_plan_and_enough_storage_gives_the_speed_back():
+    """cup-2000kN-drive's 603 kW peak comes from accelerating the crank, not from the draw: a 400 kW grid
+    limit without storage slows the plan (verified, the grid at its limit); with storage enough the plan is the
+    unlimited one within 0.1 %; with a little storage it lies between."""
+    free = cup_with()["spm"]
+    limited = cup_with(**{"drive.grid.peak_power_kW": 400.0})
+    assert limited["spm"] < free * (1 - 1e-3)
+    assert limited["power"].grid_peak_kW <= 400.0 * (1 + 1e-6)
+    assert limited["verification"].check("grid_peak_power").binds
+    stored = cup_with(**{"drive.grid.peak_power_kW": 400.0, "drive.storage.usable_energy_kJ": 200.0})
+    assert stored["spm"] == pytest.approx(free, rel=1e-3)
+    some = cup_with(**{"drive.grid.peak_power_kW": 400.0, "drive.storage.usable_energy_kJ": 2.0})
+    assert limited["spm"] < some["spm"] < free
+    assert some["power"].grid_peak_kW <= 400.0 * (1 + 1e-6)
+
+
+def test_a_grid_limit_below_the_draws_power_is_refused_before_solving(tmp_path, capsys):
+    """The side-panel drive's peak is the draw's own power at its fixed speed: a limit below it is exit 3 naming
+    the grid limit, the angle and the power; a storage too small to carry the draw is named too."""
+    path = ROOT / "cases" / "wang2023-side-panel-drive.yaml"
+    for extra, words in (([], "no drive.storage"), (["--set", "drive.storage.usable_energy_kJ=100"], "cannot carry")):
+        code = main(["solve", str(path), "--set", "drive.grid.peak_power_kW=1000", *extra, "--out", str(tmp_path / "o")])
+        err = capsys.readouterr().err
+        assert code == 3 and "drive.grid.peak_power_kW = 1000" in err and "139.2 deg" in err and "1389 kW" in err
+        assert words in err
+    assert not (tmp_path / "o").exists()

@@ -86,6 +86,8 @@ class PowerFigures:
     storage_max_kJ: float
     storage_peak_power_kW: float
     grid_limit_kW: float | None
+    bus_cap_for_limit_kW: float | None  # above the grid limit with storage: the bus cap the storage could
+    # shave to the limit on this plan's shape (planning.solver.grid.bus_cap_for_limit; None otherwise)
     schedule: Any = field(default=None, compare=False, repr=False)  # planning.solver.grid.Schedule
 
     def as_dict(self) -> dict[str, Any]:

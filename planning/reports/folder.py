@@ -41,6 +41,7 @@ SOLVE_FILES = (
     "motion_vs_time.*",
     "motion_vs_angle.*",
     "drive.*",
+    "energy.*",
 )
 COMPARE_FILES = ("comparison.json", "comparison.md")
 LAWS_FILES = ("laws.json", "laws.md", "laws_overlay.*")

@@ -227,7 +227,54 @@ def plot_files(
     out = {f"{name}.{fmt}": _figure(result, traj, published, name.split("_")[-1]) for name in FIGURES}
     if "drive" in result:
         out[f"drive.{fmt}"] = drive_figure(result, traj)
+    if "power" in result:
+        out[f"energy.{fmt}"] = energy_figure(result, traj)
     return out
+
+
+def energy_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
+    """From the motor to the grid over the cycle: shaft, bus and grid power with the grid's limit and the mean
+    bus power; the storage's energy between empty and full; the stages shaded (README, "From the motor to the
+    grid")."""
+    p = result["power"]
+    t = _thin(traj)
+    x = t["crank_angle_deg"]
+    fig = Figure(figsize=(12, 7.5), layout="constrained")
+    FigureCanvasAgg(fig)
+    power, store = fig.subplots(2, 1, sharex=True, height_ratios=(1.6, 1))
+    for ax, label in ((power, True), (store, False)):
+        _decorate(ax, result, "angle", x, label)
+    _key_ticks(power, result, "angle")
+    power.plot(x, t["motor_power_kW"], color="#2ca02c", lw=1.2, label="motor shaft power")
+    power.plot(x, t["bus_power_kW"], color="#1f77b4", lw=1.2, label="DC-bus power (losses in)")
+    power.plot(x, t["grid_power_kW"], color="#d62728", lw=1.6, label="grid power (with the storage)")
+    power.axhline(
+        p["mean_bus_power_kW"],
+        color="#555555",
+        lw=1.0,
+        ls="-.",
+        label=f"mean bus power {p['mean_bus_power_kW']:.0f} kW",
+    )
+    if p.get("grid_limit_kW") is not None:
+        _limit(power, x, p["grid_limit_kW"], f"drive.grid.peak_power_kW = {p['grid_limit_kW']:g} kW", "#b22222")
+    power.axhline(0.0, color="#444444", lw=0.6)
+    power.set_ylabel("power [kW] (drawn > 0)")
+    _legend(power)
+    store.plot(x, t["storage_energy_kJ"], color="#9467bd", lw=1.4, label="stored energy")
+    usable = p["storage_usable_kJ"]
+    _limit(store, x, usable, f"drive.storage.usable_energy_kJ = {usable:g} kJ", "#b22222")
+    _limit(store, x, 0.0, "empty", "#444444")
+    store.set_ylabel("storage [kJ]")
+    store.set_xlabel("crank angle from TDC [deg]")
+    _legend(store)
+    fig.suptitle(
+        f"{result['case']}: from the motor to the grid at {result['spm']:.3f} strokes/min\n"
+        f"grid peak {p['grid_peak_kW']:.0f} kW (without storage {p['bus_peak_kW']:.0f} kW), "
+        f"{p['grid_energy_kJ']:.0f} kJ per stroke from the grid; losses: copper {p['copper_loss_kJ']:.0f}, "
+        f"converter {p['converter_loss_kJ']:.0f}, gear {p['gear_loss_kJ']:.0f}, storage {p['storage_loss_kJ']:.0f}, "
+        f"resistor {p['resistor_loss_kJ']:.0f} kJ"
+    )
+    return fig
 
 
 def _plus_minus(ax, value: float, label: str, **style) -> None:  # noqa: ANN001 - a matplotlib Axes
@@ -304,6 +351,11 @@ def save(fig: Figure, path: Path) -> None:
     fig.savefig(path, format=path.suffix.lstrip("."))
 
 
+def _column(rows: list[dict[str, Any]], key: str) -> np.ndarray:
+    """One column of sweep rows as floats (NaN where empty)."""
+    return np.array([float(r[key]) if r.get(key) not in ("", None) else np.nan for r in rows])
+
+
 def sweep_figure(rows: list[dict[str, Any]], fields: list[str], title: str) -> Figure:
     """SPM against the swept field (one field: the points without a verified plan as red crosses on a row
     of their own below the curve) or a heat map of SPM (two fields: each cell's SPM written in it, the
@@ -326,7 +378,17 @@ def sweep_figure(rows: list[dict[str, Any]], fields: list[str], title: str) -> F
         ax.set_ylabel("strokes per minute")
         ax.grid(True, lw=0.3)
         fails.grid(True, axis="x", lw=0.3)
-        _legend(ax, fails, anchor=(1.02, 1.0))
+        grid = _column(rows, "grid_peak_kW")
+        twins = [fails]
+        if np.any(np.isfinite(grid[ok])):  # the drive's electrical side: the plant's peak beside the SPM
+            power = ax.twinx()
+            power.plot(x[ok], grid[ok], "s-", color="tab:red", ms=4, lw=1.4, label="grid peak [kW]")
+            mean = _column(rows, "mean_bus_power_kW")[ok]
+            power.plot(x[ok], mean, "--", color="tab:gray", lw=1.2, label="mean bus power [kW]")
+            power.set_ylabel("power [kW]")
+            power.set_ylim(bottom=0)
+            twins.append(power)
+        _legend(ax, *twins, anchor=(1.02 if len(twins) == 1 else 1.12, 1.0))
     else:
         ax = fig.subplots()
         fig.subplots_adjust(right=0.78)

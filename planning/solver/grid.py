@@ -49,6 +49,7 @@ SHAVING_STEP_S = 5e-3  # [s] the peak-shaving intervals are at most this long ..
 SHAVING_MIN_INTERVALS = 400  # ... and at least this many ...
 SHAVING_MAX_INTERVALS = 4000  # ... and at most this many per cycle
 PEAK_SLACK = 1e-9  # relative: the second programme keeps the grid peak within this share of the first's
+CAP_BISECTIONS = 12  # steps of bus_cap_for_limit: the cap to 1/4096 of the bus peak's overshoot
 SCALE_W = 1e3  # the programmes in kW and kJ (HiGHS's tolerances are absolute)
 _HIGHS = {"highs": {"output_flag": False, "log_to_console": False}}
 
@@ -103,9 +104,11 @@ def shaving_edges(period: float) -> np.ndarray:
     return np.linspace(0.0, period, n + 1)
 
 
-def shave(edges: np.ndarray, bus_W: np.ndarray, storage: Storage, regen_efficiency: float) -> Schedule:
+def shave(
+    edges: np.ndarray, bus_W: np.ndarray, storage: Storage, regen_efficiency: float, peak_only: bool = False
+) -> Schedule:
     """The storage schedule with the lowest grid peak on the samples ``bus_W`` [W] at ``edges`` [s], then the
-    least grid energy (module docstring)."""
+    least grid energy (module docstring; ``peak_only``: the first programme alone, for its peak)."""
     n = edges.size - 1
     dt = np.diff(edges)
     p = np.asarray(bus_W, dtype=float) / SCALE_W
@@ -144,6 +147,8 @@ def shave(edges: np.ndarray, bus_W: np.ndarray, storage: Storage, regen_efficien
     first = solver(g=g, ubx=ubx, **args)
     _solved(solver, "peak")
     peak = float(first["cost"])
+    if peak_only:
+        return Schedule(edges, np.zeros(n), np.zeros(n), np.zeros(n + 1), peak * SCALE_W)
     g = np.zeros(nv)  # the least grid energy at that peak: sum dt (r (w - wbar) + ...) with x = mean + c - d
     g[ic:id_] = r * dt
     g[id_:ie] = -r * dt
@@ -160,6 +165,21 @@ def _solved(solver: ca.Function, what: str) -> None:
     stats = solver.stats()
     if not stats.get("success", False):
         raise ArithmeticError(f"the peak-shaving programme ({what}) failed: {stats.get('return_status')}")
+
+
+def bus_cap_for_limit(edges: np.ndarray, bus_W: np.ndarray, storage: Storage, limit_W: float) -> float:
+    """The highest cap [W] on the bus power such that, were the plan's bus power clipped at it, the storage could
+    hold the grid at ``limit_W`` (bisection on the peak-shaving programme, :data:`CAP_BISECTIONS` steps): where
+    the search sends the grid limit's NLP cap when the plan's grid peak is above the limit
+    (``planning.model.limits.grid``)."""
+    lo, hi = limit_W, float(np.max(bus_W))
+    for _ in range(CAP_BISECTIONS):
+        mid = (lo + hi) / 2
+        if shave(edges, np.minimum(bus_W, mid), storage, 0.0, peak_only=True).peak <= limit_W:
+            lo = mid
+        else:
+            hi = mid
+    return lo
 
 
 def no_schedule(edges: np.ndarray, bus_W: np.ndarray) -> Schedule:
@@ -186,12 +206,16 @@ def _state(profile: Profile, case: Case, t: np.ndarray) -> tuple[np.ndarray, np.
 def schedule_of(profile: Profile, case: Case) -> Schedule:
     """The storage schedule of a plan's cycle (``profile`` from TDC): :func:`shave` on the bus power at
     :func:`shaving_edges`, or :func:`no_schedule` without storage."""
+    return _schedule_and_bus(profile, case)[0]
+
+
+def _schedule_and_bus(profile: Profile, case: Case) -> tuple[Schedule, np.ndarray]:
     edges = shaving_edges(profile.duration)
     bus = _state(profile, case, edges)[3]["bus_power_W"]
     storage = Storage.of(case)
     if storage is None:
-        return no_schedule(edges, bus)
-    return shave(edges, bus, storage, case.drive.regen_efficiency)
+        return no_schedule(edges, bus), bus
+    return shave(edges, bus, storage, case.drive.regen_efficiency), bus
 
 
 def power_columns(schedule: Schedule, state: dict, t: np.ndarray, case: Case) -> dict[str, np.ndarray]:
@@ -214,7 +238,7 @@ def power_figures(profile: Profile, case: Case, dense_t: np.ndarray, dense_state
     peaks on the dense grid ``dense_t`` [s from the start] (drive states ``dense_state`` there) and on the
     schedule's edges."""
     d = case.drive
-    schedule = schedule_of(profile, case)
+    schedule, edge_bus = _schedule_and_bus(profile, case)
     storage = Storage.of(case)
     nodes, weights = quadrature(profile, case, extra_edges=profile.t0 + schedule.edges)
     t = nodes - profile.t0
@@ -240,6 +264,9 @@ def power_figures(profile: Profile, case: Case, dense_t: np.ndarray, dense_state
     th_peak = profile.at_time(profile.t0 + np.array([times[k]]))[0][0]
     grid_energy = integral(cols["grid_power_W"])
     limit = d.grid.peak_power_kW if d.grid is not None else None
+    cap = None
+    if limit is not None and storage is not None and float(grid[k]) > limit * 1e3:
+        cap = bus_cap_for_limit(schedule.edges, edge_bus, storage, limit * 1e3) / 1e3
     return PowerFigures(
         copper_loss_kJ=integral(cols["copper_loss_W"]),
         converter_loss_kJ=integral(cols["bus_power_W"] - (shaft + cols["copper_loss_W"])),
@@ -263,5 +290,6 @@ def power_figures(profile: Profile, case: Case, dense_t: np.ndarray, dense_state
         storage_max_kJ=float(np.max(schedule.energy)) / 1e3,
         storage_peak_power_kW=float(max(np.max(schedule.charge), np.max(schedule.discharge), 0.0)) / 1e3,
         grid_limit_kW=limit,
+        bus_cap_for_limit_kW=cap,
         schedule=schedule,
     )

@@ -133,7 +133,9 @@ class Search:
                 continue
             for c in bad:  # tighten the NLP's sampled limit by the measured overshoot
                 refine = self.nlp.refinable[c.id]
-                if refine.upward:  # a lower limit (the optimal law's minimum crank speed) goes up
+                if c.refine_to is not None:  # the limit says where its parameter goes (the grid's cap)
+                    q[refine.index] = min(q[refine.index], c.refine_to) * (1 - REFINE_MARGIN)
+                elif refine.upward:  # a lower limit (the optimal law's minimum crank speed) goes up
                     q[refine.index] *= (c.limit / max(c.value, 0.5 * c.limit)) * (1 + REFINE_MARGIN)
                 else:
                     q[refine.index] *= (c.limit / c.value) * (1 - REFINE_MARGIN)
