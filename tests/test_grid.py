@@ -15,7 +15,7 @@ from scipy.optimize import linprog
 from planning.cli import main
 from planning.model.case_file import case_from_data, load_yaml, read_case
 from planning.model.profile import Profile, Segment
-from planning.solver.grid import Storage, chain, power_figures, shave, shaving_edges
+from planning.solver.grid import Storage, chain, power_figures, shave, shaving_edges, storage_needed
 from press.crank_slider import CrankSlider
 from press.dynamics import drive_state, forming_work
 
@@ -192,6 +192,11 @@ def test_sizing_curve_is_non_increasing():
     peaks = [shave(edges, bus, Storage(size * 1e3, 0.9), 0.0).peak for size in np.linspace(0, 200, 6)]
     assert all(b <= a * (1 + 1e-9) for a, b in zip(peaks, peaks[1:], strict=False))
     assert peaks[-1] < 0.8 * peaks[0]
+    # the least storage for a grid cap (storage_needed, a running-sum argument) against the programme itself
+    cap = 0.5 * (peaks[0] + peaks[-1])
+    needed = storage_needed(edges, bus, cap, 0.9, math.inf)
+    assert shave(edges, bus, Storage(needed, 0.9), 0.0, peak_only=True).peak <= cap * (1 + LP_TOL)
+    assert shave(edges, bus, Storage(0.98 * needed, 0.9), 0.0, peak_only=True).peak > cap * (1 + LP_TOL)
 
 
 def test_outputs_carry_the_chain_and_the_trajectory_gives_them(tmp_path):
@@ -286,7 +291,8 @@ def test_a_grid_limit_below_the_draws_power_is_refused_before_solving(tmp_path, 
     the grid limit, the angle and the power; a storage too small to carry the draw is named too."""
     path = ROOT / "cases" / "wang2023-side-panel-drive.yaml"
     for extra, words in (([], "no drive.storage"), (["--set", "drive.storage.usable_energy_kJ=100"], "cannot carry")):
-        code = main(["solve", str(path), "--set", "drive.grid.peak_power_kW=1000", *extra, "--out", str(tmp_path / "o")])
+        limit = ["--set", "drive.grid.peak_power_kW=1000"]
+        code = main(["solve", str(path), *limit, *extra, "--out", str(tmp_path / "o")])
         err = capsys.readouterr().err
         assert code == 3 and "drive.grid.peak_power_kW = 1000" in err and "139.2 deg" in err and "1389 kW" in err
         assert words in err

@@ -49,7 +49,8 @@ SHAVING_STEP_S = 5e-3  # [s] the peak-shaving intervals are at most this long ..
 SHAVING_MIN_INTERVALS = 400  # ... and at least this many ...
 SHAVING_MAX_INTERVALS = 4000  # ... and at most this many per cycle
 PEAK_SLACK = 1e-9  # relative: the second programme keeps the grid peak within this share of the first's
-CAP_BISECTIONS = 12  # steps of bus_cap_for_limit: the cap to 1/4096 of the bus peak's overshoot
+CAP_BISECTIONS = 30  # steps of bus_cap_for_limit: the cap to 1e-9 of the bus peak's overshoot
+FLAT_SHARE = 0.05  # storage_to_flatten: the grid's peak within this share of the mean bus power
 SCALE_W = 1e3  # the programmes in kW and kJ (HiGHS's tolerances are absolute)
 _HIGHS = {"highs": {"output_flag": False, "log_to_console": False}}
 
@@ -167,19 +168,51 @@ def _solved(solver: ca.Function, what: str) -> None:
         raise ArithmeticError(f"the peak-shaving programme ({what}) failed: {stats.get('return_status')}")
 
 
+def storage_needed(edges: np.ndarray, bus_W: np.ndarray, cap_W: float, efficiency: float, max_power_W: float) -> float:
+    """The least usable energy [J] with which a storage of ``efficiency`` and ``max_power_W`` holds the grid at or
+    below ``cap_W`` on the peak-shaving programme's samples (``inf``: no size does), exactly: on interval ``k``
+    the grid sees the larger end sample ``P_k`` plus ``c_k - d_k``, so the storage must give ``(P_k - cap)+``
+    (within its power) and may take up to ``(cap - P_k)+``; charging as much as it may, its store changes by
+    ``a_k = (eta_s min((cap - P_k)+, max) - (P_k - cap)+ / eta_s) dt``, and the least store that never runs dry
+    over the periodic cycle is the deepest fall of the running sum of ``a`` over any stretch of up to a cycle
+    (none when a cycle's sum is negative: the storage would not end where it started)."""
+    dt = np.diff(edges)
+    larger = np.maximum(bus_W[1:], bus_W[:-1])
+    need = np.maximum(larger - cap_W, 0.0)
+    if float(np.max(need)) > max_power_W:
+        return math.inf
+    room = np.minimum(np.maximum(cap_W - larger, 0.0), max_power_W)
+    a = (efficiency * room - need / efficiency) * dt
+    if float(np.sum(a)) < 0:
+        return math.inf
+    walk = np.concatenate([[0.0], np.cumsum(np.concatenate([a, a]))])
+    return float(np.max(np.maximum.accumulate(walk) - walk))
+
+
 def bus_cap_for_limit(edges: np.ndarray, bus_W: np.ndarray, storage: Storage, limit_W: float) -> float:
     """The highest cap [W] on the bus power such that, were the plan's bus power clipped at it, the storage could
-    hold the grid at ``limit_W`` (bisection on the peak-shaving programme, :data:`CAP_BISECTIONS` steps): where
-    the search sends the grid limit's NLP cap when the plan's grid peak is above the limit
+    hold the grid at ``limit_W`` (bisection, :data:`CAP_BISECTIONS` steps, on :func:`storage_needed`): where the
+    search sends the grid limit's NLP cap when the plan's grid peak is above the limit
     (``planning.model.limits.grid``)."""
     lo, hi = limit_W, float(np.max(bus_W))
     for _ in range(CAP_BISECTIONS):
         mid = (lo + hi) / 2
-        if shave(edges, np.minimum(bus_W, mid), storage, 0.0, peak_only=True).peak <= limit_W:
+        clipped = np.minimum(bus_W, mid)
+        if storage_needed(edges, clipped, limit_W, storage.efficiency, storage.max_power) <= storage.usable:
             lo = mid
         else:
             hi = mid
     return lo
+
+
+def storage_to_flatten(edges: np.ndarray, bus_W: np.ndarray, storage: Storage) -> float | None:
+    """The least usable energy [J] of a storage like ``storage`` (its efficiency and power limit) with which the
+    grid's peak on these samples comes within :data:`FLAT_SHARE` of the mean bus power (:func:`storage_needed`);
+    None when no size does (the storage's losses or its power limit keep the grid higher)."""
+    dt = np.diff(edges)
+    mean = float(np.sum(dt * (bus_W[1:] + bus_W[:-1]) / 2)) / float(edges[-1] - edges[0])
+    needed = storage_needed(edges, bus_W, (1 + FLAT_SHARE) * mean, storage.efficiency, storage.max_power)
+    return None if math.isinf(needed) else needed
 
 
 def no_schedule(edges: np.ndarray, bus_W: np.ndarray) -> Schedule:
@@ -265,6 +298,7 @@ def power_figures(profile: Profile, case: Case, dense_t: np.ndarray, dense_state
     grid_energy = integral(cols["grid_power_W"])
     limit = d.grid.peak_power_kW if d.grid is not None else None
     cap = None
+    flatten = storage_to_flatten(schedule.edges, edge_bus, storage) if storage is not None else None
     if limit is not None and storage is not None and float(grid[k]) > limit * 1e3:
         cap = bus_cap_for_limit(schedule.edges, edge_bus, storage, limit * 1e3) / 1e3
     return PowerFigures(
@@ -291,5 +325,6 @@ def power_figures(profile: Profile, case: Case, dense_t: np.ndarray, dense_state
         storage_peak_power_kW=float(max(np.max(schedule.charge), np.max(schedule.discharge), 0.0)) / 1e3,
         grid_limit_kW=limit,
         bus_cap_for_limit_kW=cap,
+        storage_to_flatten_kJ=None if flatten is None else flatten / 1e3,
         schedule=schedule,
     )
