@@ -26,7 +26,9 @@ def run(args: list[str], **kw) -> subprocess.CompletedProcess:
 
 
 def sweep_process(out: Path, workers: int) -> subprocess.Popen:
-    """A 41-point transfer-time sweep of the published case in a child process, output captured."""
+    """A 41-point transfer-time sweep of the published case in a child process, output captured; Ctrl-C as from
+    a terminal (a suite started in the background of a non-interactive shell ignores SIGINT, and a child would
+    inherit that)."""
     return subprocess.Popen(
         [*PRESSPLAN, "sweep", str(PUBLISHED_CASE), "--vary", "process.transfer_time_s=1.0:3.0:41"]
         + ["--workers", str(workers), "--out", str(out)],
@@ -34,6 +36,7 @@ def sweep_process(out: Path, workers: int) -> subprocess.Popen:
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
 
 
