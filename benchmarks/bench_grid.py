@@ -9,8 +9,9 @@ import statistics
 import time
 from pathlib import Path
 
+from results_section import write_section  # benchmarks/ is the script's folder
+
 ROOT = Path(__file__).resolve().parents[1]
-RESULTS = ROOT / "benchmarks" / "RESULTS.md"
 RUNS = 5
 BEGIN, END = "<!-- grid:begin -->", "<!-- grid:end -->"  # after the web section: bench_solve.py keeps it
 VARIANTS = [  # (case file, label, overrides)
@@ -27,11 +28,15 @@ VARIANTS = [  # (case file, label, overrides)
         {"drive.grid.peak_power_kW": 400.0, "drive.storage.usable_energy_kJ": 200.0},
     ),
     ("wang2023-side-panel-drive.yaml", "the drive alone", {}),
-    ("wang2023-side-panel-drive.yaml", "storage 500 kJ, losses", {
-        "drive.storage.usable_energy_kJ": 500.0,
-        "drive.converter_efficiency": 0.97,
-        "drive.motor.copper_loss_at_rated_kW": 40.0,
-    }),
+    (
+        "wang2023-side-panel-drive.yaml",
+        "storage 500 kJ, losses",
+        {
+            "drive.storage.usable_energy_kJ": 500.0,
+            "drive.converter_efficiency": 0.97,
+            "drive.motor.copper_loss_at_rated_kW": 40.0,
+        },
+    ),
 ]
 
 
@@ -49,7 +54,6 @@ def main() -> None:
             times[k].append(time.perf_counter() - t)
     medians = [statistics.median(t) for t in times]
     lines = [
-        BEGIN,
         "## The drive's electrical side (`python benchmarks/bench_grid.py`)",
         "",
         f"In-process solves with the NLPs built, the variants taking turns, median of {RUNS}; the ratio divides by",
@@ -62,14 +66,8 @@ def main() -> None:
     for (name, label, _), s, m in zip(VARIANTS, spm, medians, strict=True):
         base.setdefault(name, m)
         lines.append(f"| `{name}` | {label} | {s:.3f} | {m:.3f} | {m / base[name]:.2f} |")
-    lines.append(END)
-    text = RESULTS.read_text(encoding="utf-8")
     block = "\n".join(lines)
-    if BEGIN in text:
-        text = text[: text.index(BEGIN)] + block + text[text.index(END) + len(END) :]
-    else:
-        text = text.rstrip("\n") + "\n\n" + block + "\n"
-    RESULTS.write_text(text, encoding="utf-8")
+    write_section(BEGIN, END, block)
     print(block)
 
 

@@ -15,6 +15,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from results_section import write_section  # benchmarks/ is the script's folder
+
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 RUNS = 5
@@ -53,14 +55,7 @@ def main() -> None:
             "",
         ]
     )
-    results = ROOT / "benchmarks" / "RESULTS.md"
-    text = results.read_text(encoding="utf-8")
-    begin, end = "<!-- refusal:begin -->", "<!-- refusal:end -->"
-    if begin not in text:
-        text = text.rstrip("\n") + f"\n\n{begin}\n{end}\n"
-    head, rest = text.split(begin)
-    _, tail = rest.split(end)
-    results.write_text(f"{head}{begin}\n{block}{end}{tail}", encoding="utf-8")
+    write_section("<!-- refusal:begin -->", "<!-- refusal:end -->", block.rstrip("\n"))
     print(block)
 
 

@@ -14,6 +14,8 @@ import statistics
 import sys
 from pathlib import Path
 
+from results_section import write_section  # benchmarks/ is the script's folder
+
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 EDITS = 20
@@ -139,7 +141,6 @@ def main() -> None:
     typed_first_median, typed_first_p95 = _median_p95(typed_first)
     typed_median, typed_p95 = _median_p95(typed)
     section = (
-        f"{BEGIN}\n"
         f"`pressplan serve`, published case, {EDITS} edits of θ2 in headless Chromium "
         "(`python benchmarks/bench_web.py`). Committed edits (a change event): to the first updated charts "
         f"(the fast answer from the plan before), median {first_median:.0f} ms, 95th percentile "
@@ -147,16 +148,9 @@ def main() -> None:
         f"95th percentile {p95:.0f} ms. Typed (keys {KEY_DELAY_MS} ms apart), from the last key: to the first "
         f"charts median {typed_first_median:.0f} ms, 95th percentile {typed_first_p95:.0f} ms (target: median "
         f"≤ 300 ms, 95th percentile ≤ 600 ms); to the confirmed charts median {typed_median:.0f} ms, 95th "
-        f"percentile {typed_p95:.0f} ms. {_burst_text(bursts)}\n{END}"
+        f"percentile {typed_p95:.0f} ms. {_burst_text(bursts)}"
     )
-    results = ROOT / "benchmarks" / "RESULTS.md"
-    text = results.read_text(encoding="utf-8")
-    if BEGIN in text:
-        head, rest = text.split(BEGIN)
-        text = head + section + rest.split(END)[1]
-    else:
-        text = text.rstrip("\n") + "\n\n" + section + "\n"
-    results.write_text(text, encoding="utf-8")
+    write_section(BEGIN, END, section)
     print(section)
 
 

@@ -68,3 +68,16 @@ def storage_rate(charge_W: Any, discharge_W: Any, efficiency: float) -> Any:
 def storage_loss(charge_W: Any, discharge_W: Any, efficiency: float) -> Any:
     """The storage's loss [W]: ``(1 - eta_s) c + (1 / eta_s - 1) d``."""
     return (1.0 - efficiency) * charge_W + (1.0 / efficiency - 1.0) * discharge_W
+
+
+def chain(
+    motor_torque_Nm: Any,
+    shaft_power_W: Any,
+    rated_torque_Nm: float,
+    loss_at_rated_W: float,
+    converter_efficiency: float,
+) -> dict[str, Any]:
+    """The chain from the shaft to the DC bus [W]: ``copper_loss_W``, ``electrical_power_W``, ``bus_power_W``."""
+    cu = copper_loss(motor_torque_Nm, rated_torque_Nm, loss_at_rated_W)
+    el = electrical_power(shaft_power_W, cu)
+    return {"copper_loss_W": cu, "electrical_power_W": el, "bus_power_W": bus_power(el, converter_efficiency)}

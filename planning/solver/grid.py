@@ -35,10 +35,8 @@ from planning.model.case import Case
 from planning.model.drive import PowerFigures, quadrature
 from planning.model.profile import Profile
 from press.dynamics import drive_state
+from press.power import chain as bus_chain
 from press.power import (
-    bus_power,
-    copper_loss,
-    electrical_power,
     grid_power,
     resistor_power,
     storage_loss,
@@ -115,7 +113,7 @@ def shave(
     p = np.asarray(bus_W, dtype=float) / SCALE_W
     eta, r = storage.efficiency, regen_efficiency
     usable = storage.usable / SCALE_W
-    top = storage.max_power / SCALE_W if math.isfinite(storage.max_power) else ca.inf
+    top = storage.max_power / SCALE_W  # inf: no limit
     # variables: z, c (n), d (n), E (n; E_n = E_0), w (n; w >= 0, w >= the interval's mean net power)
     iz, ic, id_, ie, iw = 0, 1, 1 + n, 1 + 2 * n, 1 + 3 * n
     nv = 1 + 4 * n
@@ -141,7 +139,7 @@ def shave(
     )
     solver = ca.conic("shaving", "highs", {"a": A.sparsity(), "h": ca.Sparsity(nv, nv)}, _HIGHS)
     lbx = np.concatenate([[-np.inf], np.zeros(3 * n), np.zeros(n)])
-    ubx = np.concatenate([[np.inf], np.full(2 * n, top if top != ca.inf else np.inf), np.full(n, usable), inf])
+    ubx = np.concatenate([[np.inf], np.full(2 * n, top), np.full(n, usable), inf])
     args = {"a": A, "lba": np.concatenate(lo), "uba": np.concatenate(hi), "lbx": lbx}
     g = np.zeros(nv)
     g[iz] = 1.0
@@ -225,9 +223,10 @@ def chain(state: dict, case: Case) -> dict[str, np.ndarray]:
     """The power chain [W] at drive states (``press.dynamics.drive_state``): ``copper_loss_W``,
     ``electrical_power_W``, ``bus_power_W``."""
     d = case.drive
-    cu = copper_loss(state["motor_torque_Nm"], d.motor.rated_torque_Nm, d.motor.copper_loss_at_rated_kW * 1e3)
-    el = electrical_power(state["motor_power_W"], cu)
-    return {"copper_loss_W": cu, "electrical_power_W": el, "bus_power_W": bus_power(el, d.converter_efficiency)}
+    loss = d.motor.copper_loss_at_rated_kW * 1e3
+    return bus_chain(
+        state["motor_torque_Nm"], state["motor_power_W"], d.motor.rated_torque_Nm, loss, d.converter_efficiency
+    )
 
 
 def _state(profile: Profile, case: Case, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict]:
@@ -242,13 +241,15 @@ def schedule_of(profile: Profile, case: Case) -> Schedule:
     return _schedule_and_bus(profile, case)[0]
 
 
-def _schedule_and_bus(profile: Profile, case: Case) -> tuple[Schedule, np.ndarray]:
+def _schedule_and_bus(profile: Profile, case: Case) -> tuple[Schedule, dict]:
+    """The schedule and the drive's state with its power chain at the schedule's edges."""
     edges = shaving_edges(profile.duration)
-    bus = _state(profile, case, edges)[3]["bus_power_W"]
+    state = _state(profile, case, edges)[3]
+    bus = state["bus_power_W"]
     storage = Storage.of(case)
     if storage is None:
-        return no_schedule(edges, bus), bus
-    return shave(edges, bus, storage, case.drive.regen_efficiency), bus
+        return no_schedule(edges, bus), state
+    return shave(edges, bus, storage, case.drive.regen_efficiency), state
 
 
 def power_columns(schedule: Schedule, state: dict, t: np.ndarray, case: Case) -> dict[str, np.ndarray]:
@@ -271,7 +272,8 @@ def power_figures(profile: Profile, case: Case, dense_t: np.ndarray, dense_state
     peaks on the dense grid ``dense_t`` [s from the start] (drive states ``dense_state`` there) and on the
     schedule's edges."""
     d = case.drive
-    schedule, edge_bus = _schedule_and_bus(profile, case)
+    schedule, edge_state = _schedule_and_bus(profile, case)
+    edge_bus = edge_state["bus_power_W"]
     storage = Storage.of(case)
     nodes, weights = quadrature(profile, case, extra_edges=profile.t0 + schedule.edges)
     t = nodes - profile.t0
@@ -288,7 +290,7 @@ def power_figures(profile: Profile, case: Case, dense_t: np.ndarray, dense_state
     dt = np.diff(schedule.edges)
     eta_s = storage.efficiency if storage is not None else 1.0
     stored = storage_rate(schedule.charge, schedule.discharge, eta_s)
-    edge_cols = power_columns(schedule, _state(profile, case, schedule.edges)[3], schedule.edges, case)
+    edge_cols = power_columns(schedule, edge_state, schedule.edges, case)
     dense_cols = power_columns(schedule, {**dense_state, **chain(dense_state, case)}, dense_t, case)
     bus_peak = max(float(np.max(dense_cols["bus_power_W"])), float(np.max(edge_cols["bus_power_W"])))
     grid = np.concatenate([dense_cols["grid_power_W"], edge_cols["grid_power_W"]])

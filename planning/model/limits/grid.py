@@ -22,12 +22,11 @@ from typing import Any
 import numpy as np
 
 from planning.model.limits.base import REL_TOL, Check, Dense, Impossible, Limit, Row, Transcription
+from planning.model.limits.motor import draw_drive_state
 from planning.model.units import RPM
-from press.dynamics import drive_state
-from press.power import bus_power, copper_loss, electrical_power
+from press.power import chain
 
 CAP_HEADROOM = 1.01  # the starting cap with storage: this much above the most the motors can draw from the bus
-DRAW_POINTS = 2001  # angles theta2 .. theta3 of the precheck's draw at constant speed
 
 
 class GridPeakLimit(Limit):
@@ -79,11 +78,8 @@ class GridPeakLimit(Limit):
         d = case.drive
         limit = d.grid.peak_power_kW * 1e3
         w2 = given if given is not None else lowest
-        _, th2, th3, _ = case.key_angles
-        theta = np.linspace(th2, th3, DRAW_POINTS)
-        state = drive_state(theta, np.full_like(theta, w2), np.zeros_like(theta), case.machine, case.drive_model)
-        cu = copper_loss(state["motor_torque_Nm"], d.motor.rated_torque_Nm, d.motor.copper_loss_at_rated_kW * 1e3)
-        bus = bus_power(electrical_power(state["motor_power_W"], cu), d.converter_efficiency)
+        theta, state = draw_drive_state(case, w2)
+        bus = _chain(state["motor_torque_Nm"], state["motor_power_W"], d)["bus_power_W"]
         k = int(np.argmax(bus))
         if bus[k] <= limit * (1 + REL_TOL):
             return None
@@ -125,8 +121,13 @@ class GridPeakLimit(Limit):
 def _most_bus_power(case: Any) -> float:
     """The most the motors can draw from the bus [W]: the peak torque at the base speed (the envelope's
     constant power), with its copper loss, through the converter."""
-    d = case.drive
-    m = d.motor
-    shaft = m.peak_torque_Nm * m.base_speed_rpm * RPM
-    cu = copper_loss(m.peak_torque_Nm, m.rated_torque_Nm, m.copper_loss_at_rated_kW * 1e3)
-    return float(bus_power(electrical_power(shaft, cu), d.converter_efficiency))
+    m = case.drive.motor
+    return float(_chain(m.peak_torque_Nm, m.peak_torque_Nm * m.base_speed_rpm * RPM, case.drive)["bus_power_W"])
+
+
+def _chain(motor_torque_Nm: Any, shaft_power_W: Any, drive: Any) -> dict[str, Any]:
+    """``press.power.chain`` with the case's ``drive`` section's figures."""
+    m = drive.motor
+    return chain(
+        motor_torque_Nm, shaft_power_W, m.rated_torque_Nm, m.copper_loss_at_rated_kW * 1e3, drive.converter_efficiency
+    )

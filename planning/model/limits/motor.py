@@ -111,7 +111,7 @@ class MotorPeakTorqueLimit(Limit):
         lever: the motor cannot make the draw even at the lowest draw speed the case allows."""
         motor = case.drive.motor
         w2 = given if given is not None else lowest
-        theta, state = _draw_state(case, w2)
+        theta, state = draw_drive_state(case, w2)
         envelope = envelope_torque(state["motor_speed_rad_s"], motor.peak_torque_Nm, motor.base_speed_rpm * RPM)
         use = np.abs(state["motor_torque_Nm"]) / envelope
         k = int(np.argmax(use))
@@ -192,7 +192,7 @@ class MotorRMSTorqueLimit(Limit):
         if given is None:
             return None
         motor = case.drive.motor
-        theta, state = _draw_state(case, given)
+        theta, state = draw_drive_state(case, given)
         sq = state["motor_torque_Nm"] ** 2
         draw_heat = float(np.sum(np.diff(theta) * (sq[1:] + sq[:-1]) / 2)) / given
         longest = 2 * math.pi / (case.limits.min_crank_speed_rpm * RPM)
@@ -225,7 +225,7 @@ class MotorRMSTorqueLimit(Limit):
         return None
 
 
-def _draw_state(case: Any, w2: float) -> tuple[np.ndarray, dict]:
+def draw_drive_state(case: Any, w2: float) -> tuple[np.ndarray, dict]:
     """The drive's state through the draw at constant speed ``w2`` [rad/s] (2001 angles theta2 .. theta3)."""
     _, th2, th3, _ = case.key_angles
     theta = np.linspace(th2, th3, 2001)
