@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 from pydantic import BaseModel
 
-from planning.model.case import Case
+from planning.model.case import ELECTRICAL_KEYS, Case, states_electrical
 from planning.model.case_file import with_fields
 
 BLOCK_POINTS = 6
@@ -42,7 +42,6 @@ DRIVE_ROW_FIELDS = (
 )
 # with the drive's electrical side (losses, storage, grid): what the plant must give at each point
 POWER_ROW_FIELDS = ("grid_peak_kW", "bus_peak_kW", "mean_bus_power_kW", "grid_energy_kJ", "storage_swing_kJ")
-ELECTRICAL_FIELDS = ("drive.storage.", "drive.grid.", "drive.converter_efficiency", "drive.motor.copper_loss")
 
 
 class SweepError(ValueError):
@@ -170,13 +169,11 @@ def _solved_row(sol, case) -> dict[str, Any]:  # noqa: ANN001 - a Solution and i
 
 
 def _electrical(base: dict[str, Any], fields: list[str]) -> bool:
-    """The sweep's cases state the drive's electrical side (the base case does, or a swept field is one of
-    its keys)."""
-    drive = base.get("drive") or {}
-    stated = {"storage", "grid", "converter_efficiency"} & set(drive) or "copper_loss_at_rated_kW" in drive.get(
-        "motor", {}
-    )
-    return bool(drive) and bool(stated or any(f.startswith(ELECTRICAL_FIELDS) for f in fields))
+    """The sweep's cases have the drive's electrical side (the base case has, or a swept field is one of its
+    keys: ``planning.model.case.ELECTRICAL_KEYS``)."""
+    drive = base.get("drive")
+    swept = any(f.startswith(tuple(f"drive.{key}" for key in ELECTRICAL_KEYS)) for f in fields)
+    return bool(drive) and (states_electrical(drive) or swept)
 
 
 def neighbours(index: int, shape: tuple[int, ...]) -> list[int]:

@@ -252,10 +252,14 @@ def test_without_the_new_keys_the_outputs_are_todays():
     """No electrical key: no ``power`` block, the trajectory's columns as before (the golden outputs'
     shape; their values are checked by the drive tests)."""
     from planning.reports.report import DRIVE_COLUMNS, TRAJECTORY_COLUMNS, trajectory_columns
+    from planning.sweep import _electrical
 
     case = read_case(DRIVE_CASES[1])
     assert not case.drive.electrical
     assert trajectory_columns(case) == TRAJECTORY_COLUMNS + DRIVE_COLUMNS
+    base = case.model_dump(exclude_none=True)  # as `pressplan sweep` hands it on: the defaults written out
+    assert not _electrical(base, ["process.transfer_time_s"])  # no grid columns in today's drive sweeps
+    assert _electrical(base, ["drive.storage.usable_energy_kJ"])
 
 
 CUP = DRIVE_CASES[1]

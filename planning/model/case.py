@@ -335,12 +335,24 @@ class DriveSection(_Model):
 
     @property
     def electrical(self) -> bool:
-        """The case states the drive's electrical side (losses, converter, storage or grid): the outputs then
-        carry the power chain from the motors to the grid."""
-        return bool(
-            {"converter_efficiency", "storage", "grid"} & self.model_fields_set
-            or "copper_loss_at_rated_kW" in self.motor.model_fields_set
-        )
+        """The drive has an electrical side beyond the shaft (:func:`states_electrical`): the outputs then carry
+        the power chain from the motors to the grid."""
+        return states_electrical(self.model_dump())
+
+
+ELECTRICAL_KEYS = ("motor.copper_loss_at_rated_kW", "converter_efficiency", "storage", "grid")  # within drive:
+
+
+def states_electrical(drive: dict[str, Any]) -> bool:
+    """A ``drive:`` section (as data) with an electrical side beyond the shaft (:data:`ELECTRICAL_KEYS`): a
+    copper loss, a converter loss, a storage or a grid (their defaults, 0 loss and efficiency 1, state none)."""
+    motor = drive.get("motor") or {}
+    return bool(
+        motor.get("copper_loss_at_rated_kW", 0.0) > 0
+        or drive.get("converter_efficiency", 1.0) < 1
+        or drive.get("storage") is not None
+        or drive.get("grid") is not None
+    )
 
 
 class PlannerModel(_Model):
