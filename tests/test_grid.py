@@ -15,7 +15,16 @@ from scipy.optimize import linprog
 from planning.cli import main
 from planning.model.case_file import case_from_data, load_yaml, read_case
 from planning.model.profile import Profile, Segment
-from planning.solver.grid import Storage, chain, power_figures, shave, shaving_edges, storage_needed
+from planning.solver.grid import (
+    Storage,
+    chain,
+    end_peaks,
+    peak_programme,
+    power_figures,
+    shave,
+    shaving_edges,
+    storage_needed,
+)
 from press.crank_slider import CrankSlider
 from press.dynamics import drive_state, forming_work
 
@@ -167,8 +176,17 @@ def test_peak_shaving_equals_an_independent_lp(usable_kJ, power_kW):
     ours = shave(edges, bus, storage, case.drive.regen_efficiency)
     theirs = linprog_peak(edges, bus, storage)
     assert ours.peak == pytest.approx(theirs, rel=LP_TOL)
+    assert peak_programme(edges, bus, storage) == pytest.approx(theirs, rel=LP_TOL)  # the exact method's LP
     assert ours.peak < float(np.max(bus))  # the storage shaves
     assert float(np.min(ours.energy)) >= -1e-6 and float(np.max(ours.energy)) <= storage.usable * (1 + 1e-9)
+    # the search's lazy schedule (O(N)): the same peak, within the storage's bounds and power, periodic
+    lazy = shave(edges, bus, storage, case.drive.regen_efficiency, least_energy=False)
+    assert lazy.peak == pytest.approx(theirs, rel=LP_TOL)
+    assert float(np.min(lazy.energy)) >= 0.0 and float(np.max(lazy.energy)) <= storage.usable * (1 + 1e-12)
+    assert float(np.max(lazy.charge)) <= storage.max_power and float(np.max(lazy.discharge)) <= storage.max_power
+    flow = (0.9 * lazy.charge - lazy.discharge / 0.9) * np.diff(edges)
+    assert np.allclose(lazy.energy[0] + np.cumsum(flow), lazy.energy[1:], rtol=0, atol=1e-6 * storage.usable)
+    assert lazy.energy[-1] == lazy.energy[0]
 
 
 def test_no_storage_gives_the_bus_peak_and_unbounded_storage_the_mean():
@@ -194,9 +212,9 @@ def test_sizing_curve_is_non_increasing():
     assert peaks[-1] < 0.8 * peaks[0]
     # the least storage for a grid cap (storage_needed, a running-sum argument) against the programme itself
     cap = 0.5 * (peaks[0] + peaks[-1])
-    needed = storage_needed(edges, bus, cap, 0.9, math.inf)
-    assert shave(edges, bus, Storage(needed, 0.9), 0.0, peak_only=True).peak <= cap * (1 + LP_TOL)
-    assert shave(edges, bus, Storage(0.98 * needed, 0.9), 0.0, peak_only=True).peak > cap * (1 + LP_TOL)
+    needed = storage_needed(edges, end_peaks(bus), cap, 0.9, math.inf)
+    assert peak_programme(edges, bus, Storage(needed, 0.9)) <= cap * (1 + LP_TOL)
+    assert peak_programme(edges, bus, Storage(0.98 * needed, 0.9)) > cap * (1 + LP_TOL)
 
 
 def test_outputs_carry_the_chain_and_the_trajectory_gives_them(tmp_path):

@@ -30,7 +30,7 @@ from planning.solver.nlp import CycleNLP
 from planning.solver.outcomes import Attempt, NoPlanFound, Unverified
 from planning.solver.precheck import precheck
 from planning.solver.solution import Solution
-from planning.solver.verify import Verification, assess, field_of_check
+from planning.solver.verify import Verification, assess, field_of_check, schedule_matters
 
 REFINEMENTS = 8  # re-solves with a lowered sampled limit
 REFINE_MARGIN = 1e-5  # relative: a refined sampled limit is tightened this much beyond the measured overshoot
@@ -107,7 +107,7 @@ class Search:
                 self.attempts.append(Attempt(res.return_status, block.name, amount, case_field=block.field))
                 return found
             plan = self.plan_of(values, placement, res.return_status)
-            verification, drive = assess(plan, self.case)
+            verification, drive = assess(plan, self.case, least_energy=False)  # the answer's in full
             if verification.passed:
                 solution = Solution(plan, verification, drive)
                 score = self.score_of(solution)
@@ -214,6 +214,14 @@ class Search:
                 f"cannot be met; last: {last}",
                 tuple(self.attempts),
             )
+        if schedule_matters(self.case):  # verified with the storage's lazy schedule: now with its least-energy one
+            verification, drive = assess(self.best.plan, self.case)
+            if not verification.passed:
+                raise Unverified(
+                    "no plan meets the limits: " + Attempt(check=verification.failures()[0]).describe(),
+                    verification.failures()[0],
+                )
+            self.best = replace(self.best, verification=verification, drive=drive)
         plan = self.best.plan
         if self.placement == "free" and plan.placement == "published":
             # the published structure is one of the free structures: report it as the free answer

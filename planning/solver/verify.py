@@ -90,8 +90,11 @@ def verify(plan: Plan, case: Case) -> Verification:
     return assess(plan, case)[0]
 
 
-def assess(plan: Plan, case: Case) -> tuple[Verification, DriveFigures | None]:
-    """:func:`verify`, and with a drive the drive's figures of the plan from the same evaluation."""
+def assess(plan: Plan, case: Case, least_energy: bool = True) -> tuple[Verification, DriveFigures | None]:
+    """:func:`verify`, and with a drive the drive's figures of the plan from the same evaluation.
+    ``least_energy`` False: with a storage, its lazy schedule at the least grid peak instead of the one that
+    draws the least energy (``planning.solver.grid.shave``): the same peak and checks, in O(N) (a search's
+    verifications; its answer is assessed in full, ``planning.solver.search.Search.answer``)."""
     prof = plan.profile
     P = plan.period
     t = dense_times(P, prof.knot_times)
@@ -102,7 +105,7 @@ def assess(plan: Plan, case: Case) -> tuple[Verification, DriveFigures | None]:
         dense.drive_state = drive_state(th, om, al, case.machine, case.drive_model)
         dense.integrals = cycle_integrals(prof, case)
         if case.drive.electrical:
-            dense.power = power_figures(prof, case, t, dense.drive_state)
+            dense.power = power_figures(prof, case, t, dense.drive_state, least_energy)
     checks = _cycle_checks(dense)
     for limit in limits_of(case):
         checks += limit.check(dense)
@@ -116,6 +119,11 @@ def assess(plan: Plan, case: Case) -> tuple[Verification, DriveFigures | None]:
         figures = drive_figures(prof, case, dense.integrals, (th, dense.drive_state))
         figures = replace(figures, power=dense.power)
     return verification, figures
+
+
+def schedule_matters(case: Case) -> bool:
+    """Whether :func:`assess`'s ``least_energy`` changes anything for ``case`` (a storage on the bus)."""
+    return case.drive is not None and case.drive.storage is not None
 
 
 def _power_checks(power: PowerFigures, integrals: dict) -> list[Check]:
