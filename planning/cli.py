@@ -47,7 +47,9 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--placement", choices=("free", "published"), help="where theta1/theta4 may fall (default: case)")
     s.add_argument("--law", choices=tuple(LAWS), default=None, help="motion law (default: case, improved-s-curve)")
     s.add_argument("--objective", choices=OBJECTIVES, default=None, help="what to optimise (default: case, max-spm)")
-    s.add_argument("--spm", type=_rate, default=None, help="the line's rate for min-rms-torque / min-energy")
+    s.add_argument(
+        "--spm", type=_rate, default=None, help="the line's rate for min-rms-torque / min-energy / min-grid-peak"
+    )
     s.add_argument("--json", action="store_true", help="print result.json instead of the summary")
     s.add_argument("--format", choices=PLOT_FORMATS, default="png", help="figure format (default png)")
     s.add_argument("--no-plots", action="store_true", help="do not draw the figures")
@@ -77,14 +79,14 @@ def _parser() -> argparse.ArgumentParser:
     w.add_argument("--workers", type=_whole(1, 256), default=2, help="local worker processes (default 2)")
     w.add_argument("--scheduler", help="address of a Dask distributed scheduler (instead of local workers)")
     w.add_argument("--out", required=True, help="output folder (sweep.csv, sweep.json, sweep_spm.png)")
-    t = sub.add_parser("tradeoff", help="the least RMS torque or energy at each line rate, beside waiting")
+    t = sub.add_parser("tradeoff", help="the least RMS torque, energy or grid peak at each line rate, beside waiting")
     t.add_argument("case", help="case file (YAML) with a drive: section")
     t.add_argument("--spm", required=True, metavar="START:STOP:COUNT", help="rates, e.g. 6:max:7 (max: the fastest)")
     t.add_argument(
         "--objective",
         choices=OBJECTIVES[1:],
         default=None,
-        help="min-rms-torque or min-energy (default: case, else min-rms-torque)",
+        help="min-rms-torque, min-energy or min-grid-peak (default: case, else min-rms-torque)",
     )
     t.add_argument("--law", choices=tuple(LAWS), default=None, help="motion law (default: case)")
     t.add_argument("--placement", choices=("free", "published"), help="where theta1/theta4 may fall")
@@ -438,7 +440,7 @@ def _tradeoff(case, args) -> int:
     import planning.solver.optimize  # noqa: F401 - loaded once here, inherited by forked workers
     from planning.model.case import CaseError
     from planning.reports.folder import TRADEOFF_FILES, write_atomic
-    from planning.tradeoff import COLUMNS, parse_rates, run_tradeoff, table_text, write_rows
+    from planning.tradeoff import columns, parse_rates, run_tradeoff, table_text, write_rows
 
     rates = parse_rates(args.spm)
     if case.drive is None:
@@ -455,7 +457,7 @@ def _tradeoff(case, args) -> int:
 
     title = f"{case.name}: {objective} at the line's rate ({case.planner.motion_law})"
     writers = {
-        "tradeoff.csv": lambda p: write_rows(p, result.rows, COLUMNS),
+        "tradeoff.csv": lambda p: write_rows(p, result.rows, columns(case)),
         "tradeoff.png": lambda p: save(tradeoff_figure(result.rows, case, title), p),
     }
     files = write_atomic(out, writers, TRADEOFF_FILES, keep=args.case)

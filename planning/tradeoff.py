@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from planning.model.case import Case, Placement
+from planning.solver.solution import GRID_PEAK
 from planning.sweep import SweepError, _cell, execute
 
 # one row per rate: the plan's figures, the baseline's, the savings
@@ -45,7 +46,18 @@ COLUMNS = (
     "solve_time_s",
     "message",
 )
+# with the drive's electrical side (``Case.electrical``; min-grid-peak's): the grid's peak and its saving
+GRID_COLUMNS = ("grid_peak_kW", "baseline_grid_peak_kW", "saving_grid_peak_pct")
 MAX_RATES = 1000
+
+
+def columns(case: Case) -> tuple[str, ...]:
+    """The columns of ``tradeoff.csv`` for ``case``: :data:`COLUMNS`, and :data:`GRID_COLUMNS` before the
+    solve's status and time where the grid's side is computed."""
+    if not case.electrical:
+        return COLUMNS
+    at = COLUMNS.index("improved_on_baseline")
+    return COLUMNS[:at] + GRID_COLUMNS + COLUMNS[at:]
 
 
 @dataclass(frozen=True)
@@ -114,6 +126,10 @@ def solved_row(sol: Any, case: Case) -> dict[str, Any]:
         row.update({f"{prefix}{k}": figures[k] for k in FIGURE_FIELDS})
     row["saving_rms_pct"] = sol.saving_pct("rms_motor_torque_Nm")
     row["saving_energy_pct"] = sol.saving_pct("supply_energy_kJ")
+    if sol.drive.power is not None and a.baseline.drive.power is not None:
+        row["grid_peak_kW"] = sol.drive.power.grid_peak_kW
+        row["baseline_grid_peak_kW"] = a.baseline.drive.power.grid_peak_kW
+        row["saving_grid_peak_pct"] = sol.saving_pct(GRID_PEAK)
     return row
 
 
@@ -154,13 +170,15 @@ def run_tradeoff(
     placement: Placement | None = None,
     meanwhile: Callable[[], object] | None = None,
 ) -> TradeoffResult:
-    """One plan per rate at ``case.planner.objective`` (min-rms-torque or min-energy); ``meanwhile``: see
+    """One plan per rate at ``case.planner.objective`` (min-rms-torque, min-energy or min-grid-peak); ``meanwhile``: see
     ``planning.sweep.execute``."""
     from planning.solver.halves_nlp import halves_nlp_for
     from planning.solver.optimize import solve
 
     fastest = solve(case.with_objective("max-spm"), placement)
     halves_nlp_for(case, drive=True, rate=True)  # built once here, inherited by forked workers
+    if case.planner.objective == "min-grid-peak":
+        halves_nlp_for(case, drive=True, rate=True, peak=True)
     values = rates.values(fastest.plan.spm)
     order = list(enumerate(values.tolist()))[::-1]  # from the fastest rate down
     # each rate a task of its own (each is solved cold, independent of the others): the workers take the
@@ -184,10 +202,12 @@ def write_rows(path: Path, rows: list[dict[str, Any]], columns: tuple[str, ...])
 
 def table_text(result: TradeoffResult, case: Case) -> str:
     """The console table: per rate the RMS torque and the energy, optimised against the baseline."""
+    grid = case.electrical
     lines = [
         f"{case.name}: {result.objective} at the line's rate ({case.planner.motion_law}); "
         f"rated torque {case.drive.motor.rated_torque_Nm:g} N m, peak {case.drive.motor.peak_torque_Nm:g} N m",
-        f"  {'SPM':>8} {'RMS kN m':>9} {'baseline':>9} {'saving':>7} {'energy kJ':>10} {'baseline':>9} {'saving':>7}",
+        f"  {'SPM':>8} {'RMS kN m':>9} {'baseline':>9} {'saving':>7} {'energy kJ':>10} {'baseline':>9} {'saving':>7}"
+        + (f" {'grid kW':>8} {'baseline':>9} {'saving':>7}" if grid else ""),
     ]
     for r in result.rows:
         if r["status"] != "verified":
@@ -198,6 +218,11 @@ def table_text(result: TradeoffResult, case: Case) -> str:
             f"{r['baseline_rms_motor_torque_Nm'] / 1e3:9.2f} "
             f"{r['saving_rms_pct']:6.1f}% {r['supply_energy_kJ']:10.1f} {r['baseline_supply_energy_kJ']:9.1f} "
             f"{r['saving_energy_pct']:6.1f}%"
+            + (
+                f" {r['grid_peak_kW']:8.0f} {r['baseline_grid_peak_kW']:9.0f} {r['saving_grid_peak_pct']:6.1f}%"
+                if grid
+                else ""
+            )
         )
     lines.append("  " + result.thermal_statement(case))
     return "\n".join(lines)

@@ -147,7 +147,7 @@ def test_solver_success_but_failed_verification_is_exit_3(monkeypatch, tmp_path,
     import planning.solver.search as search
     from planning.solver.verify import Check, Verification
 
-    def failing(plan, case):
+    def failing(plan, case, **_):
         check = Check("|slider acceleration|", 9999.0, 3500.0, "mm/s^2", "max", False, "slider_accel")
         return Verification((check,), 1e-3, 10), None
 

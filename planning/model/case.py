@@ -45,7 +45,7 @@ from press.linkage import KnuckleJoint, LinkageError, LinkDrive
 from press.mechanism import Mechanism
 
 Placement = Literal["free", "published"]  # where theta1 / theta4 may fall (the paper's Fig. 6, or anywhere)
-Objective = Literal["max-spm", "min-rms-torque", "min-energy"]  # what the planner optimises
+Objective = Literal["max-spm", "min-rms-torque", "min-energy", "min-grid-peak"]  # what the planner optimises
 OBJECTIVES: tuple[str, ...] = Objective.__args__
 __all__ = ["RPM", "Case", "CaseError", "show_value"]  # RPM and CaseError: where the model's users find them
 
@@ -359,7 +359,8 @@ class PlannerModel(_Model):
     """``motion_law``, ``placement`` of the key points (free | published) and ``law_parameter``: the
     law's shape parameter held fixed (seven-segment jerk share, logistic flexible); omitted: optimised.
     ``objective``: the most strokes (``max-spm``), or at ``target_spm`` [strokes/min] the least RMS motor
-    torque (``min-rms-torque``) or the least energy drawn from the supply per stroke (``min-energy``)."""
+    torque (``min-rms-torque``), the least energy drawn from the supply per stroke (``min-energy``) or the
+    least peak power drawn from the grid (``min-grid-peak``, with the case's storage)."""
 
     motion_law: LawName = Field(
         DEFAULT_LAW,
@@ -380,14 +381,14 @@ class PlannerModel(_Model):
         "max-spm",
         title="objective",
         description=(
-            "max-spm: the most strokes; min-rms-torque or min-energy: the gentlest plan at the target rate (needs a "
-            "drive)."
+            "max-spm: the most strokes; min-rms-torque, min-energy or min-grid-peak: the gentlest plan at the "
+            "target rate (needs a drive)."
         ),
     )
     target_spm: Annotated[float, Field(gt=0, le=1e4)] | None = Field(
         None,
         title="target rate [strokes/min]",
-        description="The line's rate for min-rms-torque and min-energy.",
+        description="The line's rate for min-rms-torque, min-energy and min-grid-peak.",
     )
 
 
@@ -452,6 +453,12 @@ class Case(_Model):
         """The press mechanism of the case (``press.mechanism``): the crank-slider (in line or offset), the
         link drive or the knuckle joint."""
         return _machine(self.press)
+
+    @property
+    def electrical(self) -> bool:
+        """The plan's power chain to the grid is computed and written: the drive states its electrical side
+        (``DriveSection.electrical``) or the objective is the grid's peak."""
+        return self.drive is not None and (self.drive.electrical or self.planner.objective == "min-grid-peak")
 
     @property
     def key_angles(self) -> np.ndarray:

@@ -460,8 +460,9 @@ def tradeoff_figure(rows: list[dict[str, Any]], case: Any, title: str) -> Figure
     """The motor-sizing picture: RMS and peak motor torque against SPM with the motor's rated and peak
     torque as lines (top), energy from the supply per stroke against SPM on an axis around the data
     (middle), and what the optimised plan saves against the baseline, in % (bottom); optimised plans
-    solid, the baseline (the max-SPM plan with the spare time given to the transfer) dashed; a rate
-    without a plan as a red line. Legends right of the panels."""
+    solid, the baseline (the max-SPM plan with the spare time given to the transfer) dashed; with the
+    grid's side (``grid_peak_kW`` in the rows) the grid's peak on a second axis of the middle panel and its
+    saving below; a rate without a plan as a red line. Legends right of the panels."""
     fig = Figure(figsize=(12, 10), dpi=90)
     fig.subplots_adjust(left=0.08, right=0.68, top=0.94, bottom=0.07, hspace=0.25)
     FigureCanvasAgg(fig)
@@ -485,10 +486,27 @@ def tradeoff_figure(rows: list[dict[str, Any]], case: Any, title: str) -> Figure
         ):
             ls = "-" if not prefix else "--"
             ax.plot(spm, column(prefix + name) * unit, marker + ls, color=colour, label=f"{what}, {label}", **style)
-    for name, marker, colour, what in (
+    grid = bool(ok) and all(r.get("grid_peak_kW") is not None for r in ok)
+    if grid:
+        right = middle.twinx()
+        right.plot(spm, column("grid_peak_kW"), "D-", color="tab:purple", lw=1.5, ms=4, label="grid peak, optimised")
+        right.plot(
+            spm,
+            column("baseline_grid_peak_kW"),
+            "D--",
+            color="tab:purple",
+            lw=1,
+            ms=3,
+            mfc="none",
+            label="grid peak, baseline",
+        )
+        right.set_ylabel("grid peak [kW]", color="tab:purple")
+        right.set_ylim(bottom=0)
+    savings = (
         ("rms_motor_torque_Nm", "o", "tab:blue", "RMS torque"),
         ("supply_energy_kJ", "o", "tab:green", "energy per stroke"),
-    ):
+    ) + ((("grid_peak_kW", "D", "tab:purple", "grid peak"),) if grid else ())
+    for name, marker, colour, what in savings:
         if ok:
             saving = 100.0 * (1.0 - column(name) / column("baseline_" + name))
             bottom.plot(spm, saving, marker + "-", color=colour, lw=1.5, ms=4, label=f"{what} saved")
@@ -507,6 +525,7 @@ def tradeoff_figure(rows: list[dict[str, Any]], case: Any, title: str) -> Figure
     bottom.set_xlabel("strokes per minute")
     for ax in (top, middle, bottom):
         ax.grid(True, lw=0.3)
-        _legend(ax, anchor=(1.02, 1.0))
+        twins = (right,) if grid and ax is middle else ()
+        _legend(ax, *twins, anchor=(1.12 if twins else 1.02, 1.0))
     top.set_title(title, fontsize=10)
     return fig

@@ -18,7 +18,7 @@ from planning.model.limits.slider_accel import SliderAccelLimit
 from planning.model.profile import MAX_STEP_S, Profile
 from planning.reports.stages import stage_table
 from planning.solver.grid import Schedule, power_columns, schedule_of
-from planning.solver.solution import Solution
+from planning.solver.solution import GRID_PEAK, Solution
 from press.dynamics import drive_state
 from press.mechanism import Mechanism
 
@@ -57,7 +57,7 @@ def sample_profile(
     if case is not None and case.drive is not None:
         s = drive_state(th, om, al, case.machine, case.drive_model)
         columns += [s["crank_torque_Nm"], s["motor_speed_rad_s"] / RPM, s["motor_torque_Nm"], s["motor_power_W"] / 1e3]
-        if case.drive.electrical:
+        if case.electrical:
             schedule = schedule if schedule is not None else schedule_of(profile, case)
             c = power_columns(schedule, s, t, case)
             columns += [c["copper_loss_W"] / 1e3, c["bus_power_W"] / 1e3, c["grid_power_W"] / 1e3]
@@ -69,7 +69,7 @@ def trajectory_columns(case: Case) -> tuple[str, ...]:
     """The columns of ``trajectory.csv`` for ``case``."""
     if case.drive is None:
         return TRAJECTORY_COLUMNS
-    return TRAJECTORY_COLUMNS + DRIVE_COLUMNS + (POWER_COLUMNS if case.drive.electrical else ())
+    return TRAJECTORY_COLUMNS + DRIVE_COLUMNS + (POWER_COLUMNS if case.electrical else ())
 
 
 def trajectory(solution: Solution, case: Case, max_step: float = MAX_STEP_S) -> dict[str, np.ndarray]:
@@ -215,6 +215,9 @@ def objective_block(solution: Solution, case: Case) -> dict[str, Any]:
             "rms_torque": solution.saving_pct("rms_motor_torque_Nm"),
             "energy": solution.saving_pct("supply_energy_kJ"),
         }
+        if b.drive.power is not None and solution.drive.power is not None:  # the grid's side (Case.electrical)
+            out["baseline"]["grid_peak_kW"] = b.drive.power.grid_peak_kW
+            out["saving_pct"]["grid_peak"] = solution.saving_pct(GRID_PEAK)
         out["improved_on_baseline"] = a.improved
         out["fastest_spm"] = a.fastest_spm
     return out
@@ -298,6 +301,12 @@ def summary_text(result: dict[str, Any]) -> str:
             f"RMS {b['rms_motor_torque_Nm'] / 1e3:.2f} kN m, energy {b['supply_energy_kJ']:.1f} kJ; "
             f"saving {saving['rms_torque']:.1f} % "
             f"RMS torque, {saving['energy']:.1f} % energy"
+            + (
+                f", {saving['grid_peak']:.1f} % grid peak "
+                f"({b['grid_peak_kW']:.0f} -> {r['power']['grid_peak_kW']:.0f} kW)"
+                if "grid_peak" in saving
+                else ""
+            )
             + ("" if r["improved_on_baseline"] else " (no solve beat the baseline: it is the plan)"),
         ]
     lines.append("")

@@ -104,12 +104,15 @@ def _nanmax(values: np.ndarray) -> float:
 
 
 def _binding_fields(result: dict[str, Any]) -> list[str]:
-    """The case fields of the checks that bind (``result.json``'s verification), in its order."""
-    from planning.solver.verify import field_of_check
+    """The case fields of the checks that bind (``result.json``'s verification), in its order; the storage
+    schedule's bounds apart (``planning.solver.verify.SCHEDULE_CHECKS``)."""
+    from planning.solver.verify import SCHEDULE_CHECKS, field_of_check
 
     fields = []
     for check in result["verification"]["checks"]:
         if check["kind"] == "equal" or check["margin"] > BINDING_SHARE * max(abs(check["limit"]), 1e-12):
+            continue
+        if check["id"] in SCHEDULE_CHECKS:
             continue
         name = field_of_check(check["id"]) or check["name"]
         if name not in fields:

@@ -59,6 +59,7 @@ from planning.solver.nlp import (
     CycleNLP,
     Rows,
     add_limit_rows,
+    bus_power_samples,
     clipped_advance,
     draw_states,
     nlp_limits,
@@ -86,6 +87,8 @@ VARIABLES: tuple[tuple[str, str], ...] = (
     ("die_up_time", "time"),  # time of the ascending die-height crossing
 )
 VARIABLE_INDEX = {name: i for i, (name, _) in enumerate(VARIABLES)}
+# the rate NLP of the least grid peak adds the bus power's peak at the samples [W] (an epigraph variable)
+PEAK_VARIABLE = ("bus_peak", "power")
 SAMPLES_CONSTANT = 20  # samples on the constant-speed transfer dwell
 MIN_HALF_S = 4e-3  # [s] lower bound on the duration of a half (1 ms per improved-S-curve sub-segment)
 TOP_SPEED = 1e3  # [rad/s] upper bound of the crank speeds (far above any press)
@@ -134,6 +137,20 @@ def variable_bounds(
     return lo, hi
 
 
+def peak_variable_scales(case: Case) -> np.ndarray:
+    """:func:`variable_scales` and the bus peak's: the motor's rated torque at its base speed [W]."""
+    motor = case.drive.motor
+    return np.append(variable_scales(case), motor.rated_torque_Nm * motor.base_speed_rpm * RPM)
+
+
+def peak_variable_bounds(
+    case: Case, layout: ParameterLayout, w2_lo: float, w2_hi: float, parameters: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`variable_bounds` and the bus peak's (free)."""
+    lo, hi = variable_bounds(case, layout, w2_lo, w2_hi, parameters)
+    return np.append(lo, -np.inf), np.append(hi, np.inf)
+
+
 def make_plan(case: Case, values: dict[str, float], placement: Placement, info: SolverInfo) -> Plan:
     """The plan of the NLP's variable ``values``: the law's cycle rotated to start at TDC, with where theta1
     and theta4 fall (``structure``) and the values themselves (a neighbour's warm start)."""
@@ -171,14 +188,16 @@ def _build(
     rate: bool,
     zone: bool,
     links: tuple[str, ...] = (),
+    peak: bool = False,
 ) -> CycleNLP:
     law = get_law(law_name)
     drive = drive or rate
     zone = zone or rate
     layout = ParameterLayout(formula, limit_ids, drive, rate, links if drive else ())
-    x = ca.SX.sym("x", len(VARIABLES))
+    variables = VARIABLES + ((PEAK_VARIABLE,) if peak else ())
+    x = ca.SX.sym("x", len(variables))
     p_case = ca.SX.sym("p", layout.size)
-    p_scale = ca.SX.sym("scale", len(VARIABLES))  # physical value = scale * x, chosen per case
+    p_scale = ca.SX.sym("scale", len(variables))  # physical value = scale * x, chosen per case
     v = {name: x[i] * p_scale[i] for i, (name, _) in enumerate(VARIABLES)}
     unit = {name: p_scale[i] for i, (name, _) in enumerate(VARIABLES)}
     q = layout.symbols(p_case)
@@ -278,9 +297,15 @@ def _build(
         heat, energy = objective_terms(q, torque, states[2], times)
         objective = q["weight_period"] * params.period + q["weight_heat"] * heat + q["weight_energy"] * energy
         objective -= q["weight_dwell"] * params.transfer_dwell
+    if peak:  # the least grid peak: bus power <= bus_peak at every sample, bus_peak weighed (weight_peak)
+        bus_peak, power_unit = x[-1] * p_scale[-1], p_scale[-1]
+        bus = bus_power_samples(q, torque)
+        rows.add("bus power under its peak", (bus - bus_peak) / power_unit, -np.inf, 0.0, "planner.objective")
+        objective += q["weight_peak"] * bus_peak
 
     problem = {"x": x, "p": ca.vertcat(p_case, p_scale), "f": objective, "g": ca.vertcat(*rows.g)}
     kind = ("_rate" if rate else "_drive" if drive else "") + ("_zone" if zone and not rate else "")
+    kind += "_peak" if peak else ""
     options = {**CYCLE_OPTIONS, **(DRIVE_OPTIONS if drive else {}), **(RATE_OPTIONS if rate else {})}
     program = NLPSolver("press_cycle_" + law_name.replace("-", "_") + kind, problem, options, lift=lift)
     return CycleNLP(
@@ -288,13 +313,13 @@ def _build(
         *rows.bounds(),
         tuple(rows.blocks),
         layout,
-        VARIABLES,
-        variable_scales,
-        variable_bounds,
+        variables,
+        peak_variable_scales if peak else variable_scales,
+        peak_variable_bounds if peak else variable_bounds,
         make_plan,
         published_rows,
         refinable,
-        None if zone else partial(halves_nlp, law_name, formula, limit_ids, drive, rate, True, links),
+        None if zone else partial(halves_nlp, law_name, formula, limit_ids, drive, rate, True, links, peak),
     )
 
 
@@ -307,23 +332,25 @@ def halves_nlp(
     rate: bool = False,
     zone: bool = False,
     links: tuple[str, ...] = (),
+    peak: bool = False,
 ) -> CycleNLP:
     """The compiled NLP of motion law ``law`` on a mechanism of closed form ``formula`` holding the limits
     ``limit_ids``, with the motor's torque when ``drive`` (the mechanism's massive ``links`` in it);
     ``rate``: the drive NLP of a target rate (see the module docstring); ``zone``: the limits that hold in
     the die zone held at every sample there (the rate NLP's always; otherwise the denser variant a search
-    turns to when a plan's crank speed peaks inside the die zone, between the crossings). Built on first
+    turns to when a plan's crank speed peaks inside the die zone, between the crossings); ``peak``: the rate
+    NLP with the bus power's peak as a variable (:data:`PEAK_VARIABLE`; the least grid peak). Built on first
     use in a process, then reused for every case and start."""
-    return _build(law, formula, limit_ids, drive, rate, zone, links)
+    return _build(law, formula, limit_ids, drive, rate, zone, links, peak)
 
 
-def halves_nlp_for(case: Case, drive: bool | None = None, rate: bool = False) -> CycleNLP:
+def halves_nlp_for(case: Case, drive: bool | None = None, rate: bool = False, peak: bool = False) -> CycleNLP:
     """The NLP of ``case``'s law, mechanism and limits; ``drive`` None: with the motor's rows when the case
-    has a drive."""
+    has a drive; ``rate``, ``peak``: see :func:`halves_nlp`."""
     drive = case.drive is not None if drive is None else drive
     limit_ids = nlp_limits(case, drive or rate)
     links = drive_links(case) if drive or rate else ()
-    return halves_nlp(case.planner.motion_law, case.machine.formula, limit_ids, drive, rate, False, links)
+    return halves_nlp(case.planner.motion_law, case.machine.formula, limit_ids, drive, rate, False, links, peak)
 
 
 def fresh_build(case: Case) -> CycleNLP:

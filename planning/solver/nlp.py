@@ -290,6 +290,13 @@ def sample_states(
     return fields, torque, lift
 
 
+def bus_power_samples(q: dict, drive: DriveSamples) -> Any:
+    """The bus power at the samples [W] for the least grid peak (``press.power``): the motor's shaft power and
+    copper loss through the converter, ``(T_m omega_m + k T_m^2) / eta_c`` (a braking sample's is lower than
+    the converter's ``eta_c`` times, and far from any peak)."""
+    return (drive.tm * drive.speed + q["copper_coefficient"] * drive.tm**2) / q["converter_efficiency"]
+
+
 def objective_terms(q: dict, drive: DriveSamples, al: Any, times: Any) -> tuple[Any, Any]:
     """The rate NLP's trapezoidal ``(heat, supply energy)``: integral T_m^2 dt [N^2 m^2 s] and integral
     (r P + (1 - r) smoothmax(P, 0)) dt [J], on a smooth torque: the gear's loss switches sides where T_c

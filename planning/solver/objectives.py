@@ -9,7 +9,12 @@ held fixed) the planner minimises
 - ``min-energy``: the energy drawn from the supply per stroke ``E+ - r |E-|`` (``r`` =
   ``drive.regen_efficiency``). ``max(P, 0)`` has a kink where the power changes sign: the NLP uses the
   smooth ``(P + sqrt(P^2 + eps^2)) / 2`` on its samples; the verification and every output use the
-  exact integral (``planning.model.drive``).
+  exact integral (``planning.model.drive``);
+- ``min-grid-peak``: the grid's peak power with the case's storage (``planning.solver.grid``). The NLP
+  (the rate NLP's peak variant) minimises the bus power's peak at its samples, an epigraph variable
+  ``bus_peak >= (T_m omega_m + k T_m^2) / eta_c`` at every sample, with the heat as a tie-break; the
+  answer is chosen by the exact grid peak on the dense grid (with a storage: the least peak its schedule
+  reaches, which the NLP does not model).
 
 Every limit of ``max-spm`` still holds. Steps: the fastest plan (``max-spm``; a target above its rate
 is :class:`Infeasible`, naming the limits that bind there); the **baseline**, the max-SPM plan run at
@@ -31,16 +36,17 @@ from dataclasses import replace
 
 from planning.model.case import Case, Placement
 from planning.model.plan import Plan
-from planning.solver.halves_nlp import VARIABLE_INDEX, VARIABLES, halves_nlp_for
+from planning.solver.halves_nlp import PEAK_VARIABLE, VARIABLE_INDEX, VARIABLES, halves_nlp_for
 from planning.solver.max_spm import solve_max_spm
 from planning.solver.outcomes import Infeasible, NoPlanFound
 from planning.solver.search import Search, prepare
 from planning.solver.solution import AtRate, Solution, objective_value
-from planning.solver.verify import field_of_check
+from planning.solver.verify import assess, field_of_check
 
 RATE_TOLERANCE = 1e-9  # relative: a target this close above the fastest rate is that rate
 SAME_PERIOD_S = 1e-9  # [s] a plan whose period is this close to the target cycle time runs at the rate
-HEAT_TIE_BREAK = 1e-3  # min-energy: the heat's weight against the energy's (both normalised by the baseline's)
+HEAT_TIE_BREAK = 1e-3  # min-energy, min-grid-peak: the heat's weight against the objective's (both normalised)
+PEAK_START_HEADROOM = 1.05  # min-grid-peak: a start's bus peak this much above the slower starts' grid peak
 BASELINE_SCORE = 1.0  # the objective's score of the baseline (the objectives are normalised by its figures)
 
 
@@ -64,6 +70,9 @@ def solve_at_rate(
     objective, target = case.planner.objective, case.planner.target_spm
     if fastest is None:
         fastest = solve_max_spm(case.with_objective("max-spm"), placement)
+    if case.electrical and fastest.drive.power is None:  # the max-SPM case leaves the grid out: its figures here
+        verification, drive = assess(fastest.plan, case)
+        fastest = replace(fastest, verification=verification, drive=drive)
     _check_reachable(target, fastest, case)
     period = 60.0 / target
     baseline = _baseline(case, placement, fastest, period, neighbour_baseline, confirm)
@@ -71,17 +80,26 @@ def solve_at_rate(
 
     if baseline is fastest:  # at the fastest rate the limits leave (generically) that one plan
         return replace(fastest, at_rate=AtRate(objective, target, fastest.plan.spm, fastest, False))
-    search = _rate_search(case, placement, period)
-    # normalised by the baseline: its objective is 1 (heat [N^2 m^2 s], energy [J] in the NLP)
+    peak = objective == "min-grid-peak"
+    search = _rate_search(case, placement, period, peak)
+    # normalised by the baseline: its objective is 1 (heat [N^2 m^2 s], energy [J], bus peak [W] in the NLP)
     heat_weight = 1.0 / (baseline.drive.rms_motor_torque_Nm**2 * period)
     if objective == "min-rms-torque":
         search.parameters[search.parameter("weight_heat")] = heat_weight
+    elif peak:  # the peak leaves whole stretches of the cycle free: the heat breaks ties
+        search.parameters[search.parameter("weight_peak")] = 1.0 / (baseline.drive.power.bus_peak_kW * 1e3)
+        search.parameters[search.parameter("weight_heat")] = HEAT_TIE_BREAK * heat_weight
     else:  # the energy has flat directions (a plan's speeds can trade without changing it): the heat breaks ties
         search.parameters[search.parameter("weight_energy")] = 1.0 / (baseline.drive.supply_energy_kJ * 1e3)
         search.parameters[search.parameter("weight_heat")] = HEAT_TIE_BREAK * heat_weight
     search.score = lambda solution: objective_value(solution, objective) / scale
     search.consider(baseline, BASELINE_SCORE)
     starts = [_slowed(fastest.plan, period / fastest.plan.period, search), baseline.plan.nlp_values]
+    if peak:  # the bus peak's start: above what either start draws
+        top = PEAK_START_HEADROOM * 1e3 * max(baseline.drive.power.bus_peak_kW, fastest.drive.power.bus_peak_kW)
+        starts = [{**values, PEAK_VARIABLE[0]: top} for values in starts]
+        if neighbour is not None and PEAK_VARIABLE[0] not in neighbour.nlp_values:
+            neighbour = replace(neighbour, nlp_values={**neighbour.nlp_values, PEAK_VARIABLE[0]: top})
     _run_starts(search, starts, neighbour, placement, confirm, to_beat=BASELINE_SCORE)
     improved = search.best is not baseline
     answer = search.answer()
@@ -110,9 +128,10 @@ def _check_reachable(target: float, fastest: Solution, case: Case) -> None:
     )
 
 
-def _rate_search(case: Case, placement: Placement, period: float) -> Search:
-    """The rate NLP's search with the cycle time held at ``period`` [s] and every objective weight 0."""
-    search = prepare(case, placement, halves_nlp_for(case, drive=True, rate=True))
+def _rate_search(case: Case, placement: Placement, period: float, peak: bool = False) -> Search:
+    """The rate NLP's search (``peak``: its peak variant) with the cycle time held at ``period`` [s] and every
+    objective weight 0."""
+    search = prepare(case, placement, halves_nlp_for(case, drive=True, rate=True, peak=peak))
     search.parameters = search.parameters.copy()
     search.parameters[search.parameter("target_period")] = period
     search.parameters[search.parameter("weight_period")] = 0.0

@@ -51,7 +51,7 @@ DRIVE = (
 # centre of gravity lies [mm] and its inertia [kg m^2]
 LINK = ("mass", "along", "across", "inertia")
 # the objective of the rate NLP (``planning.solver.objectives``): f = weight_period * period + weight_heat *
-# heat + weight_energy * supply energy - weight_dwell * transfer dwell
+# heat + weight_energy * supply energy - weight_dwell * transfer dwell (+ weight_peak * bus peak, its peak variant)
 OBJECTIVE = (
     "weight_period",  # [1/s]
     "weight_heat",  # [1/(N^2 m^2 s)] heat = integral T_m^2 dt over the cycle
@@ -59,6 +59,9 @@ OBJECTIVE = (
     "weight_dwell",  # [1/s] the constant-speed transfer dwell
     "regen",  # r, the share of the returned energy the supply takes back, 0 ... 1
     "power_smoothing",  # [W] epsilon of smoothmax(P, 0) = (P + sqrt(P^2 + epsilon^2)) / 2
+    "weight_peak",  # [1/W] the bus power's peak (the rate NLP's peak variant)
+    "copper_coefficient",  # [W/(N m)^2] copper loss = k T_m^2 (drive.motor.copper_loss_at_rated_kW / rated^2)
+    "converter_efficiency",  # eta_c, the bus power's P_el / eta_c
 )
 DRAW_SAMPLES_DRIVE = 80  # with a drive the draw is sampled finer: the forming force changes fast there
 FORMING_SAMPLES = DRAW_SAMPLES_DRIVE + 1  # forming force [N] at the draw's samples, theta2 ... theta3
@@ -202,6 +205,9 @@ def objective_values(case: Case) -> dict[str, float]:
         "weight_dwell": 0.0,
         "regen": case.drive.regen_efficiency,
         "power_smoothing": POWER_SMOOTHING * motor.rated_torque_Nm * motor.base_speed_rpm * RPM,
+        "weight_peak": 0.0,
+        "copper_coefficient": motor.copper_loss_at_rated_kW * 1e3 / motor.rated_torque_Nm**2,
+        "converter_efficiency": case.drive.converter_efficiency,
     }
 
 

@@ -12,6 +12,8 @@ from planning.model.drive import DriveFigures
 from planning.model.plan import Plan
 from planning.solver.verify import Verification
 
+GRID_PEAK = "grid_peak_kW"  # the power figures' key of the grid's peak
+
 
 @dataclass(frozen=True)
 class Solution:
@@ -25,10 +27,12 @@ class Solution:
     at_rate: AtRate | None = None
 
     def saving_pct(self, key: str) -> float:
-        """How much lower this plan's drive figure ``key`` (``rms_motor_torque_Nm`` or ``supply_energy_kJ``,
-        what an objective at a rate saves) is than the baseline's at the same rate [%] (needs ``at_rate``)."""
-        base = getattr(self.at_rate.baseline.drive, key)
-        return 100.0 * (base - getattr(self.drive, key)) / base if base else 0.0
+        """How much lower this plan's drive figure ``key`` (``rms_motor_torque_Nm``, ``supply_energy_kJ`` or,
+        from the power figures, ``grid_peak_kW``: what an objective at a rate saves) is than the baseline's at
+        the same rate [%] (needs ``at_rate``)."""
+        base, ours = ((s.drive.power if key == GRID_PEAK else s.drive) for s in (self.at_rate.baseline, self))
+        base, ours = getattr(base, key), getattr(ours, key)
+        return 100.0 * (base - ours) / base if base else 0.0
 
 
 @dataclass(frozen=True)
@@ -47,6 +51,9 @@ class AtRate:
 
 def objective_value(solution: Solution, objective: str) -> float:
     """The exact objective of a verified plan: RMS torque squared [N^2 m^2] (the heat over the fixed cycle
-    time) for ``min-rms-torque``, else the energy drawn from the supply per stroke [kJ]."""
+    time) for ``min-rms-torque``, the grid's peak [kW] with the case's storage for ``min-grid-peak`` (its
+    power figures, ``Case.electrical``), else the energy drawn from the supply per stroke [kJ]."""
     d = solution.drive
+    if objective == "min-grid-peak":
+        return d.power.grid_peak_kW
     return d.rms_motor_torque_Nm**2 if objective == "min-rms-torque" else d.supply_energy_kJ

@@ -104,7 +104,7 @@ def assess(plan: Plan, case: Case, least_energy: bool = True) -> tuple[Verificat
     if case.drive is not None:
         dense.drive_state = drive_state(th, om, al, case.machine, case.drive_model)
         dense.integrals = cycle_integrals(prof, case)
-        if case.drive.electrical:
+        if case.electrical:
             dense.power = power_figures(prof, case, t, dense.drive_state, least_energy)
     checks = _cycle_checks(dense)
     for limit in limits_of(case):
@@ -112,7 +112,7 @@ def assess(plan: Plan, case: Case, least_energy: bool = True) -> tuple[Verificat
     if case.drive is not None:
         checks.append(_energy_balance(dense.integrals))
     if dense.power is not None:
-        checks += _power_checks(dense.power, dense.integrals)
+        checks += _power_checks(dense.power, dense.integrals, case.drive.storage is not None)
     verification = Verification(tuple(checks), float(np.max(np.diff(t))), int(t.size))
     figures = None
     if case.drive is not None:
@@ -126,10 +126,10 @@ def schedule_matters(case: Case) -> bool:
     return case.drive is not None and case.drive.storage is not None
 
 
-def _power_checks(power: PowerFigures, integrals: dict) -> list[Check]:
+def _power_checks(power: PowerFigures, integrals: dict, storage: bool) -> list[Check]:
     """The power chain over the cycle: the grid's energy is the forming work and every loss (the kinetic
-    energies return to their start), and the storage stays within its usable energy and ends where it
-    started."""
+    energies return to their start), and (``storage``) the storage stays within its usable energy and ends
+    where it started."""
     losses = (
         power.gear_loss_kJ
         + power.copper_loss_kJ
@@ -140,7 +140,7 @@ def _power_checks(power: PowerFigures, integrals: dict) -> list[Check]:
     scale = max(abs(integrals["forming_work_kJ"]), integrals["crank_work_abs_kJ"], abs(power.grid_energy_kJ))
     usable = power.storage_usable_kJ
     room = ENERGY_REL_TOL * max(usable, scale)
-    return [
+    balance = [
         Check.of(
             CheckId.GRID_BALANCE,
             "energy balance: grid = forming work + losses + storage change",
@@ -149,7 +149,11 @@ def _power_checks(power: PowerFigures, integrals: dict) -> list[Check]:
             "kJ",
             "equal",
             ENERGY_REL_TOL * scale,
-        ),
+        )
+    ]
+    if not storage:
+        return balance
+    return balance + [
         Check.of(CheckId.STORAGE_EMPTY, "storage above empty", power.storage_min_kJ, 0.0, "kJ", "min", room),
         Check.of(CheckId.STORAGE_FULL, "storage below full", power.storage_max_kJ, usable, "kJ", "max", room),
         Check.of(CheckId.STORAGE_CLOSES, "storage closes", power.storage_change_kJ, 0.0, "kJ", "equal", room),
