@@ -319,3 +319,27 @@ def test_a_grid_limit_below_the_draws_power_is_refused_before_solving(tmp_path, 
         assert code == 3 and "drive.grid.peak_power_kW = 1000" in err and "139.2 deg" in err and "1389 kW" in err
         assert words in err
     assert not (tmp_path / "o").exists()
+
+
+def test_min_energy_counts_the_losses():
+    """``min-energy`` with a copper loss and a converter minimises the energy at the bus (before storage), not
+    at the shaft: its plan draws no more than the baseline, nor than the loss-free objective's plan does once
+    the losses are counted (the same verification, ``bus_supply_energy_kJ``)."""
+    from planning.solver.objectives import solve_at_rate
+    from planning.solver.optimize import solve
+    from planning.solver.verify import assess
+
+    path = ROOT / "cases" / "cup-2000kN-drive.yaml"
+    at_rate = {"planner.objective": "min-energy", "planner.target_spm": 30.0}
+    losses = {"drive.motor.copper_loss_at_rated_kW": 30.0, "drive.converter_efficiency": 0.95}
+    plain, lossy = read_case(path, at_rate), read_case(path, {**at_rate, **losses})
+    fastest = solve(plain.with_objective("max-spm"))
+    aware = solve_at_rate(lossy, fastest=fastest)
+    unaware = solve_at_rate(plain, fastest=fastest)
+    verification, counted = assess(unaware.plan, lossy)
+    assert aware.verification.passed and verification.passed
+    energy = aware.drive.power.bus_supply_energy_kJ
+    assert energy <= aware.at_rate.baseline.drive.power.bus_supply_energy_kJ * (1 + 1e-12)
+    assert energy <= counted.power.bus_supply_energy_kJ * (1 + 1e-6)
+    # the losses are in it: the bus supplies the shaft's energy and the copper and converter losses
+    assert energy > aware.drive.supply_energy_kJ + aware.drive.power.copper_loss_kJ

@@ -267,7 +267,20 @@ def test_a_drive_case_shows_its_motor(site) -> None:
     edit(tab, "planner.target_spm", "30")
     assert tab.locator("#spm").inner_text() == "30.000"
     assert tab.locator("#objective-line").inner_text().startswith("min-energy at 30 SPM")
+    assert not tab.locator("#energy-chart").is_visible()  # no electrical side stated, nor the grid's objective
     screenshot(tab, "web-drive")
+    # the least grid peak: the grid's side is computed, its chart shown with the CLI's grid peak
+    before = int(tab.evaluate("document.body.dataset.rendered"))
+    tab.locator('[data-field="planner.objective"]').select_option("min-grid-peak")
+    wait_rendered(tab, before)
+    data["planner"].update(objective="min-grid-peak", target_spm=30.0)
+    expected = solve(case_from_data(copy.deepcopy(data), "cases/cup-2000kN-drive.yaml")).drive.power.grid_peak_kW
+    line = tab.locator("#objective-line").inner_text()
+    assert line.startswith("min-grid-peak at 30 SPM") and f"→ {expected:.0f} kW" in line, line
+    assert tab.locator("#energy-chart .main-svg").count() > 0
+    names = tab.evaluate("Array.from(document.querySelector('#energy-chart').data, (t) => t.name)")
+    assert f"grid power [kW] (peak {expected:.0f} kW)" in names and any(n.startswith("mean bus power") for n in names)
+    screenshot(tab, "web-energy")
     context.close()
 
 

@@ -71,6 +71,7 @@ class PowerFigures:
     resistor_loss_kJ: float
     storage_change_kJ: float  # stored energy at the cycle's end minus at its start
     bus_energy_kJ: float
+    bus_supply_energy_kJ: float  # what the grid gives without storage: integral r P_bus + (1 - r) max(P_bus, 0) dt
     grid_energy_kJ: float
     grid_energy_kWh_per_1000_strokes: float
     mean_bus_power_kW: float

@@ -409,6 +409,7 @@ def power_figures(
         resistor_loss_kJ=integral(cols["resistor_W"]),
         storage_change_kJ=float(np.sum(dt * stored)) / 1e3,
         bus_energy_kJ=integral(cols["bus_power_W"]),
+        bus_supply_energy_kJ=integral(grid_power(cols["bus_power_W"], d.regen_efficiency)),
         grid_energy_kJ=grid_energy,
         grid_energy_kWh_per_1000_strokes=grid_energy / 3.6,
         mean_bus_power_kW=integral(cols["bus_power_W"]) / profile.duration,

@@ -7,9 +7,10 @@ held fixed) the planner minimises
 - ``min-rms-torque``: the heat ``integral T_m^2 dt`` over the cycle (the RMS torque squared times the
   cycle time, which is fixed);
 - ``min-energy``: the energy drawn from the supply per stroke ``E+ - r |E-|`` (``r`` =
-  ``drive.regen_efficiency``). ``max(P, 0)`` has a kink where the power changes sign: the NLP uses the
+  ``drive.regen_efficiency``) of the bus power (the motors' copper loss and the converter counted, where the
+  drive states them; no storage). ``max(P, 0)`` has a kink where the power changes sign: the NLP uses the
   smooth ``(P + sqrt(P^2 + eps^2)) / 2`` on its samples; the verification and every output use the
-  exact integral (``planning.model.drive``);
+  exact integral (``planning.model.drive``, ``planning.solver.grid``);
 - ``min-grid-peak``: the grid's peak power with the case's storage (``planning.solver.grid``). The NLP
   (the rate NLP's peak variant) minimises the bus power's peak at its samples, an epigraph variable
   ``bus_peak >= (T_m omega_m + k T_m^2) / eta_c`` at every sample, with the heat as a tie-break; the
@@ -90,7 +91,7 @@ def solve_at_rate(
         search.parameters[search.parameter("weight_peak")] = 1.0 / (baseline.drive.power.bus_peak_kW * 1e3)
         search.parameters[search.parameter("weight_heat")] = HEAT_TIE_BREAK * heat_weight
     else:  # the energy has flat directions (a plan's speeds can trade without changing it): the heat breaks ties
-        search.parameters[search.parameter("weight_energy")] = 1.0 / (baseline.drive.supply_energy_kJ * 1e3)
+        search.parameters[search.parameter("weight_energy")] = 1.0 / (scale * 1e3)
         search.parameters[search.parameter("weight_heat")] = HEAT_TIE_BREAK * heat_weight
     search.score = lambda solution: objective_value(solution, objective) / scale
     search.consider(baseline, BASELINE_SCORE)

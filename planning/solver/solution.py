@@ -52,8 +52,11 @@ class AtRate:
 def objective_value(solution: Solution, objective: str) -> float:
     """The exact objective of a verified plan: RMS torque squared [N^2 m^2] (the heat over the fixed cycle
     time) for ``min-rms-torque``, the grid's peak [kW] with the case's storage for ``min-grid-peak`` (its
-    power figures, ``Case.electrical``), else the energy drawn from the supply per stroke [kJ]."""
+    power figures, ``Case.electrical``), else the energy drawn from the supply per stroke [kJ] (with the
+    drive's electrical side: at the bus, its losses counted, before any storage)."""
     d = solution.drive
     if objective == "min-grid-peak":
         return d.power.grid_peak_kW
+    if objective == "min-energy" and d.power is not None:
+        return d.power.bus_supply_energy_kJ
     return d.rms_motor_torque_Nm**2 if objective == "min-rms-torque" else d.supply_energy_kJ

@@ -293,8 +293,7 @@ function clearPlan() {
   $("#key-points tbody").innerHTML = "";
   $("#stages tbody").innerHTML = "";
   Plotly.purge("motion-chart");
-  Plotly.purge("drive-chart");
-  $("#drive-chart").style.display = "none";
+  for (const id of ["drive-chart", "energy-chart"]) { Plotly.purge(id); $("#" + id).style.display = "none"; }
   $("#mechanism-svg").innerHTML = "";
 }
 
@@ -356,7 +355,9 @@ function render(answer, seq, confirmed) {
     (confirmed ? "" : "; confirming against the cold solve…"), confirmed ? "" : "busy");
   $("#objective-line").textContent = r.baseline
     ? `${r.objective} at ${r.target_spm} SPM: RMS ${(r.drive.rms_motor_torque_Nm / 1e3).toFixed(2)} kN m, energy ${r.drive.supply_energy_kJ.toFixed(1)} kJ/stroke; ` +
-      `saving ${r.saving_pct.rms_torque.toFixed(1)} % RMS, ${r.saving_pct.energy.toFixed(1)} % energy against waiting`
+      `saving ${r.saving_pct.rms_torque.toFixed(1)} % RMS, ${r.saving_pct.energy.toFixed(1)} % energy` +
+      (r.saving_pct.grid_peak !== undefined ? `, ${r.saving_pct.grid_peak.toFixed(1)} % grid peak (${r.baseline.grid_peak_kW.toFixed(0)} → ${r.power.grid_peak_kW.toFixed(0)} kW)` : "") +
+      " against waiting"
     : "";
   $("#drive-line").textContent = r.drive
     ? `motor: peak ${(r.drive.peak_motor_torque_Nm / 1e3).toFixed(2)} kN m (${r.drive.peak_torque_use_pct.toFixed(1)} % of the envelope), ` +
@@ -480,6 +481,7 @@ function drawCharts() {
   const chart = $("#motion-chart");
   if (!chart.dataset.follows) { chart.on("plotly_hover", followChart); chart.dataset.follows = "1"; }
   drawDrive(r, c, x, axis);
+  drawEnergy(r, c, x, axis);
 }
 
 function nearest(xs, v) {
@@ -526,6 +528,44 @@ function drawDrive(r, c, x, axis) {
     yaxis2: { ...round, domain: [0, 0.45], anchor: "x", zeroline: true, title: { text: "motor power [kW]" } },
     xaxis2: { ...round, domain: [0.7, 1], title: { text: "motor speed [rpm]" }, anchor: "y3" },
     yaxis3: { ...round, anchor: "x2", title: { text: "torque [kN m]" } },
+    shapes: shapes.map((sh) => ({ ...sh, xref: "x", yref: "paper" })),
+  };
+  Plotly.react(el, traces, layout, { responsive: true, displaylogo: false });
+}
+
+// the drive's electrical side (result.power, the trajectory's power columns): shaft, bus and grid power with
+// the mean bus power and the grid's limit, and the storage's energy between empty and full (energy.png's)
+function drawEnergy(r, c, x, axis) {
+  const el = $("#energy-chart");
+  const p = r.power;
+  if (!p || !c.grid_power_kW) { Plotly.purge(el); el.style.display = "none"; return; }
+  el.style.display = "block";
+  const line = (y, name, color, dash, yaxis) => ({ x, y, name, yaxis, hoverinfo: "name+y", line: { color, dash, width: dash ? 1.2 : 1.6 } });
+  const flat = (v) => x.map(() => v);
+  const traces = [
+    line(c.motor_power_kW, "shaft power [kW]", "#17becf"),
+    line(c.bus_power_kW, "bus power [kW]", "#7f7f7f"),
+    line(c.grid_power_kW, `grid power [kW] (peak ${p.grid_peak_kW.toFixed(0)} kW)`, "#9467bd"),
+    line(flat(p.mean_bus_power_kW), `mean bus power ${p.mean_bus_power_kW.toFixed(0)} kW`, "#555555", "dot"),
+  ];
+  if (p.grid_limit_kW !== null && p.grid_limit_kW !== undefined) {
+    traces.push(line(flat(p.grid_limit_kW), `drive.grid.peak_power_kW = ${p.grid_limit_kW} kW`, "#b22222", "dash"));
+  }
+  const storage = p.storage_usable_kJ > 0;
+  if (storage) {
+    traces.push(line(c.storage_energy_kJ, "stored energy [kJ]", "#2ca02c", undefined, "y2"));
+    traces.push(line(flat(p.storage_usable_kJ), `drive.storage.usable_energy_kJ = ${p.storage_usable_kJ} kJ`, "#2ca02c", "dash", "y2"));
+    traces.push(line(flat(0), "storage empty", "#2ca02c", "dot", "y2"));
+  }
+  const { shapes } = cycleShapes(r, x, axis);
+  const round = { nticks: 6, tickformat: "~g" };
+  const layout = {
+    margin: { l: 60, r: 30, t: 10, b: 40 },
+    hovermode: "closest",
+    legend: { orientation: "h", y: -0.18, yanchor: "top", font: { size: 10 } },
+    xaxis: { anchor: storage ? "y2" : "y", title: { text: axis === "time" ? "time from TDC [s]" : "crank angle [deg]" } },
+    yaxis: { ...round, domain: storage ? [0.4, 1] : [0, 1], zeroline: true, title: { text: "power [kW]" } },
+    yaxis2: { ...round, domain: [0, 0.32], anchor: "x", rangemode: "tozero", title: { text: "storage [kJ]" } },
     shapes: shapes.map((sh) => ({ ...sh, xref: "x", yref: "paper" })),
   };
   Plotly.react(el, traces, layout, { responsive: true, displaylogo: false });
