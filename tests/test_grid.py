@@ -280,6 +280,57 @@ def test_without_the_new_keys_the_outputs_are_todays():
     assert _electrical(base, ["drive.storage.usable_energy_kJ"])
 
 
+
+GOLDEN = ROOT / "tests" / "data" / "golden_drive"  # written by the commit before the grid's work (ded1870)
+GOLDEN_RUNS = {  # folder: the command's arguments
+    "cup-max-spm": ["solve", str(DRIVE_CASES[1])],
+    "cup-min-energy-30": ["solve", str(DRIVE_CASES[1]), "--objective", "min-energy", "--spm", "30"],
+}
+GOLDEN_EVERY = 10  # the golden tables keep their header and every 10th row
+GOLDEN_REL = 1e-9  # relative agreement of every number (the same machine gives them bit for bit)
+
+
+def _golden_same(a, b, path: str = "") -> list[str]:  # noqa: ANN001 - JSON data
+    if isinstance(a, dict) and isinstance(b, dict):
+        if set(a) != set(b):
+            return [f"{path}: keys {sorted(set(a) ^ set(b))}"]
+        return [d for k in a if k != "wall_time_s" for d in _golden_same(a[k], b[k], f"{path}.{k}")]
+    if isinstance(a, list) and isinstance(b, list):
+        if len(a) != len(b):
+            return [f"{path}: {len(a)} != {len(b)} items"]
+        return [d for i, (x, y) in enumerate(zip(a, b, strict=True)) for d in _golden_same(x, y, f"{path}[{i}]")]
+    if isinstance(a, float | int) and isinstance(b, float | int) and not isinstance(a, bool):
+        return [] if math.isclose(a, b, rel_tol=GOLDEN_REL, abs_tol=1e-12) else [f"{path}: {a} != {b}"]
+    return [] if a == b else [f"{path}: {a!r} != {b!r}"]
+
+
+@pytest.mark.parametrize("name", sorted(GOLDEN_RUNS))
+def test_without_the_new_keys_every_output_is_the_golden_one(name, tmp_path):
+    """A drive case without the electrical keys, at the most strokes and at a rate (min-energy, whose NLP term
+    now carries the losses): result.json, summary.txt and the tables equal the outputs written before the
+    grid's work (``tests/data/golden_drive``), timing aside."""
+    import csv
+
+    assert main([*GOLDEN_RUNS[name], "--out", str(tmp_path), "--no-plots"]) == 0
+    folder = GOLDEN / name
+    now, then = (json.loads((f / "result.json").read_text()) for f in (tmp_path, folder))
+    assert not _golden_same(then, now)
+    lines = [(f / "summary.txt").read_text().splitlines() for f in (tmp_path, folder)]
+    assert [x for x in lines[0] if "solver:" not in x] == [x for x in lines[1] if "solver:" not in x]
+    for table in ("trajectory.csv", "cam_table.csv"):
+        rows = list(csv.reader((tmp_path / table).open()))
+        kept = [rows[0]] + rows[1::GOLDEN_EVERY]
+        golden = list(csv.reader((folder / table).open()))
+        assert len(kept) == len(golden)
+        for mine, theirs in zip(kept, golden, strict=True):
+            assert len(mine) == len(theirs), table
+            for x, y in zip(mine, theirs, strict=True):
+                try:
+                    assert math.isclose(float(x), float(y), rel_tol=GOLDEN_REL, abs_tol=1e-12), (table, x, y)
+                except ValueError:  # the header and the words
+                    assert x == y, (table, x, y)
+
+
 CUP = DRIVE_CASES[1]
 
 

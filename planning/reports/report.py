@@ -192,8 +192,12 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
 
 def drive_block(solution: Solution, case: Case) -> dict[str, Any]:
     """The ``drive`` block of ``result.json``: what the motor must give over the cycle (the figures the
-    solve computed), and its limits."""
-    return {**solution.drive.as_dict(), "motor": case.drive.motor.model_dump(), "gear_ratio": case.drive.gear_ratio}
+    solve computed), and its limits (the motor's copper loss only where the drive states one: without the
+    electrical keys the block is what it was before them)."""
+    motor = case.drive.motor.model_dump()
+    if not motor["copper_loss_at_rated_kW"]:
+        del motor["copper_loss_at_rated_kW"]
+    return {**solution.drive.as_dict(), "motor": motor, "gear_ratio": case.drive.gear_ratio}
 
 
 def objective_block(solution: Solution, case: Case) -> dict[str, Any]:
