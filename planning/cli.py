@@ -11,6 +11,7 @@ import argparse
 import json
 import math
 import sys
+import time
 from collections.abc import Sequence
 from pathlib import Path
 from typing import NoReturn
@@ -79,6 +80,7 @@ def _parser() -> argparse.ArgumentParser:
     w.add_argument("--workers", type=_whole(1, 256), default=2, help="local worker processes (default 2)")
     w.add_argument("--scheduler", help="address of a Dask distributed scheduler (instead of local workers)")
     w.add_argument("--out", required=True, help="output folder (sweep.csv, sweep.json, sweep_spm.png)")
+    w.add_argument("--progress", action="store_true", help=PROGRESS_HELP)
     t = sub.add_parser("tradeoff", help="the least RMS torque, energy or grid peak at each line rate, beside waiting")
     t.add_argument("case", help="case file (YAML) with a drive: section")
     t.add_argument("--spm", required=True, metavar="START:STOP:COUNT", help="rates, e.g. 6:max:7 (max: the fastest)")
@@ -92,7 +94,8 @@ def _parser() -> argparse.ArgumentParser:
     t.add_argument("--placement", choices=("free", "published"), help="where theta1/theta4 may fall")
     t.add_argument("--workers", type=_whole(1, 256), default=2, help="local worker processes (default 2)")
     t.add_argument("--scheduler", help="address of a Dask distributed scheduler (instead of local workers)")
-    t.add_argument("--out", required=True, help="output folder (tradeoff.csv, tradeoff.png)")
+    t.add_argument("--out", required=True, help="output folder (tradeoff.csv, tradeoff.json, tradeoff.png)")
+    t.add_argument("--progress", action="store_true", help=PROGRESS_HELP)
     b = sub.add_parser(
         "bound",
         help="the time-optimal bound: the most strokes any motion can make",
@@ -393,6 +396,42 @@ def _write_and_report(out: Path, writers: dict, data: dict, text: str, args, own
     return EXIT_OK
 
 
+PROGRESS_HELP = "show progress (points done, points/s, the expected end) even when stderr is not a terminal"
+PROGRESS_EVERY_S = 1.0  # [s] without a terminal, a progress line at most this often (and the last one)
+
+
+class ProgressBar:
+    """A sweep's or a trade-off's progress on stderr: a bar redrawn in place on a terminal, or (``always``)
+    a line at most every :data:`PROGRESS_EVERY_S` without one; points done, points/s, the expected end."""
+
+    def __init__(self, what: str, always: bool) -> None:
+        self.what, self.tty = what, sys.stderr.isatty()
+        self.shown = self.tty or always
+        self.started = time.perf_counter()
+        self.last = -math.inf
+        self.drawn = False
+
+    def update(self, done: int, total: int, failed: int) -> None:
+        if not self.shown:
+            return
+        now = time.perf_counter()
+        if not self.tty and done < total and now - self.last < PROGRESS_EVERY_S:
+            return
+        self.last = now
+        rate = done / max(now - self.started, 1e-9)
+        left = (total - done) / rate if rate > 0 else math.inf
+        bar = "#" * int(30 * done / total)
+        line = f"{self.what} [{bar:<30}] {done}/{total} points, {failed} without a plan, {rate:.1f} points/s, " + (
+            f"done in about {left:.0f} s" if done < total else "all solved"
+        )
+        print(("\r" + line) if self.tty else line, end="" if self.tty else "\n", file=sys.stderr, flush=True)
+        self.drawn = True
+
+    def close(self) -> None:
+        if self.tty and self.drawn:
+            print(file=sys.stderr)
+
+
 def _load_plots() -> None:
     """Load the plotting module (matplotlib: about a second) while the workers solve, not before them."""
     import planning.reports.plots  # noqa: F401
@@ -409,25 +448,21 @@ def _sweep(case, args) -> int:
     out = Path(args.out)
     ensure_writable(out)
     base = _with_law(case, args).model_dump(exclude_none=True)
-    tty = sys.stderr.isatty()
+    bar = ProgressBar("sweep", args.progress)
 
-    def progress(done: int, total: int, failed: int) -> None:
-        if tty:
-            bar = "#" * int(30 * done / total)
-            print(f"\rsweep [{bar:<30}] {done}/{total} points, {failed} without a plan", end="", file=sys.stderr)
+    def figure(result) -> None:  # noqa: ANN001 - a SweepResult
+        from planning.reports.plots import save, sweep_figure
+
+        if len(varies) <= 2:
+            title = f"{case.name}: strokes per minute over {' x '.join(v.field for v in varies)}"
+            save(sweep_figure(result.rows, result.fields, title), out / "sweep_spm.png")
 
     result = run_sweep(
-        base, args.case, varies, out, args.workers, args.scheduler, args.placement, progress, _load_plots
+        base, args.case, varies, out, args.workers, args.scheduler, args.placement, bar.update, _load_plots, figure
     )
-    if tty:
-        print(file=sys.stderr)
-    from planning.reports.plots import save, sweep_figure
-
+    bar.close()
     rows = result.rows
     verified = sum(r["status"] == "verified" for r in rows)
-    if len(varies) <= 2:
-        title = f"{case.name}: strokes per minute over {' x '.join(v.field for v in varies)}"
-        save(sweep_figure(rows, result.fields, title), out / "sweep_spm.png")
     print(
         f"{case.name}: {len(rows)} points, {verified} verified, {len(rows) - verified} without a plan"
         f"{f' ({result.resumed} from an earlier run)' if result.resumed else ''}"
@@ -452,12 +487,16 @@ def _tradeoff(case, args) -> int:
     except CaseError as exc:
         raise CommandError(f"{args.case}: {exc.line()}") from None
     out = _output_folder(case, args, TRADEOFF_FILES)
-    result = run_tradeoff(case, rates, args.workers, args.scheduler, args.placement, _load_plots)
+    bar = ProgressBar("tradeoff", args.progress)
+    result = run_tradeoff(case, rates, args.workers, args.scheduler, args.placement, _load_plots, bar.update)
+    bar.close()
     from planning.reports.plots import save, tradeoff_figure
 
     title = f"{case.name}: {objective} at the line's rate ({case.planner.motion_law})"
+    record = {"case": case.name, "objective": objective, "spm": args.spm, "timeline": result.timeline}
     writers = {
         "tradeoff.csv": lambda p: write_rows(p, result.rows, columns(case)),
+        "tradeoff.json": lambda p: p.write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8"),
         "tradeoff.png": lambda p: save(tradeoff_figure(result.rows, case, title), p),
     }
     files = write_atomic(out, writers, TRADEOFF_FILES, keep=args.case)

@@ -8,6 +8,11 @@ rows. Rows are appended to ``sweep.csv`` as blocks finish, so a sweep that is st
 points it lacks. A point that fails becomes a row that says why; it never stops the sweep. When all blocks
 are in, a repair pass re-solves any point whose neighbour's plan is feasible for it and better (see
 :func:`repair`), and the file is rewritten in grid order.
+
+Before local workers fork, the first point is solved once in this process so that every NLP its solve builds
+is inherited by the workers instead of built in each. ``sweep.json`` records the run's timeline
+(``planning.timeline``): start-up, each worker's busy and idle time, each block, the second pass and the
+writing.
 """
 
 from __future__ import annotations
@@ -29,6 +34,8 @@ from pydantic import BaseModel
 
 from planning.model.case import ELECTRICAL_KEYS, Case, states_electrical
 from planning.model.case_file import with_fields
+from planning.model.limits.base import TIME_TOL
+from planning.timeline import Timeline, stamp
 
 BLOCK_POINTS = 6
 ROW_FIELDS = ("spm", "cycle_time_s", "status", "binding", "solve_time_s", "message")
@@ -132,12 +139,12 @@ def solve_block(
     previous = None  # the plan of the point before: the next point starts from it
     for index, values in points:
         row: dict[str, Any] = {"index": index, **dict(zip(fields, values, strict=True))}
-        t = time.perf_counter()
+        t, started = time.perf_counter(), time.time()
         try:
             case = case_from_data(point_data(base, fields, values), f"{label}[{index}]")
             sol = solve(case, placement, neighbour=previous)
             previous = sol.plan
-            row.update(_solved_row(sol, case), plan=sol.plan)
+            row.update(_solved_row(sol, case), plan=sol.plan, case=case)
         except CaseFileError as exc:
             row.update(status="bad input", message=str(exc))
         except PlanningError as exc:
@@ -145,6 +152,7 @@ def solve_block(
         except Exception as exc:  # noqa: BLE001 - one failing point never stops the sweep
             row.update(status="error", message=f"{type(exc).__name__}: {exc}")
         row["solve_time_s"] = time.perf_counter() - t
+        stamp(row, started)
         rows.append(row)
     return rows
 
@@ -198,47 +206,88 @@ def repair(
     placement: str | None,
     label: str,
     passes: int = 12,
+    workers: int = 1,
+    scheduler: str | None = None,
+    timeline: Timeline | None = None,
 ) -> int:
     """Where a neighbour's plan verifies for a point and beats it, re-solve the point from that plan.
 
     Each point is its cold solve's answer or better, but a neighbour's plan may be better still (the NLP is
     not convex: another local optimum). A plan of a neighbouring point that passes this point's verification
-    is a feasible answer here, so the point is never left worse than it. Passes alternate in direction until
-    nothing changes. Returns how many re-solves improved a point.
+    is a feasible answer here, so the point is never left worse than it. Each pass finds, in this process,
+    every point with such plans (a plan once tried for a point is not tried again), then re-solves those
+    points on the ``workers`` (or the Dask ``scheduler``), each from the plans it found, keeping the best;
+    passes repeat until no point improves. Returns how many re-solves improved a point; ``timeline``: the
+    time of the finding (one process) is added to its ``second_pass_serial_s``.
     """
     from planning.model.case_file import CaseFileError, case_from_data
-    from planning.solver.optimize import solve
-    from planning.solver.outcomes import PlanningError
     from planning.solver.verify import verify
 
     improved = 0
-    for k in range(passes):
-        changed = False
-        for i in sorted(rows, reverse=k % 2 == 1):  # alternate directions: improvements travel both ways
-            try:
-                case = case_from_data(point_data(base, fields, points[i]), f"{label}[{i}]")
-            except CaseFileError:
+    cases: dict[int, Any] = {}  # each point's case, read once for every pass
+    tried: set[tuple[int, int]] = set()  # (point, id of a neighbour's plan) already checked
+    for _ in range(passes):
+        finding = time.time()
+        work = []
+        for i in sorted(rows):
+            if i not in cases and rows[i].get("case") is not None:  # the point's solve read it
+                cases[i] = rows[i]["case"]
+            if i not in cases:
+                try:
+                    cases[i] = case_from_data(point_data(base, fields, points[i]), f"{label}[{i}]")
+                except CaseFileError:
+                    cases[i] = None
+            case = cases[i]
+            if case is None:
                 continue
             current = rows[i].get("spm") if rows[i].get("status") == "verified" else None
+            plans = []
             for j in neighbours(i, shape):
                 plan = rows.get(j, {}).get("plan")
-                if plan is None or (current is not None and plan.spm <= current + 1e-9):
+                if plan is None or (current is not None and plan.spm <= current + 1e-9) or (i, id(plan)) in tried:
                     continue
+                tried.add((i, id(plan)))
                 same = np.allclose(plan.key_angles, case.key_angles, atol=1e-12)
-                if not same or not verify(plan, case).passed:
-                    continue
-                try:
-                    sol = solve(case, placement, neighbour=plan, follow=True)
-                except PlanningError:
-                    continue
-                if current is None or sol.plan.spm > current + 1e-9:
-                    rows[i].update(_solved_row(sol, case), plan=sol.plan)
-                    current = sol.plan.spm
-                    improved += 1
-                    changed = True
+                # the robot's window first: the verification's own check, without its dense grid (a faster
+                # neighbour in a sweep of the transfer time fails it, and only it)
+                short = plan.transfer_window() < case.process.transfer_time_s - TIME_TOL
+                if same and not short and verify(plan, case).passed:
+                    plans.append(plan)
+            if plans:
+                work.append((case, placement, i, current, plans))
+        if timeline is not None:
+            timeline.add("second_pass_serial_s", time.time() - finding)
+        changed = False
+        for found in execute(resolve_from, work, workers, scheduler):
+            for row in found:
+                i = row.pop("index")
+                rows[i].update(row)
+                improved += 1
+                changed = True
         if not changed:
             break
     return improved
+
+
+def resolve_from(
+    case: Case, placement: str | None, index: int, current: float | None, plans: list[Any]
+) -> list[dict[str, Any]]:
+    """Point ``index`` (its ``case``) re-solved from each of ``plans``: the best that beats ``current`` [SPM]
+    as a row update (``index``, the figures, the plan), or none."""
+    from planning.solver.optimize import solve
+    from planning.solver.outcomes import PlanningError
+
+    best = None
+    for plan in plans:
+        try:
+            sol = solve(case, placement, neighbour=plan, follow=True)
+        except PlanningError:
+            continue
+        if (current is None or sol.plan.spm > current + 1e-9) and (best is None or sol.plan.spm > best.plan.spm):
+            best = sol
+    if best is None:
+        return []
+    return [{"index": index, **_solved_row(best, case), "plan": best.plan}]
 
 
 def blocks(pending: list[int], points: list[tuple[float, ...]]) -> list[list[tuple[int, tuple[float, ...]]]]:
@@ -252,12 +301,13 @@ def blocks(pending: list[int], points: list[tuple[float, ...]]) -> list[list[tup
 @dataclass
 class SweepResult:
     """``rows`` (all points, by index), how many were ``resumed`` from an earlier run, how many were
-    ``repaired`` from a neighbour's better plan."""
+    ``repaired`` from a neighbour's better plan, and the run's ``timeline`` (``planning.timeline``)."""
 
     rows: list[dict[str, Any]]
     resumed: int
     fields: list[str]
     repaired: int = 0
+    timeline: dict[str, Any] | None = None
 
 
 def _read_spec(path: Path, out: Path) -> Any:
@@ -310,9 +360,12 @@ def run_sweep(
     placement: str | None = None,
     progress: Callable[[int, int, int], None] | None = None,
     meanwhile: Callable[[], object] | None = None,
+    finish: Callable[[SweepResult], None] | None = None,
 ) -> SweepResult:
     """Solve the grid into ``out/sweep.csv`` (resuming what an earlier run of the same sweep wrote);
-    ``meanwhile``: see :func:`execute`."""
+    ``meanwhile``: see :func:`execute`; ``finish``: called with the result before the timeline closes
+    (the caller's figure)."""
+    timeline = Timeline()
     fields = [v.field for v in varies]
     points = grid(varies)
     out.mkdir(parents=True, exist_ok=True)
@@ -323,7 +376,10 @@ def run_sweep(
         "placement": placement,
     }
     spec_path, csv_path = out / "sweep.json", out / "sweep.csv"
-    if _read_spec(spec_path, out) not in (None, spec):
+    earlier_spec = _read_spec(spec_path, out)
+    if isinstance(earlier_spec, dict):
+        earlier_spec.pop("timeline", None)  # a run's own record, not the sweep's definition
+    if earlier_spec not in (None, spec):
         raise SweepError(f"{out}: holds a different sweep (sweep.json); choose another --out")
     spec_path.write_text(json.dumps(spec, indent=2) + "\n", encoding="utf-8")
     earlier = _earlier_rows(csv_path, out, len(points))
@@ -339,7 +395,10 @@ def run_sweep(
         writer = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
         if new_file:
             writer.writeheader()
-        work = [(base, fields, blk, placement, label) for blk in blocks(pending, points)]
+        cut = blocks(pending, points)
+        if cut and workers > 1 and not scheduler:  # the NLPs built here, inherited by the forked workers
+            solve_block(base, fields, cut[0][:1], placement, label)
+        work = [(base, fields, blk, placement, label) for blk in cut]
         for rows in execute(solve_block, work, workers, scheduler, meanwhile):
             for row in rows:
                 writer.writerow({k: _cell(row.get(k)) for k in columns})
@@ -353,7 +412,9 @@ def run_sweep(
     shape = tuple(v.count for v in varies)
     for i, r in earlier.items():  # rows of an earlier run: their plans are not kept
         fresh.setdefault(i, {**r, "index": i, "spm": float(r["spm"]) if r.get("spm") else None})
-    improved = repair(base, fields, points, shape, fresh, placement, label)
+    timeline.mark("second_pass_start")
+    improved = repair(base, fields, points, shape, fresh, placement, label, 12, workers, scheduler, timeline)
+    timeline.mark("second_pass_end")
     tmp = csv_path.with_suffix(".csv.tmp")
     with open(tmp, "w", newline="", encoding="utf-8") as fh:
         writer = csv.DictWriter(fh, fieldnames=columns, extrasaction="ignore")
@@ -362,7 +423,13 @@ def run_sweep(
             writer.writerow({k: _cell(fresh[i].get(k)) for k in columns})
     os.replace(tmp, csv_path)
     rows = sorted(_read_rows(csv_path), key=lambda r: int(r["index"]))
-    return SweepResult(rows, len(done), fields, improved)
+    result = SweepResult(rows, len(done), fields, improved)
+    if finish is not None:
+        finish(result)
+    timeline.mark("end")
+    result.timeline = timeline.as_dict(list(fresh.values()), [[i for i, _ in blk] for blk in cut])
+    spec_path.write_text(json.dumps({**spec, "timeline": result.timeline}, indent=2) + "\n", encoding="utf-8")
+    return result
 
 
 def _cell(value: Any) -> Any:

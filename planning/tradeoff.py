@@ -23,6 +23,7 @@ import numpy as np
 from planning.model.case import Case, Placement
 from planning.solver.solution import GRID_PEAK
 from planning.sweep import SweepError, _cell, execute
+from planning.timeline import Timeline, stamp
 
 # one row per rate: the plan's figures, the baseline's, the savings
 FIGURE_FIELDS = (
@@ -106,13 +107,14 @@ def rate_block(case: Case, placement: Placement | None, fastest: Any, rates: lis
     rows = []
     for index, rate in rates:
         row: dict[str, Any] = {"index": index, "target_spm": rate}
-        t = time.perf_counter()
+        t, started = time.perf_counter(), time.time()
         try:
             at_rate = case.with_objective(None, rate)
             row.update(solved_row(solve_at_rate(at_rate, placement, fastest=fastest), at_rate))
         except PlanningError as exc:
             row.update(status=exc.kind, message=exc.reason)
         row["solve_time_s"] = time.perf_counter() - t
+        stamp(row, started)
         rows.append(row)
     return rows
 
@@ -135,11 +137,12 @@ def solved_row(sol: Any, case: Case) -> dict[str, Any]:
 
 @dataclass
 class TradeoffResult:
-    """``rows`` in rate order, the ``fastest`` max-SPM solution, and the case's motor ratings."""
+    """``rows`` in rate order, the ``fastest`` max-SPM solution, the ``objective`` and the run's ``timeline``."""
 
     rows: list[dict[str, Any]]
     fastest: Any
     objective: str
+    timeline: dict[str, Any] | None = None  # planning.timeline (the outputs' writing apart)
 
     def thermal_statement(self, case: Case) -> str:
         """What the motor's thermal limit allows: whether it sets the fastest rate, and the RMS there."""
@@ -169,12 +172,14 @@ def run_tradeoff(
     scheduler: str | None = None,
     placement: Placement | None = None,
     meanwhile: Callable[[], object] | None = None,
+    progress: Callable[[int, int, int], None] | None = None,
 ) -> TradeoffResult:
     """One plan per rate at ``case.planner.objective`` (min-rms-torque, min-energy or min-grid-peak); ``meanwhile``: see
     ``planning.sweep.execute``."""
     from planning.solver.halves_nlp import halves_nlp_for
     from planning.solver.optimize import solve
 
+    timeline = Timeline()
     fastest = solve(case.with_objective("max-spm"), placement)
     halves_nlp_for(case, drive=True, rate=True)  # built once here, inherited by forked workers
     if case.planner.objective == "min-grid-peak":
@@ -188,7 +193,11 @@ def run_tradeoff(
     for block in execute(rate_block, work, workers, scheduler, meanwhile):
         for row in block:
             rows[row["index"]] = row
-    return TradeoffResult([rows[i] for i in sorted(rows)], fastest, case.planner.objective)
+        if progress is not None:
+            progress(len(rows), len(order), sum(r["status"] != "verified" for r in rows.values()))
+    timeline.mark("end")
+    ordered = [rows[i] for i in sorted(rows)]
+    return TradeoffResult(ordered, fastest, case.planner.objective, timeline.as_dict(ordered))
 
 
 def write_rows(path: Path, rows: list[dict[str, Any]], columns: tuple[str, ...]) -> None:

@@ -45,7 +45,7 @@ SOLVE_FILES = (
 )
 COMPARE_FILES = ("comparison.json", "comparison.md")
 LAWS_FILES = ("laws.json", "laws.md", "laws_overlay.*")
-TRADEOFF_FILES = ("tradeoff.csv", "tradeoff.png")
+TRADEOFF_FILES = ("tradeoff.csv", "tradeoff.json", "tradeoff.png")
 MAX_FOREIGN_FILES = 200
 _LEFTOVER = re.compile(r"^\.(?P<name>.+)\.pressplan-(?P<pid>\d+)-(?P<kind>new|old)-[0-9a-f]+$")
 _LEGACY_TEMP = re.compile(r"^\.pressplan-[A-Za-z0-9_]+$")  # temp folders of earlier versions, inside the folder

@@ -142,9 +142,7 @@ def upper_bound(case: Case, points: int = UPPER_POINTS, pieces: int = UPPER_PIEC
     h_a, d1_a = m.jets(a)[:2]
     h_b, d1_b = m.jets(b)[:2]
     slope2_min = np.where(dead, 0.0, np.minimum(d1_a**2, d1_b**2))
-    grid = RelaxedGrid(
-        case, th, h, d1, d2, dth, window, cell=cell, a=a, b=b, h_a=h_a, h_b=h_b, slope2_min=slope2_min
-    )
+    grid = RelaxedGrid(case, th, h, d1, d2, dth, window, cell=cell, a=a, b=b, h_a=h_a, h_b=h_b, slope2_min=slope2_min)
 
     w_acc2 = case.limits.slider_accel_mm_s2 / m.peak_curvature  # scales, as the grid bound's
     s_unit = np.clip(np.full(n, w_acc2), lbx_s, ubx_s)
