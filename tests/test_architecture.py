@@ -17,6 +17,7 @@ LAYERS = (  # module prefix -> layer, the most specific prefix wins
     ("planning.reports", 3),
     ("planning.sweep", 3),
     ("planning.tradeoff", 3),
+    ("planning.timeline", 3),
     ("planning.web", 3),
     ("planning.cli", 3),
 )
