@@ -177,9 +177,20 @@ def test_dask_cluster_gives_the_local_results(tmp_path):
     distributed = pytest.importorskip("dask.distributed")
     base = read_case(PUBLISHED_CASE).model_dump(exclude_none=True)
     varies = [parse_vary("process.transfer_time_s=1.8:2.4:8")]
-    local = run_sweep(base, "local", varies, tmp_path / "local", workers=2)
+    seen = {"local": [], "dask": []}  # the progress each run reports: (done, total, failed)
+    local = run_sweep(base, "local", varies, tmp_path / "local", workers=2, progress=lambda *p: seen["local"].append(p))
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as lc:
-        remote = run_sweep(base, "dask", varies, tmp_path / "dask", scheduler=lc.scheduler_address)
+        remote = run_sweep(
+            base,
+            "dask",
+            varies,
+            tmp_path / "dask",
+            scheduler=lc.scheduler_address,
+            progress=lambda *p: seen["dask"].append(p),
+        )
+    for reports in seen.values():  # one report per block as it finishes, counting up to every point
+        assert reports[-1] == (8, 8, 0) and [r[0] for r in reports] == sorted(r[0] for r in reports)
+        assert len(reports) == 2  # 8 points in blocks of 6: two blocks
     keys = ("index", "process.transfer_time_s", "spm", "status", "binding")
     assert [[r[k] for k in keys] for r in local.rows] == [[r[k] for k in keys] for r in remote.rows]
     assert all(r["status"] == "verified" for r in remote.rows)
