@@ -189,6 +189,7 @@ def _build(
     zone: bool,
     links: tuple[str, ...] = (),
     peak: bool = False,
+    losses: bool = False,
 ) -> CycleNLP:
     law = get_law(law_name)
     drive = drive or rate
@@ -294,7 +295,7 @@ def _build(
     refinable = add_limit_rows(rows, nlp, layout)
     objective = params.period
     if rate:
-        heat, energy = objective_terms(q, torque, states[2], times)
+        heat, energy = objective_terms(q, torque, states[2], times, losses)
         objective = q["weight_period"] * params.period + q["weight_heat"] * heat + q["weight_energy"] * energy
         objective -= q["weight_dwell"] * params.transfer_dwell
     if peak:  # the least grid peak: bus power <= bus_peak at every sample, bus_peak weighed (weight_peak)
@@ -305,7 +306,7 @@ def _build(
 
     problem = {"x": x, "p": ca.vertcat(p_case, p_scale), "f": objective, "g": ca.vertcat(*rows.g)}
     kind = ("_rate" if rate else "_drive" if drive else "") + ("_zone" if zone and not rate else "")
-    kind += "_peak" if peak else ""
+    kind += ("_peak" if peak else "") + ("_losses" if losses else "")
     options = {**CYCLE_OPTIONS, **(DRIVE_OPTIONS if drive else {}), **(RATE_OPTIONS if rate else {})}
     program = NLPSolver("press_cycle_" + law_name.replace("-", "_") + kind, problem, options, lift=lift)
     return CycleNLP(
@@ -319,7 +320,7 @@ def _build(
         make_plan,
         published_rows,
         refinable,
-        None if zone else partial(halves_nlp, law_name, formula, limit_ids, drive, rate, True, links, peak),
+        None if zone else partial(halves_nlp, law_name, formula, limit_ids, drive, rate, True, links, peak, losses),
     )
 
 
@@ -333,15 +334,17 @@ def halves_nlp(
     zone: bool = False,
     links: tuple[str, ...] = (),
     peak: bool = False,
+    losses: bool = False,
 ) -> CycleNLP:
     """The compiled NLP of motion law ``law`` on a mechanism of closed form ``formula`` holding the limits
     ``limit_ids``, with the motor's torque when ``drive`` (the mechanism's massive ``links`` in it);
     ``rate``: the drive NLP of a target rate (see the module docstring); ``zone``: the limits that hold in
     the die zone held at every sample there (the rate NLP's always; otherwise the denser variant a search
     turns to when a plan's crank speed peaks inside the die zone, between the crossings); ``peak``: the rate
-    NLP with the bus power's peak as a variable (:data:`PEAK_VARIABLE`; the least grid peak). Built on first
-    use in a process, then reused for every case and start."""
-    return _build(law, formula, limit_ids, drive, rate, zone, links, peak)
+    NLP with the bus power's peak as a variable (:data:`PEAK_VARIABLE`; the least grid peak); ``losses``: its
+    supply energy through the copper loss and the converter (``planning.solver.nlp.objective_terms``). Built
+    on first use in a process, then reused for every case and start."""
+    return _build(law, formula, limit_ids, drive, rate, zone, links, peak, losses)
 
 
 def halves_nlp_for(case: Case, drive: bool | None = None, rate: bool = False, peak: bool = False) -> CycleNLP:
@@ -350,7 +353,10 @@ def halves_nlp_for(case: Case, drive: bool | None = None, rate: bool = False, pe
     drive = case.drive is not None if drive is None else drive
     limit_ids = nlp_limits(case, drive or rate)
     links = drive_links(case) if drive or rate else ()
-    return halves_nlp(case.planner.motion_law, case.machine.formula, limit_ids, drive, rate, False, links, peak)
+    d = case.drive
+    losses = rate and (d.motor.copper_loss_at_rated_kW > 0 or d.converter_efficiency < 1)
+    law, formula = case.planner.motion_law, case.machine.formula
+    return halves_nlp(law, formula, limit_ids, drive, rate, False, links, peak, losses)
 
 
 def fresh_build(case: Case) -> CycleNLP:

@@ -297,10 +297,10 @@ def bus_power_samples(q: dict, drive: DriveSamples) -> Any:
     return (drive.tm * drive.speed + q["copper_coefficient"] * drive.tm**2) / q["converter_efficiency"]
 
 
-def objective_terms(q: dict, drive: DriveSamples, al: Any, times: Any) -> tuple[Any, Any]:
+def objective_terms(q: dict, drive: DriveSamples, al: Any, times: Any, losses: bool = False) -> tuple[Any, Any]:
     """The rate NLP's trapezoidal ``(heat, supply energy)``: integral T_m^2 dt [N^2 m^2 s] and integral
     (r P + (1 - r) smoothmax(P, 0)) dt [J] of the bus power P = conv(T_m omega_m + k T_m^2) (the motors'
-    copper loss and the converter, ``press.power``; the shaft power when the drive states neither), on a
+    copper loss and the converter, ``press.power``, with ``losses``; else the shaft power), on a
     smooth torque: the gear's loss switches sides where T_c changes sign, and a plan that saves heat or
     energy coasts there (T_c = 0 over stretches), so the kinks are rounded: |x| -> sqrt(x^2 + eps^2) (the
     converter's P / eta_c or P eta_c with the same rounding)."""
@@ -309,9 +309,12 @@ def objective_terms(q: dict, drive: DriveSamples, al: Any, times: Any) -> tuple[
     eps_crank = q["power_smoothing"] / (q["motor_base_speed"] * down)  # [N m] at the crank
     through = drive.tc * (up + down) / 2 + ca.sqrt(drive.tc**2 + eps_crank**2) * (up - down) / 2
     smooth_torque = through + model.J_m * model.i * al
-    electrical = smooth_torque * drive.speed + q["copper_coefficient"] * smooth_torque**2
-    eta_c, eps = q["converter_efficiency"], q["power_smoothing"]
-    power = electrical * (1 / eta_c + eta_c) / 2 + ca.sqrt(electrical**2 + eps**2) * (1 / eta_c - eta_c) / 2
+    eps = q["power_smoothing"]
+    power = smooth_torque * drive.speed
+    if losses:  # else P is the shaft power (the terms below vanish: k = 0, eta_c = 1), at less cost per iteration
+        electrical = power + q["copper_coefficient"] * smooth_torque**2
+        eta_c = q["converter_efficiency"]
+        power = electrical * (1 / eta_c + eta_c) / 2 + ca.sqrt(electrical**2 + eps**2) * (1 / eta_c - eta_c) / 2
     drawn = (power + ca.sqrt(power**2 + eps**2)) / 2  # smooth max(P, 0)
     energy = trapezoid(q["regen"] * power + (1 - q["regen"]) * drawn, times)
     return trapezoid(smooth_torque**2, times), energy
