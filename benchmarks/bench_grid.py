@@ -19,7 +19,7 @@ VARIANTS = [  # (case file, label, overrides)
     ("cup-2000kN-drive.yaml", "grid limit 400 kW, no storage", {"drive.grid.peak_power_kW": 400.0}),
     (
         "cup-2000kN-drive.yaml",
-        "grid limit 400 kW, storage 2 kJ (the cap searched)",
+        "grid limit 400 kW, storage 2 kJ (the storage's energy row binds)",
         {"drive.grid.peak_power_kW": 400.0, "drive.storage.usable_energy_kJ": 2.0},
     ),
     (

@@ -357,6 +357,21 @@ def test_a_grid_limit_slows_the_plan_and_enough_storage_gives_the_speed_back():
     some = cup_with(**{"drive.grid.peak_power_kW": 400.0, "drive.storage.usable_energy_kJ": 2.0})
     assert limited["spm"] < some["spm"] < free
     assert some["power"].grid_peak_kW <= 400.0 * (1 + 1e-6)
+    # the plan leans on the storage (the NLP's energy row), not on a lower cap alone: most of it is needed
+    assert 0.5 * 2.0 <= some["power"].storage_for_limit_kJ <= 2.0 * (1 + 1e-9)
+    # a storage whose power ends before the bus's peak: the cap (limit + its power) refined by the bus's peak
+    # between the samples (this ended unverified, 351.5 kW against 350, before the refinement scaled the cap)
+    weak = cup_with(
+        **{
+            "drive.grid.peak_power_kW": 350.0,
+            "drive.storage.usable_energy_kJ": 10.0,
+            "drive.storage.efficiency": 0.9,
+            "drive.storage.max_power_kW": 100.0,
+        }
+    )
+    p = weak["power"]
+    assert p.grid_peak_kW <= 350.0 * (1 + 1e-6) < p.bus_peak_kW <= 450.0 * (1 + 1e-6)
+    assert p.storage_peak_power_kW <= 100.0 * (1 + 1e-9)
 
 
 def test_a_grid_limit_below_the_draws_power_is_refused_before_solving(tmp_path, capsys):

@@ -399,6 +399,9 @@ def power_figures(
     limit = d.grid.peak_power_kW if d.grid is not None else None
     cap = None
     flatten = storage_to_flatten(edges, edge_bus, top, storage) if storage is not None else None
+    for_limit = None
+    if limit is not None and storage is not None:
+        for_limit = storage_needed(edges, top, limit * 1e3, storage.efficiency, storage.max_power) / 1e3
     if limit is not None and storage is not None and float(grid[k]) > limit * 1e3:
         cap = bus_cap_for_limit(edges, top, storage, limit * 1e3) / 1e3
     return PowerFigures(
@@ -426,6 +429,7 @@ def power_figures(
         storage_peak_power_kW=float(max(np.max(schedule.charge), np.max(schedule.discharge), 0.0)) / 1e3,
         grid_limit_kW=limit,
         bus_cap_for_limit_kW=cap,
+        storage_for_limit_kJ=for_limit,
         storage_to_flatten_kJ=None if flatten is None else flatten / 1e3,
         schedule=schedule,
     )

@@ -52,8 +52,9 @@ class Check:
     kind: str
     passed: bool
     id: str = field(compare=False)
-    refine_to: float | None = field(default=None, compare=False)  # where the NLP's refined parameter goes
-    # when this check fails (inside units; None: lowered by limit / value, the measured overshoot)
+    refine_by: tuple[str, float] | None = field(default=None, compare=False)  # the NLP parameter this
+    # check's failure scales and the factor (the grid's cap or storage allowance; None: the limit's refined
+    # parameter lowered by limit / value, the measured overshoot)
 
     @classmethod
     def of(cls, check_id: str, name: str, value: float, limit: float, unit: str, kind: str, tol: float) -> Check:
@@ -87,7 +88,7 @@ class Check:
         """The check as ``result.json`` writes it (stable id, display name, value, limit, unit, kind, passed,
         margin): a script finds a check by its ``id``, the name is for people."""
         out = asdict(self)
-        out.pop("refine_to")
+        out.pop("refine_by")
         return {"id": out.pop("id"), **out, "margin": self.margin}
 
 
