@@ -17,7 +17,7 @@ import pytest
 
 from .conftest import PUBLISHED_CASE, ROOT
 
-KILL_TRIALS = 7  # per test (two tests, 14 kills in all)
+KILL_TRIALS = 5  # per test (two tests, 10 kills in all)
 PRESSPLAN = [sys.executable, "-m", "planning.cli"]
 
 
@@ -52,7 +52,7 @@ def state(folder: Path) -> tuple:
 
 
 @pytest.mark.skipif(sys.platform != "linux", reason="the kill test drives Linux processes")
-@pytest.mark.parametrize("seed", [2026, 2027], ids=["kills 1-7", "kills 8-14"])  # the two workers share them
+@pytest.mark.parametrize("seed", [2026, 2027], ids=["kills 1-5", "kills 6-10"])  # the two workers share them
 def test_killed_solve_leaves_the_folder_entirely_old_or_entirely_new(tmp_path, seed):
     other = tmp_path / "other.yaml"
     other.write_text(PUBLISHED_CASE.read_text().replace("transfer_time_s: 2.0", "transfer_time_s: 1.8"))

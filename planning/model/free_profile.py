@@ -20,19 +20,27 @@ import numpy as np
 from planning.model.laws.optimal import OptimalLaw
 from planning.model.profile import Profile, Segment, knot_states
 
-PHASES = (("return", 40), ("transfer", 24), ("feed", 40))  # name, segments: theta3->theta4->theta1->theta2
+Layout = tuple[tuple[str, int], ...]  # (phase, segments) in the order theta3 -> theta4 -> theta1 -> theta2
+PHASES: Layout = (("return", 40), ("transfer", 24), ("feed", 40))  # the layout every solve starts with
+FINE_FACTOR = 2.5  # the finer layout: this many times the segments of each phase (finer)
 
 
-def free_segments(durations, jerks) -> list[Segment]:  # noqa: ANN001 - floats or CasADi symbols
+def finer(layout: Layout) -> Layout:
+    """``layout`` with :data:`FINE_FACTOR` times the segments in each phase."""
+    return tuple((phase, round(n * FINE_FACTOR)) for phase, n in layout)
+
+
+def free_segments(durations, jerks, layout: Layout = PHASES) -> list[Segment]:  # noqa: ANN001 - floats or symbols
     """The segments of durations ``T_k`` [s] and constant jerks ``j_k`` [rad/s^3], named ``PHASE:k``."""
-    names = [f"{phase}:{k + 1}" for phase, n in PHASES for k in range(n)]
+    names = [f"{phase}:{k + 1}" for phase, n in layout for k in range(n)]
     return [Segment(name, T, j, 0.0) for name, T, j in zip(names, durations, jerks, strict=True)]
 
 
 @dataclass(frozen=True)
 class FreeProfileParameters:
     """A solved free profile (inside units): ``durations`` [s] and ``jerks`` [rad/s^3] of the segments from
-    theta3, ``draw_speed`` w2 [rad/s], ``draw_start`` / ``draw_end`` theta2, theta3 [rad]. The fields a
+    theta3, ``draw_speed`` w2 [rad/s], ``draw_start`` / ``draw_end`` theta2, theta3 [rad], the phases'
+    ``layout`` (:data:`PHASES` or :func:`finer`). The fields a
     report reads of every plan are derived: ``transfer_speed`` (the speed at TDC), ``feed_peak_speed`` and
     ``return_peak_speed`` (the highest speed before theta2 and after theta3, on either side of TDC)."""
 
@@ -44,9 +52,10 @@ class FreeProfileParameters:
     motion_law: str = OptimalLaw.name
     transfer_dwell: float = 0.0
     law_parameter: float = 0.0
+    layout: Layout = PHASES
 
     def segments(self) -> list[Segment]:
-        return free_segments(self.durations, self.jerks)
+        return free_segments(self.durations, self.jerks, self.layout)
 
     @property
     def draw_time(self) -> float:

@@ -20,13 +20,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
-from functools import cache
+from functools import cache, partial
 
 import casadi as ca
 import numpy as np
 
 from planning.model.case import Case
-from planning.model.free_profile import PHASES, FreeProfileParameters
+from planning.model.free_profile import PHASES, FreeProfileParameters, Layout
 from planning.model.laws.optimal import OptimalLaw
 from planning.model.limits.base import Extremes, Transcription
 from planning.model.plan import Plan, SolverInfo, rotate_to_tdc
@@ -57,11 +57,13 @@ TOP_SPEED = 1e3  # [rad/s] upper bound of the crank speeds (far above any press)
 WARM_OPTIONS = {"ipopt.mu_init": 1e-8}
 
 
-def _variables() -> tuple[tuple[str, str], ...]:
+@cache
+def variables_of(phases: Layout = PHASES) -> tuple[tuple[str, str], ...]:
+    """The NLP's variables and the kind of scale of each, for the phases' ``layout``."""
     # the die-height crossings outside the draw: going up in the return (time from theta3), going down in
     # the feed (time from theta1)
     out: list[tuple[str, str]] = [("draw_speed", "speed"), ("die_up_time", "time"), ("die_down_time", "time")]
-    for phase, n in PHASES:
+    for phase, n in phases:
         out.append((f"{phase}_step", "step"))
         out += [(f"{phase}_jerk_{k}", "jerk") for k in range(n)]
         # the knots inside the phase and its end (the start is the previous phase's end, or theta3)
@@ -72,11 +74,16 @@ def _variables() -> tuple[tuple[str, str], ...]:
     return tuple(out)
 
 
-VARIABLES = _variables()
-INDEX = {name: i for i, (name, _) in enumerate(VARIABLES)}
+VARIABLES = variables_of(PHASES)
 
 
-def variable_scales(case: Case) -> np.ndarray:
+@cache
+def index_of(phases: Layout = PHASES) -> dict[str, int]:
+    """Each variable's position for the phases' ``layout``."""
+    return {name: i for i, (name, _) in enumerate(variables_of(phases))}
+
+
+def variable_scales(case: Case, phases: Layout = PHASES) -> np.ndarray:
     """Scales from the press's characteristic time and speed (as the laws' NLP) and the jerk limit."""
     m, A = case.machine, case.limits.slider_accel_mm_s2
     t_star = math.sqrt(m.length_scale / A)
@@ -89,43 +96,51 @@ def variable_scales(case: Case) -> np.ndarray:
         "jerk": case.limits.crank_jerk_rad_s3,
         "time": t_star,
     }
-    return np.array([unit[kind] for _, kind in VARIABLES])
+    return np.array([unit[kind] for _, kind in variables_of(phases)])
 
 
 def variable_bounds(
-    case: Case, layout: ParameterLayout, w2_lo: float, w2_hi: float, parameters: np.ndarray
+    case: Case,
+    layout: ParameterLayout,
+    w2_lo: float,
+    w2_hi: float,
+    parameters: np.ndarray,
+    phases: Layout = PHASES,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The segments' jerks within the jerk limit, the steps within the longest cycle, the speeds positive,
     the draw speed within its bounds, a die crossing's time fixed where it lies in the draw."""
     J = case.limits.crank_jerk_rad_s3
     longest = time_limit(case)
-    lo, hi = np.full(len(VARIABLES), -np.inf), np.full(len(VARIABLES), np.inf)
-    for name, kind in VARIABLES:
-        i = INDEX[name]
+    variables, index = variables_of(phases), index_of(phases)
+    lo, hi = np.full(len(variables), -np.inf), np.full(len(variables), np.inf)
+    for name, kind in variables:
+        i = index[name]
         if kind == "jerk":
             lo[i], hi[i] = -J, J
         elif kind == "step":
             phase = name.removesuffix("_step")
-            lo[i], hi[i] = 0.0, longest / dict(PHASES)[phase]
+            lo[i], hi[i] = 0.0, longest / dict(phases)[phase]
         elif kind == "speed":
             lo[i], hi[i] = 0.0, TOP_SPEED
-    lo[INDEX["draw_speed"]], hi[INDEX["draw_speed"]] = w2_lo, w2_hi
+    lo[index["draw_speed"]], hi[index["draw_speed"]] = w2_lo, w2_hi
     for k in ("die_down", "die_up"):
-        i = INDEX[f"{k}_time"]
+        i = index[f"{k}_time"]
         active = parameters[layout.index(f"{k}_active")] != 0.0
         lo[i], hi[i] = (0.0, longest) if active else (0.0, 0.0)
     return lo, hi
 
 
-def make_plan(case: Case, values: dict[str, float], placement: str, info: SolverInfo) -> Plan:
+def make_plan(
+    case: Case, values: dict[str, float], placement: str, info: SolverInfo, phases: Layout = PHASES
+) -> Plan:
     """The plan of the NLP's values: the profile propagated from theta3 through the segments' closed forms
     (the NLP's knot states agree with it to its tolerance), then the draw."""
     th1, th2, th3, th4 = (float(a) for a in case.key_angles)
     durations, jerks = [], []
-    for phase, n in PHASES:
+    for phase, n in phases:
         durations += [values[f"{phase}_step"]] * n
         jerks += [values[f"{phase}_jerk_{k}"] for k in range(n)]
-    params = FreeProfileParameters(tuple(durations), tuple(jerks), values["draw_speed"], th2, th3)
+    params = FreeProfileParameters(tuple(durations), tuple(jerks), values["draw_speed"], th2, th3, layout=phases)
     segs = [seg for seg in params.segments() if seg.duration > 0]
     draw = Segment("draw:constant", params.draw_time, 0.0, 0.0)
     profile = rotate_to_tdc([*segs, draw], th3, params.draw_speed)
@@ -135,17 +150,20 @@ def make_plan(case: Case, values: dict[str, float], placement: str, info: Solver
     return replace(plan, structure=structure, nlp_values=dict(values))
 
 
-def _build(formula: Formula, limit_ids: tuple[str, ...], drive: bool, links: tuple[str, ...] = ()) -> CycleNLP:
+def _build(
+    formula: Formula, limit_ids: tuple[str, ...], drive: bool, links: tuple[str, ...] = (), phases: Layout = PHASES
+) -> CycleNLP:
     # MX with vector operations (every segment of a phase at once): CasADi derives the Jacobian and the
     # Hessian of this graph in a fraction of the time a scalar SX graph of the same problem takes, and
     # evaluates them about as fast
     layout = ParameterLayout(formula, limit_ids, drive, False, links if drive else ())
-    x = ca.MX.sym("x", len(VARIABLES))
+    variables, index = variables_of(phases), index_of(phases)
+    x = ca.MX.sym("x", len(variables))
     p_case = ca.MX.sym("p", layout.size)
-    p_scale = ca.MX.sym("scale", len(VARIABLES))
+    p_scale = ca.MX.sym("scale", len(variables))
     physical = x * p_scale
-    v = {name: physical[i] for name, i in INDEX.items()}
-    unit = {name: p_scale[i] for name, i in INDEX.items()}
+    v = {name: physical[i] for name, i in index.items()}
+    unit = {name: p_scale[i] for name, i in index.items()}
     q = layout.symbols(p_case)
     w2 = v["draw_speed"]
 
@@ -155,9 +173,9 @@ def _build(formula: Formula, limit_ids: tuple[str, ...], drive: bool, links: tup
     t0 = ca.MX(0.0)
     shooting, boundary, samples, times, knot_accels = [], [], [], [], []
     crossings = {}
-    for phase, n in PHASES:
+    for phase, n in phases:
         h = v[f"{phase}_step"]
-        first = INDEX[f"{phase}_jerk_0"]
+        first = index[f"{phase}_jerk_0"]
         jerk = physical[first : first + n]
         # the knots 1 .. n of the phase: n rows of (angle, speed, accel), stored row after row
         states = ca.reshape(physical[first + n : first + 4 * n], 3, n).T
@@ -211,7 +229,7 @@ def _build(formula: Formula, limit_ids: tuple[str, ...], drive: bool, links: tup
     nlp = Transcription(
         **samples,
         period=t0 + draw_time,
-        window_time=PHASES[1][1] * v["transfer_step"],
+        window_time=phases[1][1] * v["transfer_step"],
         speeds=Extremes(om, signed=False, sampled=True),
         accelerations=Extremes(ca.vertcat(*knot_accels), signed=True),
         jerks=None,  # the bounds of the segments' jerks
@@ -225,17 +243,17 @@ def _build(formula: Formula, limit_ids: tuple[str, ...], drive: bool, links: tup
 
     problem = {"x": x, "p": ca.vertcat(p_case, p_scale), "f": nlp.period, "g": ca.vertcat(*rows.g)}
     options = {**CYCLE_OPTIONS, **DRIVE_OPTIONS}  # MUMPS's AMD ordering: the same iterations, 5-10 % faster here
-    name = "press_cycle_optimal" + ("_drive" if drive else "")
+    name = "press_cycle_optimal" + ("_fine" if phases != PHASES else "") + ("_drive" if drive else "")
     program = NLPSolver(name, problem, options, None, WARM_OPTIONS, lift)
     return CycleNLP(
         program,
         *rows.bounds(),
         tuple(rows.blocks),
         layout,
-        VARIABLES,
-        variable_scales,
-        variable_bounds,
-        make_plan,
+        variables,
+        partial(variable_scales, phases=phases),
+        partial(variable_bounds, phases=phases),
+        partial(make_plan, phases=phases),
         refinable=refinable,
     )
 
@@ -247,15 +265,20 @@ def _interleave(columns: list) -> ca.MX:
 
 @cache
 def free_nlp(
-    formula: Formula, limit_ids: tuple[str, ...], drive: bool = False, links: tuple[str, ...] = ()
+    formula: Formula,
+    limit_ids: tuple[str, ...],
+    drive: bool = False,
+    links: tuple[str, ...] = (),
+    phases: Layout = PHASES,
 ) -> CycleNLP:
     """The compiled NLP of the optimal law for a mechanism's ``formula`` and the limits ``limit_ids``, with
-    the motor's torque when ``drive`` (the mechanism's massive ``links`` in it); built on first use in a
-    process, then reused."""
-    return _build(formula, limit_ids, drive, links)
+    the motor's torque when ``drive`` (the mechanism's massive ``links`` in it), on the phases' ``layout``;
+    built on first use in a process, then reused."""
+    return _build(formula, limit_ids, drive, links, phases)
 
 
-def free_nlp_for(case: Case) -> CycleNLP:
+def free_nlp_for(case: Case, phases: Layout = PHASES) -> CycleNLP:
     """The optimal law's NLP of ``case``'s mechanism and limits, with the motor's rows when it has a drive."""
     drive = case.drive is not None
-    return free_nlp(case.machine.formula, nlp_limits(case, drive), drive, drive_links(case) if drive else ())
+    links = drive_links(case) if drive else ()
+    return free_nlp(case.machine.formula, nlp_limits(case, drive), drive, links, phases)

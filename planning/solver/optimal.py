@@ -6,6 +6,12 @@ phases' grids (the bound's profile has no jerk limit and is a poorer start); a n
 optimal plan (a sweep, a looser limit) starts first and, when it holds here, is a candidate answer. The
 minimum crank speed is held :data:`MIN_SPEED_BACKOFF` above its limit at the samples. The plans are
 verified densely like every other.
+
+The layout of equal segments per phase (``planning.model.free_profile.PHASES``) cannot follow the arcs
+where the slider acceleration sits at its limit when the jerk limit is high (there the optimum's
+acceleration follows a curve and its jerk ramps are short): a plan whose peak jerk stays below
+:data:`FINE_JERK_SHARE` of the limit is the layout's, not the jerk limit's, and is solved again on the
+finer layout (``free_profile.finer``), started from it; the faster verified plan is the answer.
 """
 
 from __future__ import annotations
@@ -13,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from planning.model.case import Case
-from planning.model.free_profile import PHASES
+from planning.model.free_profile import PHASES, Layout, finer
 from planning.model.laws.optimal import OptimalLaw
 from planning.model.plan import Plan
 from planning.solver.free_nlp import free_nlp_for
@@ -27,17 +33,22 @@ SEED_LAW = "seven-segment"  # a jerk-limited law whose plan starts the NLP
 # relative: the sampled minimum crank speed is held this much above the limit (the speed is cubic between
 # the samples and may dip below them; the slowest point, near TDC, is usually at the limit)
 MIN_SPEED_BACKOFF = 1e-2
+FINE_JERK_SHARE = 0.5  # a plan using less than this share of the jerk limit is solved again on the finer layout
 
 
-def seed_values(seed: Plan) -> dict[str, float]:
-    """A plan of another law as the optimal NLP's values: its profile sampled on each phase's uniform
-    grid between the key points, the jerk of each segment from the change of acceleration across it."""
+def seed_values(seed: Plan, phases: Layout = PHASES) -> dict[str, float]:
+    """A plan of another law (or an optimal plan on another layout) as the optimal NLP's values on the
+    phases' ``layout``: its profile sampled on each phase's uniform grid between the key points, the jerk of
+    each segment from the change of acceleration across it."""
     prof, period = seed.profile, seed.period
     t1, t2, t3, t4 = (float(t) for t in seed.key_times())
     spans = {"return": (t3, t4), "transfer": (t4, t1 + period), "feed": (t1 + period, t2 + period)}
     values = {"draw_speed": float(seed.parameters.draw_speed), "die_up_time": seed.nlp_values["die_up_time"]}
-    values["die_down_time"] = max(seed.nlp_values["die_down_time"] - seed.nlp_values["closing_time"], 0.0)
-    for phase, n in PHASES:
+    if seed.motion_law == OptimalLaw.name:  # the descending crossing's time counts from theta1 already
+        values["die_down_time"] = seed.nlp_values["die_down_time"]
+    else:
+        values["die_down_time"] = max(seed.nlp_values["die_down_time"] - seed.nlp_values["closing_time"], 0.0)
+    for phase, n in phases:
         a, b = spans[phase]
         h = (b - a) / n
         t = a + h * np.arange(n + 1)
@@ -57,13 +68,19 @@ def from_neighbour_optimal(case: Case, neighbour: Plan) -> Solution | None:
     """The answer from ``neighbour`` alone (its plan when it holds here, one start from its values), or
     None: fast, not confirmed (``planning.solver.optimize.solve``)."""
     _require_jerk_limit(case)
-    search = _search(case)
+    search = _search(case, _layout_of(neighbour))
     return search.answer() if _from(search, neighbour) else None
 
 
-def _search(case: Case) -> Search:
-    """The optimal law's search: prechecks, parameters, bounds, scales; the minimum crank speed backed off."""
-    search = prepare(case, "free", free_nlp_for(case))
+def _layout_of(plan: Plan) -> Layout:
+    """The phases' layout of an optimal plan (the first layout for a plan of another law)."""
+    return getattr(plan.parameters, "layout", PHASES) if plan.motion_law == OptimalLaw.name else PHASES
+
+
+def _search(case: Case, phases: Layout = PHASES) -> Search:
+    """The optimal law's search on the phases' ``layout``: prechecks, parameters, bounds, scales; the minimum
+    crank speed backed off."""
+    search = prepare(case, "free", free_nlp_for(case, phases))
     search.parameters = search.parameters.copy()
     search.parameters[search.parameter("min_crank_speed")] *= 1 + MIN_SPEED_BACKOFF
     return search
@@ -97,12 +114,30 @@ def solve_optimal(case: Case, neighbour: Plan | None = None) -> Solution:
     limit). When it holds here it is a candidate; its values start the NLP, and when that start verifies
     the seed law is not solved at all (a warm re-solve)."""
     _require_jerk_limit(case)
+    if neighbour is not None:
+        search = _search(case, _layout_of(neighbour))
+        if _from(search, neighbour):
+            return _on_the_finer_layout(case, search)
     search = _search(case)
-    if neighbour is not None and _from(search, neighbour):
-        return search.answer()
     seeded = case.with_law(SEED_LAW)
     seed = converged_plan(seeded) or solve_max_spm(seeded, "free").plan
     search.iterations += seed.solver.iterations
     search.starts += seed.solver.starts
     search.multi_start([seed_values(seed)], "free", confirm=False)
-    return search.answer()
+    return _on_the_finer_layout(case, search)
+
+
+def _on_the_finer_layout(case: Case, search: Search) -> Solution:
+    """The search's answer, or, where its plan on the first layout uses less than :data:`FINE_JERK_SHARE` of
+    the jerk limit (the layout held it back, not the limit), the faster of it and the finer layout's plan
+    started from it."""
+    answer = search.answer()
+    fine_layout = finer(PHASES)
+    used = answer.plan.parameters.peak_jerks()[0]
+    if _layout_of(answer.plan) == fine_layout or used >= FINE_JERK_SHARE * case.limits.crank_jerk_rad_s3:
+        return answer
+    fine = _search(case, fine_layout)
+    fine.consider(answer, answer.plan.period)
+    fine.iterations, fine.starts = search.iterations, search.starts
+    fine.multi_start([seed_values(answer.plan, fine_layout)], "free", confirm=False)
+    return fine.answer()
