@@ -205,7 +205,7 @@ def repair(
     rows: dict[int, dict[str, Any]],
     placement: str | None,
     label: str,
-    passes: int = 12,
+    passes: int | None = None,
     workers: int = 1,
     scheduler: str | None = None,
     timeline: Timeline | None = None,
@@ -217,16 +217,18 @@ def repair(
     is a feasible answer here, so the point is never left worse than it. Each pass finds, in this process,
     every point with such plans (a plan once tried for a point is not tried again), then re-solves those
     points on the ``workers`` (or the Dask ``scheduler``), each from the plans it found, keeping the best;
-    passes repeat until no point improves. Returns how many re-solves improved a point; ``timeline``: the
-    time of the finding (one process) is added to its ``second_pass_serial_s``.
+    passes repeat until no point improves (an improvement travels one neighbour per pass; at most
+    ``passes``, by default as many as there are points). Returns how many re-solves improved a point;
+    ``timeline``: the time of the finding (one process) is added to its ``second_pass_serial_s``.
     """
     from planning.model.case_file import CaseFileError, case_from_data
     from planning.solver.verify import verify
 
     improved = 0
     cases: dict[int, Any] = {}  # each point's case, read once for every pass
-    tried: set[tuple[int, int]] = set()  # (point, id of a neighbour's plan) already checked
-    for _ in range(passes):
+    tried: dict[tuple[int, int], Any] = {}  # (point, id of a neighbour's plan) checked -> the plan (kept, so
+    # that its id is not reused by a later plan)
+    for _ in range(len(rows) + 1 if passes is None else passes):
         finding = time.time()
         work = []
         for i in sorted(rows):
@@ -246,7 +248,7 @@ def repair(
                 plan = rows.get(j, {}).get("plan")
                 if plan is None or (current is not None and plan.spm <= current + 1e-9) or (i, id(plan)) in tried:
                     continue
-                tried.add((i, id(plan)))
+                tried[(i, id(plan))] = plan
                 same = np.allclose(plan.key_angles, case.key_angles, atol=1e-12)
                 # the robot's window first: the verification's own check, without its dense grid (a faster
                 # neighbour in a sweep of the transfer time fails it, and only it)
@@ -413,7 +415,7 @@ def run_sweep(
     for i, r in earlier.items():  # rows of an earlier run: their plans are not kept
         fresh.setdefault(i, {**r, "index": i, "spm": float(r["spm"]) if r.get("spm") else None})
     timeline.mark("second_pass_start")
-    improved = repair(base, fields, points, shape, fresh, placement, label, 12, workers, scheduler, timeline)
+    improved = repair(base, fields, points, shape, fresh, placement, label, None, workers, scheduler, timeline)
     timeline.mark("second_pass_end")
     tmp = csv_path.with_suffix(".csv.tmp")
     with open(tmp, "w", newline="", encoding="utf-8") as fh:

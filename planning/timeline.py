@@ -75,9 +75,10 @@ class Timeline:
                 for w, rs in sorted(workers.items())
             ],
         )
-        # the second pass: its finding runs in this process (serial), its re-solves on the workers
+        # the second pass: its finding runs in this process (serial), its re-solves on the workers; the serial
+        # part is everything after the last point but the re-solves on the workers
         out["second_pass_serial_s"] = min(self.spans.get("second_pass_serial_s", second), second)
-        out["serial_s"] = out["startup_s"] + out["second_pass_serial_s"] + out["writing_s"]
+        out["serial_s"] = out["startup_s"] + (end - last) - (second - out["second_pass_serial_s"])
         out["efficiency"] = out["solve_time_sum_s"] / (len(workers) * span) if span > 0 else 1.0
         if blocks:
             by_index = {r["index"]: r for r in stamped}

@@ -354,6 +354,9 @@ def test_a_grid_limit_slows_the_plan_and_enough_storage_gives_the_speed_back():
     assert limited["verification"].check("grid_peak_power").binds
     stored = cup_with(**{"drive.grid.peak_power_kW": 400.0, "drive.storage.usable_energy_kJ": 200.0})
     assert stored["spm"] == pytest.approx(free, rel=1e-3)
+    # an empty storage is no worse than none (the energy row's smoothing alone would use up a tiny budget)
+    empty = cup_with(**{"drive.grid.peak_power_kW": 400.0, "drive.storage.usable_energy_kJ": 0.0})
+    assert empty["spm"] >= limited["spm"] * (1 - 1e-9)
     some = cup_with(**{"drive.grid.peak_power_kW": 400.0, "drive.storage.usable_energy_kJ": 2.0})
     assert limited["spm"] < some["spm"] < free
     assert some["power"].grid_peak_kW <= 400.0 * (1 + 1e-6)

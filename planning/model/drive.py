@@ -90,7 +90,7 @@ class PowerFigures:
     bus_cap_for_limit_kW: float | None  # above the grid limit with storage: the bus cap the storage could
     # shave to the limit on this plan's shape (planning.solver.grid.bus_cap_for_limit; None otherwise)
     storage_for_limit_kJ: float | None  # with storage and a grid limit: the least usable energy with which it
-    # holds the limit on this plan (inf: no size does; planning.solver.grid.storage_needed)
+    # holds the limit on this plan (None: no size does, or no storage or limit; planning.solver.grid.storage_needed)
     storage_to_flatten_kJ: float | None  # with storage: the least usable energy of one like it that brings the
     # grid's peak within 5 % of the mean bus power (planning.solver.grid.storage_to_flatten; None: none does)
     schedule: Any = field(default=None, compare=False, repr=False)  # planning.solver.grid.Schedule

@@ -399,9 +399,10 @@ def power_figures(
     limit = d.grid.peak_power_kW if d.grid is not None else None
     cap = None
     flatten = storage_to_flatten(edges, edge_bus, top, storage) if storage is not None else None
-    for_limit = None
+    for_limit = None  # also where no size would do (its power limit): JSON has no infinity
     if limit is not None and storage is not None:
-        for_limit = storage_needed(edges, top, limit * 1e3, storage.efficiency, storage.max_power) / 1e3
+        needed = storage_needed(edges, top, limit * 1e3, storage.efficiency, storage.max_power)
+        for_limit = needed / 1e3 if math.isfinite(needed) else None
     if limit is not None and storage is not None and float(grid[k]) > limit * 1e3:
         cap = bus_cap_for_limit(edges, top, storage, limit * 1e3) / 1e3
     return PowerFigures(

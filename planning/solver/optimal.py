@@ -114,11 +114,16 @@ def solve_optimal(case: Case, neighbour: Plan | None = None) -> Solution:
     limit). When it holds here it is a candidate; its values start the NLP, and when that start verifies
     the seed law is not solved at all (a warm re-solve)."""
     _require_jerk_limit(case)
+    spent = (0, 0)  # a neighbour's search that found nothing: its iterations and starts still count
     if neighbour is not None:
         search = _search(case, _layout_of(neighbour))
         if _from(search, neighbour):
             return _on_the_finer_layout(case, search)
+        spent = (search.iterations, search.starts)
+    t_start = search.t_start if neighbour is not None else None
     search = _search(case)
+    search.t_start = t_start or search.t_start
+    search.iterations, search.starts = spent
     seeded = case.with_law(SEED_LAW)
     seed = converged_plan(seeded) or solve_max_spm(seeded, "free").plan
     search.iterations += seed.solver.iterations
@@ -138,6 +143,6 @@ def _on_the_finer_layout(case: Case, search: Search) -> Solution:
         return answer
     fine = _search(case, fine_layout)
     fine.consider(answer, answer.plan.period)
-    fine.iterations, fine.starts = search.iterations, search.starts
+    fine.iterations, fine.starts, fine.t_start = search.iterations, search.starts, search.t_start
     fine.multi_start([seed_values(answer.plan, fine_layout)], "free", confirm=False)
     return fine.answer()

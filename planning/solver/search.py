@@ -133,9 +133,10 @@ class Search:
                 continue
             for c in bad:  # tighten the NLP's sampled limit by the measured overshoot
                 refine = self.nlp.refinable[c.id]
-                if c.refine_by is not None:  # the limit says which parameter and by how much (the grid's)
-                    name, factor = c.refine_by
-                    q[self.parameter(name)] *= factor * (1 - REFINE_MARGIN)
+                if c.refine_by is not None:  # the limit says which parameter and where it goes (the grid's)
+                    name, factor, ceiling = c.refine_by
+                    k = self.parameter(name)
+                    q[k] = min(q[k], ceiling) * factor * (1 - REFINE_MARGIN)
                 elif refine.upward:  # a lower limit (the optimal law's minimum crank speed) goes up
                     q[refine.index] *= (c.limit / max(c.value, 0.5 * c.limit)) * (1 + REFINE_MARGIN)
                 else:

@@ -52,9 +52,9 @@ class Check:
     kind: str
     passed: bool
     id: str = field(compare=False)
-    refine_by: tuple[str, float] | None = field(default=None, compare=False)  # the NLP parameter this
-    # check's failure scales and the factor (the grid's cap or storage allowance; None: the limit's refined
-    # parameter lowered by limit / value, the measured overshoot)
+    refine_by: tuple[str, float, float] | None = field(default=None, compare=False)  # (NLP parameter,
+    # factor, ceiling): this check's failure sets the parameter to min(itself, ceiling) x factor (the grid's
+    # cap or storage allowance; None: the limit's refined parameter lowered by limit / value, the overshoot)
 
     @classmethod
     def of(cls, check_id: str, name: str, value: float, limit: float, unit: str, kind: str, tol: float) -> Check:

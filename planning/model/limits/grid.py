@@ -58,19 +58,19 @@ class GridPeakLimit(Limit):
         d = case.drive
         limit = d.grid.peak_power_kW * 1e3
         cap = limit * (1 - self.backoff)
-        if d.storage is not None:
+        s = d.storage
+        if _storage_counts(case):
             top = _most_bus_power(case) * CAP_HEADROOM
-            if d.storage.max_power_kW is not None:
-                top = min(top, limit + d.storage.max_power_kW * 1e3)
+            if s.max_power_kW is not None:
+                top = min(top, limit + s.max_power_kW * 1e3)
             cap = max(cap, top)
         rated = d.motor.rated_torque_Nm
-        s = d.storage
         return {
             "grid_cap": cap,
             "grid_copper": d.motor.copper_loss_at_rated_kW * 1e3 / rated**2,
             "grid_converter": d.converter_efficiency,
             "grid_limit": limit,
-            "grid_allowance": NO_STORAGE_J if s is None else max(s.efficiency * s.usable_energy_kJ * 1e3, 1.0),
+            "grid_allowance": s.efficiency * s.usable_energy_kJ * 1e3 if _storage_counts(case) else NO_STORAGE_J,
         }
 
     def rows(self, nlp: Transcription) -> list[Row]:
@@ -135,16 +135,33 @@ class GridPeakLimit(Limit):
         limit = dense.case.drive.grid.peak_power_kW
         p = dense.power
         check = Check.of(self.id, self.name, p.grid_peak_kW, limit, self.unit, "max", REL_TOL * limit)
+        if not _storage_counts(dense.case):  # planned as without storage: the cap lowered by the overshoot
+            return [check]
         needed, usable = p.storage_for_limit_kJ, p.storage_usable_kJ
-        if needed is not None and math.isfinite(needed) and needed > usable:
-            return [replace(check, refine_by=("grid_allowance", usable / needed))]
+        if needed is not None and needed > usable:  # at most the energy the plan needs, scaled by what there is
+            eta = dense.case.drive.storage.efficiency
+            return [replace(check, refine_by=("grid_allowance", usable / needed, eta * needed * 1e3))]
         if p.bus_cap_for_limit_kW is not None and p.bus_peak_kW > p.bus_cap_for_limit_kW:
-            return [replace(check, refine_by=("grid_cap", p.bus_cap_for_limit_kW / p.bus_peak_kW))]
+            # at most the plan's bus peak, scaled by the level the storage could hold over that peak
+            factor = p.bus_cap_for_limit_kW / p.bus_peak_kW
+            return [replace(check, refine_by=("grid_cap", factor, p.bus_peak_kW * 1e3))]
         return [check]
 
     def relaxed_rows(self, grid: Any) -> None:
         """Not in the upper bound (the storage's state couples the whole cycle): left out."""
         return None
+
+
+def _storage_counts(case: Any) -> bool:
+    """Whether the case's storage enters the plan: it can give more than the energy row's smoothing adds on its
+    own (eps / 2 over the robot's transfer time, a lower bound of the cycle). A smaller storage is planned as
+    none (the grid held at the limit by the cap alone); the verification still runs its schedule."""
+    d = case.drive
+    s = d.storage
+    if s is None:
+        return False
+    smoothing = EXCESS_SMOOTHING * d.grid.peak_power_kW * 1e3 / 2 * case.process.transfer_time_s  # [J]
+    return s.efficiency * s.usable_energy_kJ * 1e3 > smoothing
 
 
 def _most_bus_power(case: Any) -> float:
