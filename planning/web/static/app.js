@@ -490,6 +490,19 @@ function nearest(xs, v) {
   return best;
 }
 
+// the drive's and the energy chart's common layout: margins, the legend below, the stages shaded (x axis "x")
+const ROUND_TICKS = { nticks: 6, tickformat: "~g" };
+function xAxisTitle(axis) { return axis === "time" ? "time from TDC [s]" : "crank angle [deg]"; }
+function cycleChartLayout(r, x, axis, legendY) {
+  const { shapes } = cycleShapes(r, x, axis);
+  return {
+    margin: { l: 60, r: 30, t: 10, b: 40 },
+    hovermode: "closest",
+    legend: { orientation: "h", y: legendY, yanchor: "top", font: { size: 10 } },
+    shapes: shapes.map((sh) => ({ ...sh, xref: "x", yref: "paper" })),
+  };
+}
+
 function drawDrive(r, c, x, axis) {
   const el = $("#drive-chart");
   if (!r.drive || !c.motor_torque_Nm) { Plotly.purge(el); el.style.display = "none"; return; }
@@ -517,18 +530,14 @@ function drawDrive(r, c, x, axis) {
     { x: [0, m.max_speed_rpm], y: [rated, rated], xaxis: "x2", yaxis: "y3", showlegend: false, name: "rated torque", line: { dash: "dash", color: "#e08000" } },
     { x: [0, m.max_speed_rpm], y: [-rated, -rated], xaxis: "x2", yaxis: "y3", showlegend: false, name: "rated torque", line: { dash: "dash", color: "#e08000" } },
   ];
-  const { shapes } = cycleShapes(r, x, axis);
-  const round = { nticks: 6, tickformat: "~g" };
+  const round = ROUND_TICKS;
   const layout = {
-    margin: { l: 60, r: 30, t: 10, b: 40 },
-    hovermode: "closest",
-    legend: { orientation: "h", y: -0.15, yanchor: "top", font: { size: 10 } },
-    xaxis: { domain: [0, 0.58], anchor: "y2", title: { text: axis === "time" ? "time from TDC [s]" : "crank angle [deg]" } },
+    ...cycleChartLayout(r, x, axis, -0.15),
+    xaxis: { domain: [0, 0.58], anchor: "y2", title: { text: xAxisTitle(axis) } },
     yaxis: { ...round, domain: [0.53, 1], anchor: "x", title: { text: "motor torque [kN m]" } },
     yaxis2: { ...round, domain: [0, 0.45], anchor: "x", zeroline: true, title: { text: "motor power [kW]" } },
     xaxis2: { ...round, domain: [0.7, 1], title: { text: "motor speed [rpm]" }, anchor: "y3" },
     yaxis3: { ...round, anchor: "x2", title: { text: "torque [kN m]" } },
-    shapes: shapes.map((sh) => ({ ...sh, xref: "x", yref: "paper" })),
   };
   Plotly.react(el, traces, layout, { responsive: true, displaylogo: false });
 }
@@ -557,16 +566,12 @@ function drawEnergy(r, c, x, axis) {
     traces.push(line(flat(p.storage_usable_kJ), `drive.storage.usable_energy_kJ = ${p.storage_usable_kJ} kJ`, "#2ca02c", "dash", "y2"));
     traces.push(line(flat(0), "storage empty", "#2ca02c", "dot", "y2"));
   }
-  const { shapes } = cycleShapes(r, x, axis);
-  const round = { nticks: 6, tickformat: "~g" };
+  const round = ROUND_TICKS;
   const layout = {
-    margin: { l: 60, r: 30, t: 10, b: 40 },
-    hovermode: "closest",
-    legend: { orientation: "h", y: -0.18, yanchor: "top", font: { size: 10 } },
-    xaxis: { anchor: storage ? "y2" : "y", title: { text: axis === "time" ? "time from TDC [s]" : "crank angle [deg]" } },
+    ...cycleChartLayout(r, x, axis, -0.18),
+    xaxis: { anchor: storage ? "y2" : "y", title: { text: xAxisTitle(axis) } },
     yaxis: { ...round, domain: storage ? [0.4, 1] : [0, 1], zeroline: true, title: { text: "power [kW]" } },
     yaxis2: { ...round, domain: [0, 0.32], anchor: "x", rangemode: "tozero", title: { text: "storage [kJ]" } },
-    shapes: shapes.map((sh) => ({ ...sh, xref: "x", yref: "paper" })),
   };
   Plotly.react(el, traces, layout, { responsive: true, displaylogo: false });
 }
