@@ -118,7 +118,20 @@ def _parser() -> argparse.ArgumentParser:
         type=_whole(2, 1_000_000),
         default=None,
         metavar="N",
-        help="the certified bound's grid intervals (default 2880; 3 pieces each)",
+        help="the certified bound's grid intervals (default 1440)",
+    )
+    b.add_argument(
+        "--bracket",
+        action="store_true",
+        help="the bracket: a verified motion (the optimal law, its layout refined) below the certified upper "
+        "bound, refined until their gap is within --tolerance or the refinements run out",
+    )
+    b.add_argument(
+        "--tolerance",
+        type=float,
+        default=None,
+        metavar="PCT",
+        help="the bracket's gap to reach [%%] (default 0.05)",
     )
     b.add_argument("--json", action="store_true", help="print JSON")
     lw = sub.add_parser("laws", help="every motion law on the case, beside the time-optimal bound")
@@ -507,14 +520,23 @@ def _tradeoff(case, args) -> int:
 
 def _bound(case, args) -> int:
     from planning.solver.bound import time_optimal_bound
+    from planning.solver.bracket import BRACKET_TOL_PCT, bracket
 
+    tolerance = BRACKET_TOL_PCT if args.tolerance is None else args.tolerance
+    if not (math.isfinite(tolerance) and tolerance > 0):
+        raise CommandError(f"--tolerance {args.tolerance}: the gap must be a positive percentage", EXIT_INPUT)
     bound = time_optimal_bound(case, args.points)
     data = {"case": case.name, **bound.as_dict()}
-    upper = None
-    if args.certified or args.upper_points is not None:
+    upper = result = None
+    if args.bracket or args.tolerance is not None:
+        result = bracket(case, tolerance)
+        upper = result.upper
+        data["bracket"] = result.as_dict()
+    if upper is None and (args.certified or args.upper_points is not None):
         from planning.solver.upper_bound import UPPER_POINTS, upper_bound
 
         upper = upper_bound(case, args.upper_points or UPPER_POINTS)
+    if upper is not None:
         data["upper_bound"] = upper.as_dict()
     if args.json:
         print(json.dumps(data, indent=2))
@@ -530,10 +552,37 @@ def _bound(case, args) -> int:
         left = f"; left out: {', '.join(upper.left_out)}" if upper.left_out else ""
         print(
             f"  certified upper bound {upper.spm:.3f} strokes/min, cycle at least {upper.cycle_time_s:.4f} s: no "
-            f"motion within the limits makes more (convex relaxation, {upper.points} intervals x {upper.pieces} "
-            f"pieces{left})"
+            f"motion within the limits makes more (convex relaxation, {upper.points} intervals"
+            + (f" x {upper.pieces} pieces" if upper.pieces > 1 else "")
+            + f"{left})"
         )
+    if result is not None:
+        print(bracket_text(result))
     return EXIT_OK
+
+
+def bracket_text(result) -> str:  # noqa: ANN001 - a Bracket
+    """The bracket in two lines: between what, how wide, and whether the tolerance was met."""
+    d = result.as_dict()
+    segments = "/".join(str(n) for _, n in d["verified_segments"])
+    allowed = (
+        f"; crank jerk up to {d['jerk_allowance_rad_s3']:.0f} rad/s^3 allowed, the case sets no limit"
+        if d["jerk_allowance_rad_s3"] is not None
+        else ""
+    )
+    left = result.upper.left_out
+    verdict = (
+        f"within the tolerance {d['tolerance_pct']:g} %"
+        if d["met"]
+        else f"NOT within the tolerance {d['tolerance_pct']:g} %: refinements ran out or stalled"
+        + (f"; the upper bound leaves out {', '.join(left)}" if left else "")
+    )
+    return (
+        f"  bracket: {d['verified_spm']:.4f} SPM verified ... {d['upper_spm']:.4f} SPM certified upper bound, gap "
+        f"{d['gap_pct']:.3f} % ({verdict}; {len(d['rounds'])} rounds)\n"
+        f"  verified motion: optimal law, {segments} segments, peak crank jerk "
+        f"{d['verified_peak_crank_jerk_rad_s3']:.0f} rad/s^3{allowed}; upper bound on {d['upper_points']} intervals"
+    )
 
 
 def _more_than_asked(used: int, asked: int) -> str:

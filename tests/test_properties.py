@@ -28,6 +28,7 @@ VERIFIED_SHARE = 0.9  # of them at least this share end in a verified plan
 OFFSET_SET = 40  # offset crank-sliders in the normal run
 RANDOM_PARTS = 4  # each set in parts of 25 presses (tests the workers share)
 UPPER_BOUND_SET = 4  # verified presses of each part checked against the certified upper bound (32 in all)
+UPPER_BOUND_LAWS_SET = 30  # random presses whose every law and bracket motion the slow run checks against it
 SLOW_CASES = 2000
 SLOW_CHUNK = 100
 RELAXATION_EXAMPLES = 10
@@ -96,6 +97,31 @@ def test_random_presses_end_verified(draw_speed_given, part):
     for data, spm in checked[:UPPER_BOUND_SET]:
         assert upper_bound(case_from_data(data), 180, 2).spm >= spm, data["name"]
     assert len(checked) >= UPPER_BOUND_SET
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", range(UPPER_BOUND_LAWS_SET))
+def test_no_law_and_no_bracket_motion_above_the_upper_bound(seed):
+    """Issue 28 on 30 random presses (slow: about 10 s each): every law's verified plan (as ``pressplan
+    laws`` solves them) and the bracket's verified motion (its first round) are at most the certified upper
+    bound; the press must give at least one verified plan."""
+    from planning.reports.law_comparison import compare_laws
+    from planning.solver.bracket import bracket
+
+    data = seeded_case(seed)
+    try:
+        case = case_from_data(data, data["name"])
+    except CaseFileError:
+        pytest.skip("bad input (exit 2)")
+    table, _ = compare_laws(case)
+    upper = table["upper_bound"]["spm"]
+    plans = [row["spm"] for row in table["laws"] if row.get("spm")]
+    assert plans and all(spm <= upper for spm in plans), (upper, plans)
+    try:
+        motion = bracket(case, math.inf)  # one round: the first verified motion and the first upper bound
+    except PlanningError:
+        return
+    assert motion.verified.verification.passed and motion.verified.plan.spm <= motion.upper.spm
 
 
 def test_random_offset_presses_end_verified():

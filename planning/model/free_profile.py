@@ -25,9 +25,9 @@ PHASES: Layout = (("return", 40), ("transfer", 24), ("feed", 40))  # the layout 
 FINE_FACTOR = 2.5  # the finer layout: this many times the segments of each phase (finer)
 
 
-def finer(layout: Layout) -> Layout:
-    """``layout`` with :data:`FINE_FACTOR` times the segments in each phase."""
-    return tuple((phase, round(n * FINE_FACTOR)) for phase, n in layout)
+def finer(layout: Layout, factor: float = FINE_FACTOR) -> Layout:
+    """``layout`` with ``factor`` times the segments in each phase."""
+    return tuple((phase, round(n * factor)) for phase, n in layout)
 
 
 def free_segments(durations, jerks, layout: Layout = PHASES) -> list[Segment]:  # noqa: ANN001 - floats or symbols

@@ -19,21 +19,26 @@ the limits (the limits state their own, ``Limit.relaxed_rows`` / ``relaxed_caps`
 - the mean crank acceleration of an interval (``(s_(i+1) - s_i) / (2 dtheta)``) within the crank's
   acceleration limit; two neighbouring means differ by at most ``J (tau_i + tau_(i+1))`` (crank jerk);
 - the robot's window: the times of its intervals add up to at least the transfer time;
-- each piece's time at least its angle over the largest crank speed any such motion can have on it:
-  ``tau_p >= (b - a) / sqrt(E)`` for each envelope E of ``s`` over the piece: a speed limit's largest
-  value on the piece (crank, motor, slider, die speed), ``(h'_i^2 s_i + 2 A |h(b) - h_i|) / min h'^2`` and
-  its mirror from the interval's end (the slide cannot gain speed faster than A allows), ``s_i + 2 A_c
-  (b - theta_i)`` and its mirror (the crank acceleration limit A_c), and ``s_i`` on the draw. On a piece
-  where h' vanishes (the first sliver next to a dead centre, :data:`DEAD_CENTRE_SLIVER` of its
-  interval) no envelope holds and its time is bounded by 0 only. Every interval has h and h'^2
-  monotone (the inflection points of h are nodes too), so the least h'^2 of a piece is at one of its
-  ends.
+- each piece's time from the mean of the crank speed squared over it (Jensen: ``1/sqrt`` is convex, so
+  ``tau_p = integral dtheta / sqrt(s) >= (b - a) / sqrt(mean s)``), the mean bounded above by the mean of
+  an envelope E of ``s`` over the piece's :data:`SUBPIECES` sub-pieces, each sub-piece at its envelope's
+  largest value there: a speed limit's largest value (crank, motor, slider, die speed), ``(h'_i^2 s_i + 2 A
+  |h(b) - h_i|) / min h'^2`` and its mirror from the interval's end (the slide cannot gain speed faster
+  than A allows), ``s_i + 2 A_c (b - theta_i)`` and its mirror (the crank acceleration limit A_c), and
+  ``s_i`` on the draw; and, at each of :data:`SPLITS`, an envelope growing from the start over the first
+  part of the piece with one from the end over the rest (a motion that speeds up, then slows down). Every
+  one of these is a valid row; the tightest binds. On a piece where h' vanishes (the first sliver next to
+  a dead centre, :data:`DEAD_CENTRE_SLIVER` of its interval) no envelope holds and its time is bounded by
+  0 only. Every interval has h and h'^2 monotone (the inflection points of h are nodes too), so the least
+  h'^2 of a sub-piece is at one of its ends. On an arc where a limit is active the envelope follows the
+  motion to O(sub-piece) and Jensen's inequality costs O(piece^2): the bound converges from above as the
+  grid refines.
 
 ``1 / sqrt`` of an affine function is convex, so the relaxed problem is convex and IPOPT's optimum is its
 global one; the upper bound is ``60 / (sum tau)`` at that optimum, up to IPOPT's tolerance (1e-10). A
 limit with no relaxed form (the motor's peak torque, the RMS torque) is left out (named in the answer):
-the number stays an upper bound, looser. The relaxation tightens as the grid refines: the piece envelopes
-differ from the motion's speed by O(piece) (:func:`upper_bound`'s ``points`` and ``pieces``).
+the number stays an upper bound, looser. The relaxation tightens as the grid refines (:func:`upper_bound`'s
+``points`` and ``pieces``).
 """
 
 from __future__ import annotations
@@ -47,14 +52,16 @@ import numpy as np
 
 from planning.model.case import RPM, Case
 from planning.model.limits import limits_of
-from planning.model.limits.base import BoundGrid, RelaxedGrid
+from planning.model.limits.base import BoundGrid, Envelope, RelaxedGrid
 from planning.solver.bound import BOUND_OPTIONS, angle_grid, node_speed_bounds
 from planning.solver.ipopt import NLPSolver
 from planning.solver.outcomes import NoPlanFound
 from planning.solver.precheck import precheck
 
-UPPER_POINTS = 2880  # intervals of the grid by default
-UPPER_PIECES = 3  # pieces per interval (the time rows)
+UPPER_POINTS = 1440  # intervals of the grid by default
+UPPER_PIECES = 1  # pieces per interval (a time variable each)
+SUBPIECES = 256  # sub-pieces per piece: a piece's mean envelope is the mean of their largest values
+SPLITS = (0.5,)  # shares of a piece after which a start-side envelope gives way to an end-side one
 DEAD_CENTRE_SLIVER = 1.0 / 1024  # share of an interval next to a dead centre whose time is bounded by 0 only
 INFLECTION_GRID = 7200  # angles on which the sign changes of h'' are looked for
 
@@ -158,13 +165,9 @@ def upper_bound(case: Case, points: int = UPPER_POINTS, pieces: int = UPPER_PIEC
     to_cell = ca.DM(ca.Sparsity.triplet(n, cell.size, cell.tolist(), list(range(cell.size))), 1.0)
     grid.tau = ca.mtimes(to_cell, tau_piece)
     grid.tau_next = ca.vertcat(grid.tau[1:], grid.tau[0])
-    grid.s_a = s[cell.tolist()]
-    grid.s_b = grid.s_next[cell.tolist()]
 
     g, lbg, ubg = [], [], []
     left_out = []
-    caps = np.full(cell.size, np.inf)
-    envelopes: list[tuple[object, np.ndarray]] = []
     for limit in limits:
         rows = limit.relaxed_rows(grid)
         if rows is None:
@@ -174,24 +177,28 @@ def upper_bound(case: Case, points: int = UPPER_POINTS, pieces: int = UPPER_PIEC
             g.append(expr)
             lbg.append(np.broadcast_to(lo, (expr.shape[0],)))
             ubg.append(np.broadcast_to(hi, (expr.shape[0],)))
-        cap = limit.relaxed_caps(grid)
-        if cap is not None:
-            caps = np.minimum(caps, cap)
-        envelopes += limit.relaxed_envelopes(grid)
-    in_draw = np.isin(cell, draw)
-    envelopes.append((grid.s_a, in_draw))  # the draw at one speed: s is its node value on the whole piece
-    if draw.size > 1:
+    if draw.size > 1:  # the draw at one speed
         g.append(s[draw[1:].tolist()] - s[draw[:-1].tolist()])
         lbg.append(np.zeros(draw.size - 1))
         ubg.append(np.zeros(draw.size - 1))
+
+    # each piece's time from the mean of the envelopes over its sub-pieces (module docstring)
+    sub = _sub_grid(grid, SUBPIECES)
+    combined = [env for limit in limits if limit.field not in left_out for env in _envelopes(limit, sub)]
+    combined.append(_Affine.of(lambda g_: Envelope(g_.s_a, np.isin(g_.cell, draw), "both"), sub))
     width = b - a
-    for expr, where in envelopes:
-        k = np.flatnonzero(where & ~dead)
+    tau_floor = np.zeros(cell.size)
+    s_start, s_end = s[cell.tolist()], grid.s_next[cell.tolist()]
+    for k_a, k_b, k_c in _mean_forms(combined, SUBPIECES):
+        ok = np.isfinite(k_c) & ~dead
+        constant = ok & (k_a == 0.0) & (k_b == 0.0)
+        tau_floor[constant] = np.maximum(tau_floor[constant], width[constant] / np.sqrt(k_c[constant]))
+        k = np.flatnonzero(ok & ~constant)
         if k.size:
-            g.append(tau_piece[k.tolist()] - ca.DM(width[k]) / ca.sqrt(expr[k.tolist()]))
+            mean = ca.DM(k_a[k]) * s_start[k.tolist()] + ca.DM(k_b[k]) * s_end[k.tolist()] + ca.DM(k_c[k])
+            g.append(tau_piece[k.tolist()] - ca.DM(width[k]) / ca.sqrt(mean))
             lbg.append(np.zeros(k.size))
             ubg.append(np.full(k.size, np.inf))
-    tau_floor = np.where(dead | ~np.isfinite(caps), 0.0, width / np.sqrt(np.where(np.isfinite(caps), caps, 1.0)))
 
     nlp = {"x": ca.vertcat(x_s, x_tau), "f": ca.sum1(tau_piece), "g": ca.vertcat(*g)}
     solver = NLPSolver("upper_bound", nlp, BOUND_OPTIONS, fixed_scale=np.concatenate([s_unit, tau_unit]))
@@ -210,6 +217,102 @@ def upper_bound(case: Case, points: int = UPPER_POINTS, pieces: int = UPPER_PIEC
         left_out=tuple(dict.fromkeys(left_out)),
         wall_time_s=time.perf_counter() - t_start,
     )
+
+
+@dataclass(frozen=True)
+class _Affine:
+    """An envelope on the sub-pieces as numbers: ``start * s_i + end * s_(i+1) + constant`` [rad^2/s^2] with
+    ``s_i``, ``s_(i+1)`` the nodes of the sub-piece's interval (infinite where it does not hold), ``side``."""
+
+    start: np.ndarray
+    end: np.ndarray
+    constant: np.ndarray
+    side: str
+
+    @classmethod
+    def of(cls, envelope_of, sub: RelaxedGrid) -> _Affine:  # noqa: ANN001 - grid -> Envelope
+        """The envelope ``envelope_of(sub)`` evaluated at the unit node values (it is affine in them)."""
+        values = []
+        for s_a, s_b in ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0)):
+            sub.s_a, sub.s_b = np.full(sub.cell.size, s_a), np.full(sub.cell.size, s_b)
+            env = envelope_of(sub)
+            values.append(np.where(env.where, np.broadcast_to(env.value, sub.cell.shape), np.inf))
+        c = values[0]
+        finite = np.isfinite(c)
+        start = np.where(finite, values[1] - np.where(finite, c, 0.0), 0.0)
+        end = np.where(finite, values[2] - np.where(finite, c, 0.0), 0.0)
+        return cls(start, end, c, env.side)
+
+
+def _envelopes(limit, sub: RelaxedGrid) -> list[_Affine]:  # noqa: ANN001 - a Limit
+    """A limit's envelopes and its cap (an envelope of either side) on the sub-pieces, as numbers."""
+    out = [
+        _Affine.of(lambda g_, k=k: limit.relaxed_envelopes(g_)[k], sub)
+        for k in range(len(limit.relaxed_envelopes(_unit(sub))))
+    ]
+    cap = limit.relaxed_caps(sub)
+    if cap is not None:
+        zero = np.zeros(sub.cell.size)
+        out.append(_Affine(zero, zero, np.asarray(cap, dtype=float), "both"))
+    return out
+
+
+def _unit(sub: RelaxedGrid) -> RelaxedGrid:
+    sub.s_a, sub.s_b = np.ones(sub.cell.size), np.ones(sub.cell.size)
+    return sub
+
+
+def _sub_grid(grid: RelaxedGrid, count: int) -> RelaxedGrid:
+    """Each piece of ``grid`` cut into ``count`` equal sub-pieces, in order (a piece's at ``count * p`` on)."""
+    frac = np.linspace(0.0, 1.0, count + 1)
+    width = (grid.b - grid.a)[:, None]
+    a = (grid.a[:, None] + width * frac[None, :-1]).ravel()
+    b = (grid.a[:, None] + width * frac[None, 1:]).ravel()
+    dead = np.repeat(grid.slope2_min == 0.0, count)
+    h_a, d1_a = grid.case.machine.jets(a)[:2]
+    h_b, d1_b = grid.case.machine.jets(b)[:2]
+    slope2_min = np.where(dead, 0.0, np.minimum(d1_a**2, d1_b**2))
+    return RelaxedGrid(
+        grid.case,
+        grid.theta,
+        grid.h,
+        grid.d1,
+        grid.d2,
+        grid.dtheta,
+        grid.window,
+        cell=np.repeat(grid.cell, count),
+        a=a,
+        b=b,
+        h_a=h_a,
+        h_b=h_b,
+        slope2_min=slope2_min,
+    )
+
+
+def _mean_forms(envelopes: list[_Affine], count: int):  # noqa: ANN202 - a generator of triples
+    """Each piece's mean of an envelope over its sub-pieces, as ``(start, end, constant)`` coefficients of
+    its interval's nodes (each a valid bound on the piece's mean crank speed squared): one envelope over the
+    whole piece, and a start-side one over the first part with an end-side one over the rest (a motion
+    accelerating at its limit, then decelerating), at each of :data:`SPLITS`."""
+
+    def mean(env: _Affine, lo: int, hi: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        cols = slice(lo, hi)
+        return tuple(
+            np.sum(np.reshape(v, (-1, count))[:, cols], axis=1) / count for v in (env.start, env.end, env.constant)
+        )
+
+    for env in envelopes:
+        yield mean(env, 0, count)
+    firsts = [e for e in envelopes if e.side in ("start", "both")]
+    lasts = [e for e in envelopes if e.side in ("end", "both")]
+    for split in SPLITS:
+        r = round(split * count)
+        for x in firsts:
+            for y in lasts:
+                if x is y:
+                    continue
+                p, q = mean(x, 0, r), mean(y, r, count)
+                yield tuple(u + v for u, v in zip(p, q, strict=True))
 
 
 __all__ = ["RPM", "UpperBound", "upper_bound"]

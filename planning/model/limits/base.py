@@ -243,6 +243,17 @@ class Draw:
         return cls(case, theta, h, d1, d2)
 
 
+class Envelope(NamedTuple):
+    """An upper bound on the crank speed squared [rad^2/s^2] over each piece of the certified upper bound's
+    grid, for every motion that meets the limit: ``value`` (one per piece, affine in the node values; the
+    largest the limit allows anywhere in the piece), ``where`` (the pieces on which it holds), ``side``:
+    ``"start"`` when it grows from the interval's start node (tight near it), ``"end"`` from its end node."""
+
+    value: Any
+    where: np.ndarray
+    side: str
+
+
 class Impossible(NamedTuple):
     """A limit that provably cannot be met, found before solving: ``reason`` (one line), the case
     ``field`` (dotted), its ``value``, what it would have to be (``needed``) and where (``angle_deg``)."""
@@ -359,10 +370,9 @@ class Limit:
         None: none), the largest the limit allows anywhere in the piece."""
         return None
 
-    def relaxed_envelopes(self, grid: RelaxedGrid) -> list[tuple[Any, np.ndarray]]:
-        """``(expression, where)`` pairs: the expression, one value per piece and affine in the node values,
-        bounds the crank speed squared [rad^2/s^2] from above over the whole piece for every motion that
-        meets the limit, on the pieces ``where`` is True."""
+    def relaxed_envelopes(self, grid: RelaxedGrid) -> list[Envelope]:
+        """The limit's :class:`Envelope` s of the crank speed squared over the grid's pieces (none by
+        default)."""
         return []
 
     def __repr__(self) -> str:

@@ -7,7 +7,17 @@ from typing import Any
 import numpy as np
 from pydantic import Field
 
-from planning.model.limits.base import REL_TOL, BoundGrid, Check, Dense, Limit, RelaxedGrid, Row, Transcription
+from planning.model.limits.base import (
+    REL_TOL,
+    BoundGrid,
+    Check,
+    Dense,
+    Envelope,
+    Limit,
+    RelaxedGrid,
+    Row,
+    Transcription,
+)
 from planning.model.units import CrankAccel
 
 
@@ -58,10 +68,13 @@ class CrankAccelLimit(Limit):
         bound's rows on the means."""
         return self.bound_rows(grid)
 
-    def relaxed_envelopes(self, grid: RelaxedGrid) -> list[tuple[Any, np.ndarray]]:
+    def relaxed_envelopes(self, grid: RelaxedGrid) -> list[Envelope]:
         """``ds/dtheta = 2 alpha``: over a piece [a, b] of interval i, ``s <= s_i + 2 A_c (b - theta_i)`` and
         ``s <= s_(i+1) + 2 A_c (theta_(i+1) - a)``."""
         limit = grid.case.limits.crank_accel_rad_s2
         every = np.ones(grid.cell.size, dtype=bool)
         start, end = grid.theta[grid.cell], grid.theta[grid.cell + 1]
-        return [(grid.s_a + 2 * limit * (grid.b - start), every), (grid.s_b + 2 * limit * (end - grid.a), every)]
+        return [
+            Envelope(grid.s_a + 2 * limit * (grid.b - start), every, "start"),
+            Envelope(grid.s_b + 2 * limit * (end - grid.a), every, "end"),
+        ]

@@ -14,6 +14,7 @@ from planning.model.limits.base import (
     Check,
     Dense,
     Draw,
+    Envelope,
     Impossible,
     Limit,
     RelaxedGrid,
@@ -110,7 +111,7 @@ class SliderAccelLimit(Limit):
             rows.append((grid.d2[dead] * grid.s[dead.tolist()], -A * np.ones(dead.size), A * np.ones(dead.size)))
         return rows
 
-    def relaxed_envelopes(self, grid: RelaxedGrid) -> list[tuple[Any, np.ndarray]]:
+    def relaxed_envelopes(self, grid: RelaxedGrid) -> list[Envelope]:
         """Over a piece [a, b] of interval i: ``v^2 <= v_i^2 + 2 A |h(b) - h_i|`` and ``<= v_(i+1)^2 + 2 A |h_(i+1) -
         h(a)|``, so ``s <= that / min h'^2`` over the piece (pieces where h' vanishes: none)."""
         A = grid.case.limits.slider_accel_mm_s2
@@ -119,4 +120,4 @@ class SliderAccelLimit(Limit):
         start, end = grid.cell, grid.cell + 1
         from_start = (grid.d1[start] ** 2 * grid.s_a + 2 * A * np.abs(grid.h_b - grid.h[start])) / m
         from_end = (grid.d1[end] ** 2 * grid.s_b + 2 * A * np.abs(grid.h[end] - grid.h_a)) / m
-        return [(from_start, moving), (from_end, moving)]
+        return [Envelope(from_start, moving, "start"), Envelope(from_end, moving, "end")]
