@@ -185,7 +185,8 @@ def upper_bound(case: Case, points: int = UPPER_POINTS, pieces: int = UPPER_PIEC
     # each piece's time from the mean of the envelopes over its sub-pieces (module docstring)
     sub = _sub_grid(grid, SUBPIECES)
     combined = [env for limit in limits if limit.field not in left_out for env in _envelopes(limit, sub)]
-    combined.append(_Affine.of(lambda g_: Envelope(g_.s_a, np.isin(g_.cell, draw), "both"), sub))
+    inside = draw[th[draw + 1] <= th3 + 1e-12]  # the draw's intervals (the node at theta3 starts the return)
+    combined.append(_Affine.of(lambda g_: Envelope(g_.s_a, np.isin(g_.cell, inside), "both"), sub))
     width = b - a
     tau_floor = np.zeros(cell.size)
     s_start, s_end = s[cell.tolist()], grid.s_next[cell.tolist()]
