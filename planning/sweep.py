@@ -178,10 +178,11 @@ def _solved_row(sol, case) -> dict[str, Any]:  # noqa: ANN001 - a Solution and i
 
 def _electrical(base: dict[str, Any], fields: list[str]) -> bool:
     """The sweep's cases have the drive's electrical side (the base case has, or a swept field is one of its
-    keys: ``planning.model.case.ELECTRICAL_KEYS``)."""
+    keys: ``planning.model.case.ELECTRICAL_KEYS``, or the objective is the grid's peak, as ``Case.electrical``)."""
     drive = base.get("drive")
     swept = any(f.startswith(tuple(f"drive.{key}" for key in ELECTRICAL_KEYS)) for f in fields)
-    return bool(drive) and (states_electrical(drive) or swept)
+    grid_objective = (base.get("planner") or {}).get("objective") == "min-grid-peak"
+    return bool(drive) and (states_electrical(drive) or swept or grid_objective)
 
 
 def neighbours(index: int, shape: tuple[int, ...]) -> list[int]:

@@ -278,6 +278,8 @@ def test_without_the_new_keys_the_outputs_are_todays():
     base = case.model_dump(exclude_none=True)  # as `pressplan sweep` hands it on: the defaults written out
     assert not _electrical(base, ["process.transfer_time_s"])  # no grid columns in today's drive sweeps
     assert _electrical(base, ["drive.storage.usable_energy_kJ"])
+    grid_peak = case.with_objective("min-grid-peak", 5.0).model_dump(exclude_none=True)
+    assert _electrical(grid_peak, ["process.transfer_time_s"])  # the grid's objective: its columns too
 
 
 
