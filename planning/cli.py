@@ -124,14 +124,15 @@ def _parser() -> argparse.ArgumentParser:
         "--bracket",
         action="store_true",
         help="the bracket: a verified motion (the optimal law, its layout refined) below the certified upper "
-        "bound, refined until their gap is within --tolerance or the refinements run out",
+        "bound, refined until their gap is within --tolerance or the refinements run out (it chooses the upper "
+        "bound's grids: --upper-points is not used)",
     )
     b.add_argument(
         "--tolerance",
         type=float,
         default=None,
         metavar="PCT",
-        help="the bracket's gap to reach [%%] (default 0.05)",
+        help="the bracket's gap to reach [%%] (default 0.05); implies --bracket",
     )
     b.add_argument("--json", action="store_true", help="print JSON")
     lw = sub.add_parser("laws", help="every motion law on the case, beside the time-optimal bound")

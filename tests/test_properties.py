@@ -117,11 +117,8 @@ def test_no_law_and_no_bracket_motion_above_the_upper_bound(seed):
     upper = table["upper_bound"]["spm"]
     plans = [row["spm"] for row in table["laws"] if row.get("spm")]
     assert plans and all(spm <= upper for spm in plans), (upper, plans)
-    try:
-        motion = bracket(case, math.inf)  # one round: the first verified motion and the first upper bound
-    except PlanningError:
-        return
-    assert motion.verified.verification.passed and motion.verified.plan.spm <= motion.upper.spm
+    motion = bracket(case, math.inf)  # one round: the first verified motion and the first upper bound
+    assert motion.verified.plan.spm <= motion.upper.spm
 
 
 def test_random_offset_presses_end_verified():

@@ -12,7 +12,10 @@ The gap reached is reported, not hidden.
 
 A case without a crank-jerk limit allows any jerk: the verified motion is planned under an allowance of
 :data:`JERK_ALLOWANCE` times the press's characteristic jerk (speed scale over time scale squared), which
-the verification then also checks; the case's own limits are verified on the same plan.
+its own verification checks; the case's own limits are verified again on the same plan. A case with an
+objective at the line's rate is bracketed for the most strokes. A refinement that finds no plan, or none
+that passes, stalls its side (the motion found before stays). A verified motion above the upper bound
+(beyond :data:`CROSSED_PCT`) would be a fault, and is raised as one.
 """
 
 from __future__ import annotations
@@ -35,6 +38,7 @@ BRACKET_TOL_PCT = 0.05  # [%] the gap the bracket refines down to by default
 UPPER_GRIDS = (1440, 2880, 5760)  # intervals of the upper bound's grid, coarse to fine (one piece each)
 LAYOUT_FACTORS = (6.0, 15.0)  # the verified motion's refinements: this many times the first layout's segments
 STALL_SHARE = 0.1  # a refinement that closes less than this share of the gap ends that side's refinements
+CROSSED_PCT = 1e-4  # [%] a verified motion this far above the upper bound is within the verification's tolerance
 JERK_ALLOWANCE = 2000.0  # x the press's characteristic jerk: the verified motion's jerk without a case limit
 
 
@@ -51,9 +55,9 @@ class BracketRound:
 class Bracket:
     """The fastest possible cycle lies in ``[verified.plan.spm, upper.spm]``: ``verified`` (a plan that passed
     the dense verification against the case's limits), ``upper`` (the certified upper bound), ``gap_pct``
-    [%] between them, ``tolerance_pct`` [%] asked, ``met`` whether the gap is within it, ``rounds`` (each
-    refinement's result), ``jerk_allowance_rad_s3`` (the jerk the verified motion was allowed when the case
-    sets none, else None), ``wall_time_s`` [s]."""
+    [%] between them, ``tolerance_pct`` [%] asked, ``met`` whether the gap is within it, ``rounds`` (the
+    first computation's result, then each refinement's), ``jerk_allowance_rad_s3`` (the jerk the verified
+    motion was allowed when the case sets none, else None), ``wall_time_s`` [s]."""
 
     verified: Solution
     upper: UpperBound
@@ -104,26 +108,38 @@ def bracket(case: Case, tolerance_pct: float = BRACKET_TOL_PCT) -> Bracket:
         limits = planned.limits.model_copy(update={"crank_jerk_rad_s3": allowance})
         planned = planned.model_copy(update={"limits": limits})
     planned = planned.with_law(OptimalLaw.name)
-    verified = _checked(case, solve_optimal(planned))
-    upper = upper_bound(case, UPPER_GRIDS[0], 1)
+    fastest = case.with_objective("max-spm")  # the bracket is about the most strokes, whatever the objective
+    verified = _checked(fastest, solve_optimal(planned))
+    upper = upper_bound(fastest, UPPER_GRIDS[0], 1)
     rounds = [BracketRound(verified.plan.spm, upper.spm, gap_pct(verified.plan.spm, upper.spm))]
     layouts = [finer(PHASES, f) for f in LAYOUT_FACTORS]
     grids = list(UPPER_GRIDS[1:])
     turn = 0
     while rounds[-1].gap_pct > tolerance_pct and (layouts or grids):
         before = rounds[-1]
+        room = STALL_SHARE * (before.upper_spm - before.verified_spm)
         if layouts and (turn % 2 == 0 or not grids):  # the two sides in turn, the verified motion first
-            verified = _checked(case, on_layout(planned, verified, layouts.pop(0)), verified)
-            if verified.plan.spm - before.verified_spm < STALL_SHARE * (before.upper_spm - before.verified_spm):
-                layouts.clear()  # the layout does not hold the motion back: finer ones will not help
+            try:
+                verified = _checked(fastest, on_layout(planned, verified, layouts.pop(0)), verified)
+            except PlanningError:  # no plan on the finer layout: the side stalls, the motion found stays
+                pass
+            if verified.plan.spm - before.verified_spm < room:
+                layouts.clear()  # the layout does not hold the motion back (or failed): finer ones will not help
         else:
-            finer_upper = upper_bound(case, grids.pop(0), 1)  # the grids are not nested: keep the lower bound
-            upper = min(upper, finer_upper, key=lambda u: u.spm)
-            if before.upper_spm - upper.spm < STALL_SHARE * (before.upper_spm - before.verified_spm):
+            try:  # the grids are not nested: the lowest upper bound is kept
+                upper = min(upper, upper_bound(fastest, grids.pop(0), 1), key=lambda u: u.spm)
+            except PlanningError:
+                pass
+            if before.upper_spm - upper.spm < room:
                 grids.clear()  # the relaxation, not its grid, leaves the gap
         turn += 1
         rounds.append(BracketRound(verified.plan.spm, upper.spm, gap_pct(verified.plan.spm, upper.spm)))
     gap = rounds[-1].gap_pct
+    if gap < -CROSSED_PCT:
+        raise NoPlanFound(
+            f"the verified motion ({verified.plan.spm:.6f} SPM) is above the certified upper bound ({upper.spm:.6f}): "
+            "a fault of pressplan's, please report it with the case"
+        )
     return Bracket(
         verified,
         upper,

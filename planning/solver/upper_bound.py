@@ -17,7 +17,8 @@ the limits (the limits state their own, ``Limit.relaxed_rows`` / ``relaxed_caps`
   h_i|`` (A the slider-acceleration limit), and ``|h'' s| <= A`` at a dead centre;
 - the draw at one speed: ``s`` equal on the draw's nodes, within the draw-speed range;
 - the mean crank acceleration of an interval (``(s_(i+1) - s_i) / (2 dtheta)``) within the crank's
-  acceleration limit; two neighbouring means differ by at most ``J (tau_i + tau_(i+1))`` (crank jerk);
+  acceleration limit; the means of intervals i and i + m - 1 differ by at most J times the m intervals'
+  time, m = 2 and 4 (crank jerk J; ``CrankJerkLimit.relaxed_rows``);
 - the robot's window: the times of its intervals add up to at least the transfer time;
 - each piece's time from the mean of the crank speed squared over it (Jensen: ``1/sqrt`` is convex, so
   ``tau_p = integral dtheta / sqrt(s) >= (b - a) / sqrt(mean s)``), the mean bounded above by the mean of
@@ -29,13 +30,15 @@ the limits (the limits state their own, ``Limit.relaxed_rows`` / ``relaxed_caps`
   part of the piece with one from the end over the rest (a motion that speeds up, then slows down). Every
   one of these is a valid row; the tightest binds. On a piece where h' vanishes (the first sliver next to
   a dead centre, :data:`DEAD_CENTRE_SLIVER` of its interval) no envelope holds and its time is bounded by
-  0 only. Every interval has h and h'^2 monotone (the inflection points of h are nodes too), so the least
-  h'^2 of a sub-piece is at one of its ends. On an arc where a limit is active the envelope follows the
-  motion to O(sub-piece) and Jensen's inequality costs O(piece^2): the bound converges from above as the
-  grid refines.
+  0 only. Every interval has h and h'^2 monotone (every zero of h' -- TDC, BDC and a linkage's other
+  dips -- and every inflection point of h is a node), so the least h'^2 of a sub-piece is at one of its
+  ends. On an arc where a limit is active the envelope follows the motion to O(sub-piece) and Jensen's
+  inequality costs O(piece^2): without a jerk limit the bound converges from above as the grid refines
+  (the jerk rows keep a slack of m / (m - 1) on a jerk ramp at any grid).
 
 ``1 / sqrt`` of an affine function is convex, so the relaxed problem is convex and IPOPT's optimum is its
-global one; the upper bound is ``60 / (sum tau)`` at that optimum, up to IPOPT's tolerance (1e-10). A
+global one; the upper bound is ``60 / (sum tau)`` at that optimum, up to IPOPT's tolerance (1e-10; only
+its status Solve_Succeeded is taken). A
 limit with no relaxed form (the motor's peak torque, the RMS torque) is left out (named in the answer):
 the number stays an upper bound, looser. The relaxation tightens as the grid refines (:func:`upper_bound`'s
 ``points`` and ``pieces``).
@@ -62,8 +65,10 @@ UPPER_POINTS = 1440  # intervals of the grid by default
 UPPER_PIECES = 1  # pieces per interval (a time variable each)
 SUBPIECES = 256  # sub-pieces per piece: a piece's mean envelope is the mean of their largest values
 SPLITS = (0.5,)  # shares of a piece after which a start-side envelope gives way to an end-side one
+SOLVED = "Solve_Succeeded"  # the only IPOPT status whose optimum is taken as the bound
 DEAD_CENTRE_SLIVER = 1.0 / 1024  # share of an interval next to a dead centre whose time is bounded by 0 only
-INFLECTION_GRID = 7200  # angles on which the sign changes of h'' are looked for
+INFLECTION_GRID = 7200  # angles on which the sign changes of h' and h'' are looked for
+SAME_NODE_RAD = 1e-9  # [rad] a zero of h' this close to TDC or BDC is that dead centre
 
 
 @dataclass(frozen=True)
@@ -92,17 +97,33 @@ class UpperBound:
         }
 
 
+def slope_zeros(case: Case) -> list[float]:
+    """Crank angles [rad] where h' changes sign other than TDC and BDC (a linkage's second dip near BDC, where
+    h is not monotone), by bisection on a grid of :data:`INFLECTION_GRID` angles; each becomes a node with a
+    dead-centre sliver, so that h is monotone on every interval."""
+    return [a for a in _sign_changes(case, 1) if _apart(a, (0.0, 2 * math.pi, case.machine.bdc_angle))]
+
+
+def _apart(angle: float, others: tuple[float, ...]) -> bool:
+    return all(abs(angle - o) > SAME_NODE_RAD for o in others)
+
+
 def inflections(case: Case) -> list[float]:
-    """Crank angles [rad] where h'' changes sign (h'^2 has its interior extremes only there and at the dead
-    centres), by bisection on a grid of :data:`INFLECTION_GRID` angles."""
+    """Crank angles [rad] where h'' changes sign (h'^2 has its interior extremes only there and at the zeros
+    of h'), by bisection on a grid of :data:`INFLECTION_GRID` angles."""
+    return _sign_changes(case, 2)
+
+
+def _sign_changes(case: Case, order: int) -> list[float]:
+    """Crank angles [rad] where the ``order``-th derivative of h changes sign."""
     grid = np.linspace(0.0, 2 * math.pi, INFLECTION_GRID + 1)
-    d2 = case.machine.jets(grid)[2]
+    d2 = case.machine.jets(grid)[order]
     k = np.flatnonzero(np.sign(d2[:-1]) * np.sign(d2[1:]) < 0)
     lo, hi = grid[k], grid[k + 1]
     sign_lo = np.sign(d2[k])
     for _ in range(60):
         mid = 0.5 * (lo + hi)
-        same = np.sign(case.machine.jets(mid)[2]) == sign_lo
+        same = np.sign(case.machine.jets(mid)[order]) == sign_lo
         lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
     return (0.5 * (lo + hi)).tolist()
 
@@ -129,13 +150,71 @@ def _pieces(theta: np.ndarray, d1: np.ndarray, pieces: int) -> tuple[np.ndarray,
     return np.array(cells), np.array(starts), np.array(ends), np.array(dead)
 
 
+@dataclass(frozen=True)
+class Relaxation:
+    """The relaxed problem of a case on one grid: ``nlp`` (CasADi: ``x`` scaled variables, ``f``, ``g``),
+    ``scale`` (physical = scale * x: the crank speed squared at the nodes [rad^2/s^2], then each piece's time
+    [s]), bounds ``lbx``, ``ubx`` (physical), ``lbg``, ``ubg``, start ``x0`` (physical); the grid: ``theta``
+    (nodes [rad], from theta1 over one turn), ``cell`` (each piece's interval), ``a``, ``b`` (its ends
+    [rad]); ``left_out`` (limits without a relaxed form)."""
+
+    nlp: dict
+    scale: np.ndarray
+    lbx: np.ndarray
+    ubx: np.ndarray
+    lbg: np.ndarray
+    ubg: np.ndarray
+    x0: np.ndarray
+    theta: np.ndarray
+    cell: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+    left_out: tuple[str, ...]
+
+    def point_of(self, speed_at, time_at) -> np.ndarray:  # noqa: ANN001 - callables of angles
+        """A motion's own point of the relaxed problem (physical): its crank speed squared at the nodes and
+        its time on each piece, from ``speed_at(angles)`` [rad/s] and ``time_at(angle)`` [s] (the time the
+        motion passes a crank angle, counted from theta1; the angles are taken over one turn from theta1)."""
+        start = self.theta[0]
+        at_a = np.array([time_at(float(x)) for x in self.a])
+        at_b = np.array([time_at(float(x)) if x < start + 2 * math.pi - 1e-12 else math.nan for x in self.b])
+        period = time_at(start + 2 * math.pi)
+        at_b = np.where(np.isnan(at_b), period, at_b)
+        return np.concatenate([np.asarray(speed_at(self.theta[:-1])) ** 2, at_b - at_a])
+
+    def rows_at(self, x: np.ndarray) -> np.ndarray:
+        """The rows ``g`` at the physical point ``x``."""
+        g = ca.Function("g", [self.nlp["x"]], [self.nlp["g"]])
+        return np.asarray(g(x / self.scale)).ravel()
+
+
 def upper_bound(case: Case, points: int = UPPER_POINTS, pieces: int = UPPER_PIECES) -> UpperBound:
     """The certified upper bound of ``case`` (module docstring) on a grid of about ``points`` intervals,
     each in ``pieces`` pieces; raises a :class:`~planning.solver.outcomes.PlanningError` if there is none."""
     t_start = time.perf_counter()
+    r = relaxation(case, points, pieces)
+    solver = NLPSolver("upper_bound", r.nlp, BOUND_OPTIONS, fixed_scale=r.scale)
+    res = solver.solve(r.x0, r.lbx, r.ubx, r.lbg, r.ubg, clip_to_bounds=False)
+    if res.return_status != SOLVED:  # not IPOPT's "acceptable" level: its rows may be violated by far more
+        raise NoPlanFound(f"the upper bound did not converge ({res.return_status})")
+    period = float(np.sum(res.x[r.theta.size - 1 :]))
+    return UpperBound(
+        spm=60.0 / period,
+        cycle_time_s=period,
+        points=r.theta.size - 1,
+        pieces=pieces,
+        left_out=r.left_out,
+        wall_time_s=time.perf_counter() - t_start,
+    )
+
+
+def relaxation(case: Case, points: int = UPPER_POINTS, pieces: int = UPPER_PIECES) -> Relaxation:
+    """The relaxed problem of ``case`` (module docstring) on a grid of about ``points`` intervals, each in
+    ``pieces`` pieces; raises a :class:`~planning.solver.outcomes.PlanningError` when the case has no
+    motion at all (the prechecks)."""
     w2_lo, w2_hi = precheck(case)
     m = case.machine
-    th = angle_grid(case, points, (0.0, m.bdc_angle, *inflections(case)))
+    th = angle_grid(case, points, (0.0, m.bdc_angle, *slope_zeros(case), *inflections(case)))
     n = th.size - 1
     dth = np.diff(th)
     h, d1, d2, _ = m.jets(th)
@@ -202,21 +281,19 @@ def upper_bound(case: Case, points: int = UPPER_POINTS, pieces: int = UPPER_PIEC
             ubg.append(np.full(k.size, np.inf))
 
     nlp = {"x": ca.vertcat(x_s, x_tau), "f": ca.sum1(tau_piece), "g": ca.vertcat(*g)}
-    solver = NLPSolver("upper_bound", nlp, BOUND_OPTIONS, fixed_scale=np.concatenate([s_unit, tau_unit]))
-    x0 = np.concatenate([s_unit, np.maximum(width / np.sqrt(s_unit[cell]), tau_floor)])
-    lbx = np.concatenate([lbx_s, tau_floor])
-    ubx = np.concatenate([ubx_s, np.full(cell.size, np.inf)])
-    res = solver.solve(x0, lbx, ubx, np.concatenate(lbg), np.concatenate(ubg), clip_to_bounds=False)
-    if not res.success:
-        raise NoPlanFound(f"the upper bound did not converge ({res.return_status})")
-    period = float(np.sum(res.x[n:]))
-    return UpperBound(
-        spm=60.0 / period,
-        cycle_time_s=period,
-        points=n,
-        pieces=pieces,
+    return Relaxation(
+        nlp=nlp,
+        scale=np.concatenate([s_unit, tau_unit]),
+        lbx=np.concatenate([lbx_s, tau_floor]),
+        ubx=np.concatenate([ubx_s, np.full(cell.size, np.inf)]),
+        lbg=np.concatenate(lbg),
+        ubg=np.concatenate(ubg),
+        x0=np.concatenate([s_unit, np.maximum(width / np.sqrt(s_unit[cell]), tau_floor)]),
+        theta=th,
+        cell=cell,
+        a=a,
+        b=b,
         left_out=tuple(dict.fromkeys(left_out)),
-        wall_time_s=time.perf_counter() - t_start,
     )
 
 
@@ -316,4 +393,4 @@ def _mean_forms(envelopes: list[_Affine], count: int):  # noqa: ANN202 - a gener
                 yield tuple(u + v for u, v in zip(p, q, strict=True))
 
 
-__all__ = ["RPM", "UpperBound", "upper_bound"]
+__all__ = ["RPM", "Relaxation", "UpperBound", "relaxation", "upper_bound"]

@@ -70,8 +70,8 @@ class CrankJerkLimit(Limit):
         """An interval's mean acceleration over angle is a value the acceleration takes within it, so the
         means of intervals i and i + m - 1 differ by at most ``J`` times the time of the m intervals from
         i to i + m - 1 (the grid bound's half is an estimate, not a bound); for m in :data:`RELAXED_SPANS`:
-        over one pair of neighbours the rows allow twice the jerk on a long ramp, over m intervals
-        ``m / (m - 2)`` times it."""
+        on a long jerk ramp the rows over m intervals allow ``m / (m - 1)`` times the jerk (twice it over
+        a pair of neighbours, 4/3 over four intervals)."""
         J = grid.case.limits.crank_jerk_rad_s3
         n = grid.dtheta.size
         rows = []
