@@ -22,7 +22,16 @@ from planning.reports.report import result_dict
 from planning.solver.optimize import solve
 from planning.solver.upper_bound import upper_bound
 
-from .web_page import ARTIFACTS, CASES, chromium, edit, missing_browser, pick_case, running_server, wait_rendered
+from .web_page import (
+    ARTIFACTS,
+    CASES,
+    chromium_profile,
+    edit,
+    missing_browser,
+    pick_case,
+    running_server,
+    wait_rendered,
+)
 
 PUBLISHED = CASES / "wang2023-side-panel.yaml"
 LABEL = "cases/wang2023-side-panel.yaml"
@@ -34,8 +43,8 @@ browser = pytest.mark.skipif(why is not None, reason=why or "")
 
 
 @pytest.fixture(scope="module")
-def site():
-    with running_server(PUBLISHED) as url, chromium() as browser:
+def site(tmp_path_factory):
+    with running_server(PUBLISHED) as url, chromium_profile(tmp_path_factory.mktemp("chromium")) as browser:
         yield url, browser
 
 
@@ -220,13 +229,14 @@ def test_downloads_equal_the_files_of_solve(page, tmp_path: Path) -> None:
 @browser
 def test_two_pages_stay_separate(site) -> None:
     url, browser = site
-    tabs = []
+    tabs, contexts = [], []
     for _ in range(2):
         context = browser.new_context(viewport={"width": 1200, "height": 900})
         tab = context.new_page()
         tab.goto(url)
         wait_rendered(tab)
         tabs.append(tab)
+        contexts.append(context)
     a, b = tabs
     # edits in both before either answer is read: each page keeps its own case and plan
     a.locator('[data-field="key_points.draw_start_deg"]').fill("134")
@@ -242,8 +252,8 @@ def test_two_pages_stay_separate(site) -> None:
     assert shown_numbers(a) == cli_numbers(data_a)
     assert shown_numbers(b) == cli_numbers(data_b)
     assert shown_numbers(a)["spm"] != shown_numbers(b)["spm"]
-    for tab in tabs:
-        tab.context.close()
+    for context in contexts:
+        context.close()
 
 
 @browser

@@ -68,6 +68,56 @@ def chromium() -> Iterator[object]:
             browser.close()
 
 
+class _Tabs:
+    """Pages of one profile with one viewport, opened and closed together (what a browser context offers the
+    tests: the page keeps no cookies or storage, and each tab sends its own session id)."""
+
+    def __init__(self, profile, viewport: dict | None):  # noqa: ANN001 - a Playwright BrowserContext
+        self.profile, self.viewport, self.pages = profile, viewport, []
+
+    def new_page(self):  # noqa: ANN201 - a Playwright page
+        page = self.profile.new_page()
+        if self.viewport:
+            page.set_viewport_size(self.viewport)
+        self.pages.append(page)
+        return page
+
+    def close(self) -> None:
+        for page in self.pages:
+            page.close()
+
+
+class _Profile:
+    """One persistent Chromium profile offering ``new_context`` as a browser does."""
+
+    def __init__(self, profile):  # noqa: ANN001 - a Playwright BrowserContext
+        self.profile = profile
+
+    def new_context(self, viewport: dict | None = None, accept_downloads: bool = True) -> _Tabs:
+        return _Tabs(self.profile, viewport)
+
+
+@contextmanager
+def chromium_profile(folder: Path) -> Iterator[_Profile]:
+    """A headless Chromium with one persistent profile in ``folder``: its pages share the compiled-code
+    cache, so a page after the second loads plotly.js in about 0.2 s instead of 1.3 s (the tests open about
+    twenty pages). Downloads are accepted."""
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as p:
+        profile = p.chromium.launch_persistent_context(
+            str(folder),
+            executable_path=chromium_path(),
+            headless=True,
+            args=["--no-sandbox"],
+            accept_downloads=True,
+        )
+        try:
+            yield _Profile(profile)
+        finally:
+            profile.close()
+
+
 def wait_rendered(page, after: int = 0) -> int:  # noqa: ANN001 - a Playwright page
     """Wait until the page has answered an edit after number ``after`` with its confirmed answer (not the
     fast one it shows while confirming); returns the answer's number."""

@@ -263,9 +263,9 @@ def relaxation(case: Case, points: int = UPPER_POINTS, pieces: int = UPPER_PIECE
 
     # each piece's time from the mean of the envelopes over its sub-pieces (module docstring)
     sub = _sub_grid(grid, SUBPIECES)
-    combined = [env for limit in limits if limit.field not in left_out for env in _envelopes(limit, sub)]
+    combined = _envelopes([limit for limit in limits if limit.field not in left_out], sub)
     inside = draw[th[draw + 1] <= th3 + 1e-12]  # the draw's intervals (the node at theta3 starts the return)
-    combined.append(_Affine.of(lambda g_: Envelope(g_.s_a, np.isin(g_.cell, inside), "both"), sub))
+    combined.append(_Affine.of(lambda g_: Envelope(g_.s_a, np.isin(g_.cell, inside), "exact"), sub))
     width = b - a
     tau_floor = np.zeros(cell.size)
     s_start, s_end = s[cell.tolist()], grid.s_next[cell.tolist()]
@@ -322,16 +322,18 @@ class _Affine:
         return cls(start, end, c, env.side)
 
 
-def _envelopes(limit, sub: RelaxedGrid) -> list[_Affine]:  # noqa: ANN001 - a Limit
-    """A limit's envelopes and its cap (an envelope of either side) on the sub-pieces, as numbers."""
+def _envelopes(limits: list, sub: RelaxedGrid) -> list[_Affine]:
+    """The limits' envelopes on the sub-pieces, as numbers, and their caps as one envelope of either side
+    (on each sub-piece the least of them)."""
     out = [
-        _Affine.of(lambda g_, k=k: limit.relaxed_envelopes(g_)[k], sub)
+        _Affine.of(lambda g_, limit=limit, k=k: limit.relaxed_envelopes(g_)[k], sub)
+        for limit in limits
         for k in range(len(limit.relaxed_envelopes(_unit(sub))))
     ]
-    cap = limit.relaxed_caps(sub)
-    if cap is not None:
+    caps = [np.asarray(c, dtype=float) for c in (limit.relaxed_caps(sub) for limit in limits) if c is not None]
+    if caps:
         zero = np.zeros(sub.cell.size)
-        out.append(_Affine(zero, zero, np.asarray(cap, dtype=float), "both"))
+        out.append(_Affine(zero, zero, np.min(caps, axis=0), "both"))
     return out
 
 
@@ -381,7 +383,7 @@ def _mean_forms(envelopes: list[_Affine], count: int):  # noqa: ANN202 - a gener
 
     for env in envelopes:
         yield mean(env, 0, count)
-    firsts = [e for e in envelopes if e.side in ("start", "both")]
+    firsts = [e for e in envelopes if e.side in ("start", "both")]  # the draw's ("exact") needs no split
     lasts = [e for e in envelopes if e.side in ("end", "both")]
     for split in SPLITS:
         r = round(split * count)
