@@ -329,6 +329,8 @@ def _solve(case, args) -> int:
     if not solution.verification.passed:  # solve() returns only verified plans; belt and braces
         raise CommandError(f"{args.case}: unverified plan not written", EXIT_INFEASIBLE)
     plot_format = None if args.no_plots else args.format
+    if plot_format is not None:
+        _load_plots()  # here, where a signal is held through the import, not inside the writers
     result = result_dict(solution, case)
     writers = solution_writers(solution, case, cam_points=args.cam_points, plot_format=plot_format, result=result)
     return _write_and_report(out, writers, result, summary_text(result), args, SOLVE_FILES)
@@ -448,8 +450,8 @@ class ProgressBar:
 
 
 def _load_plots() -> None:
-    """Load the plotting module (matplotlib: about a second) while the workers solve, not before them; a
-    Ctrl-C or SIGTERM meanwhile ends the run once the import is done (:func:`signals_deferred`)."""
+    """Load the plotting module (matplotlib: about a second; while a sweep's workers solve, not before
+    them); a Ctrl-C or SIGTERM meanwhile ends the run once the import is done (:func:`signals_deferred`)."""
     with signals_deferred():
         import planning.reports.plots  # noqa: F401
 
@@ -493,6 +495,7 @@ def _sweep(case, args) -> int:
     bar = ProgressBar("sweep", args.progress)
 
     def figure(result) -> None:  # noqa: ANN001 - a SweepResult
+        _load_plots()  # loaded already while the workers solved, unless there were none
         from planning.reports.plots import save, sweep_figure
 
         if len(varies) <= 2:
@@ -532,6 +535,7 @@ def _tradeoff(case, args) -> int:
     bar = ProgressBar("tradeoff", args.progress)
     result = run_tradeoff(case, rates, args.workers, args.scheduler, args.placement, _load_plots, bar.update)
     bar.close()
+    _load_plots()  # loaded already while the workers solved, unless there were none
     from planning.reports.plots import save, tradeoff_figure
 
     title = f"{case.name}: {objective} at the line's rate ({case.planner.motion_law})"
