@@ -8,12 +8,11 @@ no traceback. Outcomes become exit statuses in one place, :func:`_exit_code`.
 from __future__ import annotations
 
 import argparse
-import contextlib
 import json
 import math
 import sys
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import NoReturn
 
@@ -451,34 +450,11 @@ class ProgressBar:
 
 def _load_plots() -> None:
     """Load the plotting module (matplotlib: about a second; while a sweep's workers solve, not before
-    them); a Ctrl-C or SIGTERM meanwhile ends the run once the import is done (:func:`signals_deferred`)."""
-    with signals_deferred():
+    them); a Ctrl-C or SIGTERM meanwhile ends the run once the import is done (``ipopt.signals_held``)."""
+    from planning.solver.ipopt import signals_held
+
+    with signals_held():
         import planning.reports.plots  # noqa: F401
-
-
-@contextlib.contextmanager
-def signals_deferred() -> Iterator[None]:
-    """A Ctrl-C or SIGTERM that arrives inside the block is recorded and delivered, to the process's own
-    handler, once the block has ended. An exception raised in the middle of importing a compiled extension
-    (matplotlib's, while a sweep's workers solve) leaves the interpreter unable to exit: it aborted
-    (SIGABRT) or hung instead of ending with 143. Only the main thread can set handlers; elsewhere the
-    block runs as it is."""
-    import signal
-    import threading
-
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    caught: list[int] = []
-    numbers = [num for num in (signal.SIGINT, signal.SIGTERM) if signal.getsignal(num) is not signal.SIG_IGN]
-    previous = {num: signal.signal(num, lambda signum, frame: caught.append(signum)) for num in numbers}
-    try:
-        yield
-    finally:
-        for num, handler in previous.items():
-            signal.signal(num, handler)
-        if caught:
-            signal.raise_signal(caught[0])
 
 
 def _sweep(case, args) -> int:

@@ -139,21 +139,21 @@ def test_sigterm_ends_a_sweep_and_its_workers(tmp_path):
 def test_a_signal_inside_a_deferred_block_arrives_after_it():
     """A sweep loads matplotlib while its workers solve: a SIGTERM raised inside that import (in a compiled
     extension's initialisation) made the process abort instead of exiting 143 (seen in CI under load). Inside
-    ``signals_deferred`` the signal is held; the process's handler gets it once the block has ended."""
-    from planning.cli import signals_deferred
+    ``signals_held`` the signal is held; the process's handler gets it once the block has ended."""
+    from planning.solver.ipopt import signals_held
 
     steps, before = [], signal.getsignal(signal.SIGINT)
     signal.signal(signal.SIGINT, signal.default_int_handler)  # Ctrl-C raises KeyboardInterrupt (the CLI's)
     try:
-        _deferred_then_raised(signals_deferred, steps)
+        _deferred_then_raised(signals_held, steps)
     finally:
         signal.signal(signal.SIGINT, before)
     assert steps == ["after the signal, inside the block"]
 
 
-def _deferred_then_raised(signals_deferred, steps: list[str]) -> None:  # noqa: ANN001 - the context manager
+def _deferred_then_raised(signals_held, steps: list[str]) -> None:  # noqa: ANN001 - the context manager
     with pytest.raises(KeyboardInterrupt):
-        with signals_deferred():
+        with signals_held():
             signal.raise_signal(signal.SIGINT)
             steps.append("after the signal, inside the block")
         steps.append("after the block")  # not reached: the handler raised on the way out

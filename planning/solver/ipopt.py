@@ -24,6 +24,7 @@ import signal
 import sys
 import threading
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 import casadi as ca
@@ -214,30 +215,47 @@ def _call_passing_signals_on(solver: ca.Function, args: dict) -> dict:
     (``NonIpopt_Exception_Thrown``): the signal would be lost and the next start would run on. Here
     the signal is recorded, the solve is stopped, and once CasADi has returned the signal is raised
     again with the process's own handlers (exit 130 or 143 in the CLI); CasADi's warning about it is
-    dropped, anything else it writes to stderr passes through. Only the main thread can set
-    signal handlers; elsewhere (a Dask worker thread) the call is plain.
+    dropped, anything else it writes to stderr passes through.
     """
-    if threading.current_thread() is not threading.main_thread():
-        return solver(**args)
+    said = io.StringIO()  # CasADi reports a caught interrupt as a warning on sys.stderr
+    with signals_held(stop=True) as caught:
+        try:
+            with contextlib.redirect_stderr(said):
+                res = solver(**args)
+        finally:
+            lines = said.getvalue().splitlines(keepends=True)
+            sys.stderr.write("".join(ln for ln in lines if not (caught and "KeyboardInterruptException" in ln)))
+    if caught:
+        raise KeyboardInterrupt  # a handler that returned: the solve was stopped all the same
+    return res
+
+
+@contextlib.contextmanager
+def signals_held(stop: bool = False) -> Iterator[list[int]]:
+    """A Ctrl-C or SIGTERM that arrives inside the block is recorded (the list yielded) and delivered to the
+    process's own handler once the block has ended (exit 130 or 143 in the CLI). ``stop``: the recording
+    also raises KeyboardInterrupt inside the block, which stops IPOPT at its next check. Without it the
+    block runs on: an exception raised in the middle of importing a compiled extension (matplotlib's, while
+    a sweep's workers solve) left the interpreter unable to exit (it aborted or hung instead of ending with
+    143). Only the main thread can set handlers; elsewhere the block runs as it is. An ignored signal stays
+    ignored."""
     caught: list[int] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield caught
+        return
 
     def record(signum: int, frame) -> None:  # noqa: ANN001 - a signal handler's signature
         caught.append(signum)
-        raise KeyboardInterrupt  # stops IPOPT at its next check
+        if stop:
+            raise KeyboardInterrupt
 
     numbers = [getattr(signal, name) for name in _SIGNALS if hasattr(signal, name)]
-    numbers = [num for num in numbers if signal.getsignal(num) is not signal.SIG_IGN]  # ignored stays ignored
+    numbers = [num for num in numbers if signal.getsignal(num) is not signal.SIG_IGN]
     previous = {num: signal.signal(num, record) for num in numbers}
-    said = io.StringIO()  # CasADi reports a caught interrupt as a warning on sys.stderr
     try:
-        with contextlib.redirect_stderr(said):
-            res = solver(**args)
+        yield caught
     finally:
         for num, handler in previous.items():
             signal.signal(num, handler)
-        lines = said.getvalue().splitlines(keepends=True)
-        sys.stderr.write("".join(ln for ln in lines if not (caught and "KeyboardInterruptException" in ln)))
-    if caught:
-        signal.raise_signal(caught[0])  # the process's own handler decides (KeyboardInterrupt, exit, ...)
-        raise KeyboardInterrupt  # a handler that returned: the solve was stopped all the same
-    return res
+        if caught:
+            signal.raise_signal(caught[0])  # the process's own handler decides (KeyboardInterrupt, exit, ...)

@@ -141,19 +141,16 @@ def _on_the_finer_layout(case: Case, search: Search) -> Solution:
     used = answer.plan.parameters.peak_jerks()[0]
     if _layout_of(answer.plan) == fine_layout or used >= FINE_JERK_SHARE * case.limits.crank_jerk_rad_s3:
         return answer
-    return _refined(case, answer, fine_layout, search)
+    return on_layout(case, answer, fine_layout, search)
 
 
-def on_layout(case: Case, answer: Solution, layout: Layout) -> Solution:
+def on_layout(case: Case, answer: Solution, layout: Layout, search: Search | None = None) -> Solution:
     """The faster of ``answer`` (an optimal plan of ``case``) and the plan on the phases' ``layout`` started
-    from it: how the bracket (``planning.solver.bracket``) refines the verified motion."""
-    return _refined(case, answer, layout)
-
-
-def _refined(case: Case, answer: Solution, layout: Layout, search: Search | None = None) -> Solution:
+    from it (how the finer layout and the bracket, ``planning.solver.bracket``, refine a plan); ``search``:
+    the one that found ``answer``, whose time and work count."""
     fine = _search(case, layout)
     fine.consider(answer, answer.plan.period)
-    if search is not None:  # the time and work of the search that found ``answer`` count
+    if search is not None:
         fine.iterations, fine.starts, fine.t_start = search.iterations, search.starts, search.t_start
     fine.multi_start([seed_values(answer.plan, layout)], "free", confirm=False)
     return fine.answer()

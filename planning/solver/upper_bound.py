@@ -263,9 +263,15 @@ def relaxation(case: Case, points: int = UPPER_POINTS, pieces: int = UPPER_PIECE
 
     # each piece's time from the mean of the envelopes over its sub-pieces (module docstring)
     sub = _sub_grid(grid, SUBPIECES)
-    combined = _envelopes([limit for limit in limits if limit.field not in left_out], sub)
+    relaxed = [limit for limit in limits if limit.field not in left_out]
     inside = draw[th[draw + 1] <= th3 + 1e-12]  # the draw's intervals (the node at theta3 starts the return)
-    combined.append(_Affine.of(lambda g_: Envelope(g_.s_a, np.isin(g_.cell, inside), "exact"), sub))
+
+    def envelopes_of(g_: RelaxedGrid) -> list[Envelope]:  # the limits', then the draw's at one speed
+        return [e for limit in relaxed for e in limit.relaxed_envelopes(g_)] + [
+            Envelope(g_.s_a, np.isin(g_.cell, inside), "exact")
+        ]
+
+    combined = _affine(envelopes_of, sub) + _caps(relaxed, sub)
     width = b - a
     tau_floor = np.zeros(cell.size)
     s_start, s_end = s[cell.tolist()], grid.s_next[cell.tolist()]
@@ -307,39 +313,29 @@ class _Affine:
     constant: np.ndarray
     side: str
 
-    @classmethod
-    def of(cls, envelope_of, sub: RelaxedGrid) -> _Affine:  # noqa: ANN001 - grid -> Envelope
-        """The envelope ``envelope_of(sub)`` evaluated at the unit node values (it is affine in them)."""
-        values = []
-        for s_a, s_b in ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0)):
-            sub.s_a, sub.s_b = np.full(sub.cell.size, s_a), np.full(sub.cell.size, s_b)
-            env = envelope_of(sub)
-            values.append(np.where(env.where, np.broadcast_to(env.value, sub.cell.shape), np.inf))
-        c = values[0]
+
+def _affine(envelopes_of, sub: RelaxedGrid) -> list[_Affine]:  # noqa: ANN001 - grid -> list of Envelope
+    """The envelopes ``envelopes_of(sub)`` as numbers: evaluated at the unit node values (each is affine in
+    them), infinite where it does not hold."""
+    at = []
+    for s_a, s_b in ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0)):
+        sub.s_a, sub.s_b = np.full(sub.cell.size, s_a), np.full(sub.cell.size, s_b)
+        at.append([np.where(e.where, np.broadcast_to(e.value, sub.cell.shape), np.inf) for e in envelopes_of(sub)])
+    out = []
+    for c, at_start, at_end, env in zip(*at, envelopes_of(sub), strict=True):
         finite = np.isfinite(c)
-        start = np.where(finite, values[1] - np.where(finite, c, 0.0), 0.0)
-        end = np.where(finite, values[2] - np.where(finite, c, 0.0), 0.0)
-        return cls(start, end, c, env.side)
-
-
-def _envelopes(limits: list, sub: RelaxedGrid) -> list[_Affine]:
-    """The limits' envelopes on the sub-pieces, as numbers, and their caps as one envelope of either side
-    (on each sub-piece the least of them)."""
-    out = [
-        _Affine.of(lambda g_, limit=limit, k=k: limit.relaxed_envelopes(g_)[k], sub)
-        for limit in limits
-        for k in range(len(limit.relaxed_envelopes(_unit(sub))))
-    ]
-    caps = [np.asarray(c, dtype=float) for c in (limit.relaxed_caps(sub) for limit in limits) if c is not None]
-    if caps:
-        zero = np.zeros(sub.cell.size)
-        out.append(_Affine(zero, zero, np.min(caps, axis=0), "both"))
+        base = np.where(finite, c, 0.0)
+        out.append(_Affine(np.where(finite, at_start - base, 0.0), np.where(finite, at_end - base, 0.0), c, env.side))
     return out
 
 
-def _unit(sub: RelaxedGrid) -> RelaxedGrid:
-    sub.s_a, sub.s_b = np.ones(sub.cell.size), np.ones(sub.cell.size)
-    return sub
+def _caps(limits: list, sub: RelaxedGrid) -> list[_Affine]:
+    """The limits' caps as one envelope of either side: on each sub-piece the least of them (none: [])."""
+    caps = [np.asarray(c, dtype=float) for c in (limit.relaxed_caps(sub) for limit in limits) if c is not None]
+    if not caps:
+        return []
+    zero = np.zeros(sub.cell.size)
+    return [_Affine(zero, zero, np.min(caps, axis=0), "both")]
 
 
 def _sub_grid(grid: RelaxedGrid, count: int) -> RelaxedGrid:
