@@ -18,6 +18,8 @@ from results_section import write_section  # benchmarks/ is the script's folder
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+from planning.model.outcome import Outcome  # noqa: E402 - after the path
+
 EDITS = 20
 BEGIN, END = "<!-- web:begin -->", "<!-- web:end -->"
 
@@ -74,7 +76,7 @@ def burst(url: str, sessions: int) -> tuple[list[float], list[float]]:
         if not answer.get("confirmed"):
             answer = _post(url + "api/solve", {**body, "seq": 2 * k + 1, "confirm": True})
         confirmed.append(time.perf_counter() - t)
-        assert answer["status"] == "verified", answer
+        assert answer["status"] == Outcome.VERIFIED, answer
         time.sleep(QUIET_PAUSE_S)
     stop.set()
     for t in threads:

@@ -18,11 +18,14 @@ from typing import NoReturn
 
 from planning.model.case import OBJECTIVES
 from planning.model.laws import LAWS
+from planning.reports.arguments import whole
 from planning.reports.new_case import MECHANISMS
+from planning.reports.outputs import options as output_options
+from planning.reports.outputs.figures import PLOT_FORMATS
+from planning.tolerances import TINY_RATE
 
 EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = 0, 2, 3
 EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143  # Ctrl-C, SIGTERM (128 + the signal number)
-PLOT_FORMATS = ("png", "svg", "pdf")
 SERVE_FIRST = "wang2023-side-panel.yaml"  # the case the page opens with when none is given
 
 
@@ -35,6 +38,13 @@ def _parser() -> argparse.ArgumentParser:
     ap = _Parser(prog="pressplan", description="Plan the crank speed of a crank-slider servo press for maximum SPM.")
     ap.add_argument("--version", action="version", version=f"pressplan {_version()}")
     sub = ap.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    for add in (_case_commands, _batch_commands, _bound_command, _other_commands):
+        add(sub)
+    return ap
+
+
+def _case_commands(sub) -> None:  # noqa: ANN001 - argparse's sub-parsers
+    """``new``, ``check``, ``solve`` and ``compare``."""
     n = sub.add_parser("new", help="write a first case file, commented field by field, to edit")
     n.add_argument("file", help="the case file to write (YAML; not over an existing file)")
     n.add_argument("--mechanism", choices=MECHANISMS, default="crank-slider", help="the press (default crank-slider)")
@@ -52,11 +62,8 @@ def _parser() -> argparse.ArgumentParser:
         "--spm", type=_rate, default=None, help="the line's rate for min-rms-torque / min-energy / min-grid-peak"
     )
     s.add_argument("--json", action="store_true", help="print result.json instead of the summary")
-    s.add_argument("--format", choices=PLOT_FORMATS, default="png", help="figure format (default png)")
-    s.add_argument("--no-plots", action="store_true", help="do not draw the figures")
-    s.add_argument(
-        "--cam-points", type=_whole(2, 1_000_000), default=3600, metavar="N", help="cam table rows (default 3600)"
-    )
+    for option in output_options():  # what the outputs take (planning.reports.outputs)
+        s.add_argument(option.flag, **option.kwargs)
     m = sub.add_parser(
         "compare",
         help="the published solution beside ours, and checked against itself (needs published.solution)",
@@ -66,6 +73,10 @@ def _parser() -> argparse.ArgumentParser:
     m.add_argument("case", help="case file (YAML) with published.solution (the paper's X vector; see the README)")
     m.add_argument("--out", help="output folder (default: out/<case name>)")
     m.add_argument("--json", action="store_true", help="print comparison.json instead of the table")
+
+
+def _batch_commands(sub) -> None:  # noqa: ANN001 - argparse's sub-parsers
+    """``sweep`` and ``tradeoff``: many solves, on local workers or a Dask cluster."""
     w = sub.add_parser("sweep", help="solve a grid over case fields (resumable, parallel, Dask)")
     w.add_argument("case", help="case file (YAML)")
     w.add_argument(
@@ -77,7 +88,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     w.add_argument("--law", choices=tuple(LAWS), default=None, help="motion law (default: case)")
     w.add_argument("--placement", choices=("free", "published"), help="where theta1/theta4 may fall")
-    w.add_argument("--workers", type=_whole(1, 256), default=2, help="local worker processes (default 2)")
+    w.add_argument("--workers", type=whole(1, 256), default=2, help="local worker processes (default 2)")
     w.add_argument("--scheduler", help="address of a Dask distributed scheduler (instead of local workers)")
     w.add_argument("--out", required=True, help="output folder (sweep.csv, sweep.json, sweep_spm.png)")
     w.add_argument("--progress", action="store_true", help=PROGRESS_HELP)
@@ -92,10 +103,14 @@ def _parser() -> argparse.ArgumentParser:
     )
     t.add_argument("--law", choices=tuple(LAWS), default=None, help="motion law (default: case)")
     t.add_argument("--placement", choices=("free", "published"), help="where theta1/theta4 may fall")
-    t.add_argument("--workers", type=_whole(1, 256), default=2, help="local worker processes (default 2)")
+    t.add_argument("--workers", type=whole(1, 256), default=2, help="local worker processes (default 2)")
     t.add_argument("--scheduler", help="address of a Dask distributed scheduler (instead of local workers)")
     t.add_argument("--out", required=True, help="output folder (tradeoff.csv, tradeoff.json, tradeoff.png)")
     t.add_argument("--progress", action="store_true", help=PROGRESS_HELP)
+
+
+def _bound_command(sub) -> None:  # noqa: ANN001 - argparse's sub-parsers
+    """``bound``: the time-optimal bound, the certified upper bound, the bracket."""
     b = sub.add_parser(
         "bound",
         help="the time-optimal bound: the most strokes any motion can make",
@@ -105,7 +120,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     _case_argument(b)
     b.add_argument(
-        "--points", type=_whole(2, 1_000_000), default=1440, metavar="N", help="grid intervals (default 1440)"
+        "--points", type=whole(2, 1_000_000), default=1440, metavar="N", help="grid intervals (default 1440)"
     )
     b.add_argument(
         "--certified",
@@ -115,7 +130,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     b.add_argument(
         "--upper-points",
-        type=_whole(2, 1_000_000),
+        type=whole(2, 1_000_000),
         default=None,
         metavar="N",
         help="the certified bound's grid intervals (default 1440)",
@@ -135,6 +150,10 @@ def _parser() -> argparse.ArgumentParser:
         help="the bracket's gap to reach [%%] (default 0.05); implies --bracket",
     )
     b.add_argument("--json", action="store_true", help="print JSON")
+
+
+def _other_commands(sub) -> None:  # noqa: ANN001 - argparse's sub-parsers
+    """``laws``, ``serve`` and ``plot``."""
     lw = sub.add_parser("laws", help="every motion law on the case, beside the time-optimal bound")
     _case_argument(lw)
     lw.add_argument("--out", help="output folder (default: out/<case name>)")
@@ -142,7 +161,7 @@ def _parser() -> argparse.ArgumentParser:
     lw.add_argument("--format", choices=PLOT_FORMATS, default="png", help="figure format (default png)")
     sv = sub.add_parser("serve", help="a local web page to plan a motion interactively (extra 'web')")
     sv.add_argument("case", nargs="?", help="case file (YAML) to open first (default: the published case)")
-    sv.add_argument("--port", type=_whole(1, 65535), default=8050, help="port (default 8050)")
+    sv.add_argument("--port", type=whole(1, 65535), default=8050, help="port (default 8050)")
     sv.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1: this machine only)")
     sv.add_argument(
         "--cases", default="cases", help="folder whose *.yaml the page offers (default: cases, else the project's)"
@@ -150,7 +169,6 @@ def _parser() -> argparse.ArgumentParser:
     pl = sub.add_parser("plot", help="redraw the figures of a finished output folder (no solve)")
     pl.add_argument("folder", help="output folder of `pressplan solve`")
     pl.add_argument("--format", choices=PLOT_FORMATS, default="png", help="figure format (default png)")
-    return ap
 
 
 def _version() -> str:
@@ -202,21 +220,6 @@ def _rate(text: str) -> float:
     if not (math.isfinite(value) and 0 < value <= 1e4):
         raise argparse.ArgumentTypeError(f"must be above 0 and at most 10000 strokes/min, got {text}")
     return value
-
-
-def _whole(lo: int, hi: int):
-    """An argparse type: a whole number in ``lo ... hi``."""
-
-    def parse(text: str) -> int:
-        try:
-            n = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
-        if not lo <= n <= hi:
-            raise argparse.ArgumentTypeError(f"must be {lo} ... {hi}, got {n}")
-        return n
-
-    return parse
 
 
 class CommandError(Exception):
@@ -317,22 +320,19 @@ def _output_folder(case, args, owned: tuple[str, ...]) -> Path:
 
 
 def _solve(case, args) -> int:
-    from planning.reports.folder import SOLVE_FILES
-    from planning.reports.outputs import solution_writers
-    from planning.reports.report import result_dict, summary_text
+    from planning.reports.outputs import Written, owned_files, writers_of
+    from planning.reports.report import summary_text
     from planning.solver.optimize import solve
 
     case = _with_objective(_with_law(case, args), args)
-    out = _output_folder(case, args, SOLVE_FILES)
+    out = _output_folder(case, args, owned_files())
     solution = solve(case, args.placement)
-    if not solution.verification.passed:  # solve() returns only verified plans; belt and braces
-        raise CommandError(f"{args.case}: unverified plan not written", EXIT_INFEASIBLE)
-    plot_format = None if args.no_plots else args.format
-    if plot_format is not None:
+    figures = not args.no_plots
+    if figures:
         _load_plots()  # here, where a signal is held through the import, not inside the writers
-    result = result_dict(solution, case)
-    writers = solution_writers(solution, case, cam_points=args.cam_points, plot_format=plot_format, result=result)
-    return _write_and_report(out, writers, result, summary_text(result), args, SOLVE_FILES)
+    written = Written(solution, case, {o.kwargs["dest"]: getattr(args, o.kwargs["dest"]) for o in output_options()})
+    writers = writers_of(written, figures)
+    return _write_and_report(out, writers, written.result, summary_text(written.result), args, owned_files())
 
 
 def _with_law(case, args):  # noqa: ANN001, ANN202 - a Case and the parsed arguments
@@ -434,7 +434,7 @@ class ProgressBar:
         if not self.tty and done < total and now - self.last < PROGRESS_EVERY_S:
             return
         self.last = now
-        rate = done / max(now - self.started, 1e-9)
+        rate = done / max(now - self.started, TINY_RATE)
         left = (total - done) / rate if rate > 0 else math.inf
         bar = "#" * int(30 * done / total)
         line = f"{self.what} [{bar:<30}] {done}/{total} points, {failed} without a plan, {rate:.1f} points/s, " + (
@@ -483,7 +483,9 @@ def _sweep(case, args) -> int:
     )
     bar.close()
     rows = result.rows
-    verified = sum(r["status"] == "verified" for r in rows)
+    from planning.sweep import verified as holds
+
+    verified = sum(holds(r) for r in rows)
     print(
         f"{case.name}: {len(rows)} points, {verified} verified, {len(rows) - verified} without a plan"
         f"{f' ({result.resumed} from an earlier run)' if result.resumed else ''}"
@@ -609,7 +611,7 @@ def _laws(case, args) -> int:
     out = _output_folder(case, args, LAWS_FILES)
     data, tables = compare_laws(case)
     if not tables:  # each law's own reason, on the one line
-        reasons = "; ".join(f"{r['law']}: {r['status'].removeprefix('failed: ')}" for r in data["laws"])
+        reasons = "; ".join(f"{r['law']}: {r['message']}" for r in data["laws"])
         raise CommandError(f"{args.case}: no motion law gives a verified plan ({reasons})", EXIT_INFEASIBLE)
     curves = {law: dict(zip(TRAJECTORY_COLUMNS, table.T, strict=True)) for law, table in tables.items()}
     title = f"{case.name}: crank motion of each law ({data['placement']} placement)"
@@ -638,12 +640,12 @@ def _new(args) -> int:
 
 def _plot(args) -> int:
     from planning.reports.folder import write_atomic
-    from planning.reports.outputs import plot_writers
+    from planning.reports.outputs.figures import redraw
 
     folder = Path(args.folder)
     if not (folder / "result.json").is_file():
         raise CommandError(f"{folder}: no result.json here (run `pressplan solve` first)")
-    files = write_atomic(folder, plot_writers(folder, args.format))
+    files = write_atomic(folder, redraw(folder, args.format))
     print(f"wrote {', '.join(str(f) for f in files)}")
     return EXIT_OK
 

@@ -34,8 +34,9 @@ from pydantic import BaseModel
 
 from planning.model.case import ELECTRICAL_KEYS, Case, states_electrical
 from planning.model.case_file import with_fields
-from planning.model.limits.base import TIME_TOL
+from planning.model.outcome import Outcome
 from planning.timeline import Timeline, stamp
+from planning.tolerances import SAME_ANGLE_RAD, SAME_SPM, TIME_TOL_S
 
 BLOCK_POINTS = 6
 ROW_FIELDS = ("spm", "cycle_time_s", "status", "binding", "solve_time_s", "message")
@@ -113,7 +114,7 @@ def parse_vary(text: str) -> Vary:
     return Vary(field, start, stop, count)
 
 
-def grid(varies: list[Vary]) -> list[tuple[float, ...]]:
+def points_of(varies: list[Vary]) -> list[tuple[float, ...]]:
     """Every combination of the swept values, the last field varying fastest."""
     return [tuple(float(v) for v in combo) for combo in itertools.product(*(v.values for v in varies))]
 
@@ -146,11 +147,11 @@ def solve_block(
             previous = sol.plan
             row.update(_solved_row(sol, case), plan=sol.plan, case=case)
         except CaseFileError as exc:
-            row.update(status="bad input", message=str(exc))
+            row.update(status=Outcome.BAD_INPUT, message=str(exc))
         except PlanningError as exc:
-            row.update(status=exc.kind, message=exc.reason)
+            row.update(status=exc.outcome, message=exc.reason)
         except Exception as exc:  # noqa: BLE001 - one failing point never stops the sweep
-            row.update(status="error", message=f"{type(exc).__name__}: {exc}")
+            row.update(status=Outcome.ERROR, message=f"{type(exc).__name__}: {exc}")
         row["solve_time_s"] = time.perf_counter() - t
         stamp(row, started)
         rows.append(row)
@@ -163,7 +164,7 @@ def _solved_row(sol, case) -> dict[str, Any]:  # noqa: ANN001 - a Solution and i
     row = {
         "spm": sol.plan.spm,
         "cycle_time_s": sol.plan.period,
-        "status": "verified",
+        "status": Outcome.VERIFIED,
         "binding": ";".join(binding(sol)),
         "message": "",
     }
@@ -223,7 +224,8 @@ def repair(
     ``timeline``: the time of the finding (one process) is added to its ``second_pass_serial_s``.
     """
     from planning.model.case_file import CaseFileError, case_from_data
-    from planning.solver.verify import verify
+    from planning.solver.solution import Solution
+    from planning.solver.verify import evaluate
 
     improved = 0
     cases: dict[int, Any] = {}  # each point's case, read once for every pass
@@ -243,19 +245,21 @@ def repair(
             case = cases[i]
             if case is None:
                 continue
-            current = rows[i].get("spm") if rows[i].get("status") == "verified" else None
+            current = rows[i].get("spm") if verified(rows[i]) else None
             plans = []
             for j in neighbours(i, shape):
                 plan = rows.get(j, {}).get("plan")
-                if plan is None or (current is not None and plan.spm <= current + 1e-9) or (i, id(plan)) in tried:
+                if plan is None or (current is not None and plan.spm <= current + SAME_SPM) or (i, id(plan)) in tried:
                     continue
                 tried[(i, id(plan))] = plan
-                same = np.allclose(plan.key_angles, case.key_angles, atol=1e-12)
+                same = np.allclose(plan.key_angles, case.key_angles, atol=SAME_ANGLE_RAD)
                 # the robot's window first: the verification's own check, without its dense grid (a faster
                 # neighbour in a sweep of the transfer time fails it, and only it)
-                short = plan.transfer_window() < case.process.transfer_time_s - TIME_TOL
-                if same and not short and verify(plan, case).passed:
-                    plans.append(plan)
+                short = plan.transfer_window() < case.process.transfer_time_s - TIME_TOL_S
+                if same and not short:
+                    evaluation = evaluate(plan, case)  # handed over with the plan: not evaluated again
+                    if evaluation.verification.passed:
+                        plans.append(Solution(plan, evaluation))
             if plans:
                 work.append((case, placement, i, current, plans))
         if timeline is not None:
@@ -275,8 +279,9 @@ def repair(
 def resolve_from(
     case: Case, placement: str | None, index: int, current: float | None, plans: list[Any]
 ) -> list[dict[str, Any]]:
-    """Point ``index`` (its ``case``) re-solved from each of ``plans``: the best that beats ``current`` [SPM]
-    as a row update (``index``, the figures, the plan), or none."""
+    """Point ``index`` (its ``case``) re-solved from each of ``plans`` (neighbours' plans verified against
+    it, as solutions): the best that beats ``current`` [SPM] as a row update (``index``, the figures, the
+    plan), or none."""
     from planning.solver.optimize import solve
     from planning.solver.outcomes import PlanningError
 
@@ -286,7 +291,7 @@ def resolve_from(
             sol = solve(case, placement, neighbour=plan, follow=True)
         except PlanningError:
             continue
-        if (current is None or sol.plan.spm > current + 1e-9) and (best is None or sol.plan.spm > best.plan.spm):
+        if (current is None or sol.plan.spm > current + SAME_SPM) and (best is None or sol.plan.spm > best.plan.spm):
             best = sol
     if best is None:
         return []
@@ -370,7 +375,7 @@ def run_sweep(
     (the caller's figure)."""
     timeline = Timeline()
     fields = [v.field for v in varies]
-    points = grid(varies)
+    points = points_of(varies)
     out.mkdir(parents=True, exist_ok=True)
     spec = {
         "fields": fields,
@@ -391,7 +396,7 @@ def run_sweep(
     columns = ["index", *fields, *ROW_FIELDS, *(DRIVE_ROW_FIELDS if base.get("drive") else ())]
     columns += POWER_ROW_FIELDS if _electrical(base, fields) else ()
     new_file = not csv_path.exists() or csv_path.stat().st_size == 0
-    failed = sum(1 for r in earlier.values() if r["status"] != "verified")
+    failed = sum(1 for r in earlier.values() if not verified(r))
     finished = len(done)
     fresh: dict[int, dict[str, Any]] = {}
     with open(csv_path, "a", newline="", encoding="utf-8") as fh:
@@ -407,7 +412,7 @@ def run_sweep(
                 writer.writerow({k: _cell(row.get(k)) for k in columns})
                 fresh[row["index"]] = row
                 finished += 1
-                failed += row["status"] != "verified"
+                failed += not verified(row)
             fh.flush()
             os.fsync(fh.fileno())
             if progress:
@@ -438,7 +443,14 @@ def run_sweep(
 def _cell(value: Any) -> Any:
     if isinstance(value, float):
         return repr(value)
+    if isinstance(value, Outcome):
+        return value.value
     return "" if value is None else value
+
+
+def verified(row: dict[str, Any]) -> bool:
+    """Whether a sweep's or a trade-off's row (solved now or read back from its file) holds a verified plan."""
+    return Outcome.of(row.get("status")).succeeded
 
 
 def execute(

@@ -21,8 +21,9 @@ from typing import Any
 import numpy as np
 
 from planning.model.case import Case, Placement
+from planning.model.outcome import Outcome
 from planning.solver.solution import GRID_PEAK
-from planning.sweep import SweepError, _cell, execute
+from planning.sweep import SweepError, _cell, execute, verified
 from planning.timeline import Timeline, stamp
 
 # one row per rate: the plan's figures, the baseline's, the savings
@@ -112,7 +113,7 @@ def rate_block(case: Case, placement: Placement | None, fastest: Any, rates: lis
             at_rate = case.with_objective(None, rate)
             row.update(solved_row(solve_at_rate(at_rate, placement, fastest=fastest), at_rate))
         except PlanningError as exc:
-            row.update(status=exc.kind, message=exc.reason)
+            row.update(status=exc.outcome, message=exc.reason)
         row["solve_time_s"] = time.perf_counter() - t
         stamp(row, started)
         rows.append(row)
@@ -122,7 +123,7 @@ def rate_block(case: Case, placement: Placement | None, fastest: Any, rates: lis
 def solved_row(sol: Any, case: Case) -> dict[str, Any]:
     """The figures of a solution at a rate and of its baseline (the drive's figures each carries)."""
     a = sol.at_rate
-    row: dict[str, Any] = {"status": "verified", "message": "", "improved_on_baseline": a.improved}
+    row: dict[str, Any] = {"status": Outcome.VERIFIED, "message": "", "improved_on_baseline": a.improved}
     for prefix, solution in (("", sol), ("baseline_", a.baseline)):
         figures = {**solution.drive.as_dict(), "transfer_window_s": solution.plan.transfer_window()}
         row.update({f"{prefix}{k}": figures[k] for k in FIGURE_FIELDS})
@@ -194,7 +195,7 @@ def run_tradeoff(
         for row in block:
             rows[row["index"]] = row
         if progress is not None:
-            progress(len(rows), len(order), sum(r["status"] != "verified" for r in rows.values()))
+            progress(len(rows), len(order), sum(not verified(r) for r in rows.values()))
     timeline.mark("end")
     ordered = [rows[i] for i in sorted(rows)]
     return TradeoffResult(ordered, fastest, case.planner.objective, timeline.as_dict(ordered))
@@ -219,7 +220,7 @@ def table_text(result: TradeoffResult, case: Case) -> str:
         + (f" {'grid kW':>8} {'baseline':>9} {'saving':>7}" if grid else ""),
     ]
     for r in result.rows:
-        if r["status"] != "verified":
+        if not verified(r):
             lines.append(f"  {r['target_spm']:8.3f}  {r['status']}: {r['message']}")
             continue
         lines.append(

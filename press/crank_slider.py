@@ -46,9 +46,10 @@ from typing import Any
 
 import numpy as np
 
+from planning.tolerances import SAME_HEIGHT_MM
 from press.backend import math_module
 from press.jets import ORDER, Jet, Point
-from press.mechanism import HEIGHT_TOL, Formula, Jets, Mechanism
+from press.mechanism import Formula, Jets, Mechanism
 
 
 def offset_jets(theta: Any, geometry: Sequence[Any]) -> Jets:
@@ -235,7 +236,7 @@ class CrankSlider(Mechanism):
         R, L, e = self.crank_radius, self.rod_length, self.offset
         phi_tdc, y_bdc = -math.asin(e / (L - R)), -math.sqrt((L + R) ** 2 - e**2)
         h_arr = np.asarray(h, dtype=float)
-        if np.any(h_arr < -HEIGHT_TOL) or np.any(h_arr > self.stroke + HEIGHT_TOL):
+        if np.any(h_arr < -SAME_HEIGHT_MM) or np.any(h_arr > self.stroke + SAME_HEIGHT_MM):
             raise ValueError(f"height {h} mm is outside the stroke 0 ... {self.stroke:g} mm")
         if e == 0:  # in line: the law of cosines in the triangle centre-pin-slide, symmetric about BDC
             s = L + R - h_arr

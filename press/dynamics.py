@@ -43,6 +43,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from planning.tolerances import TINY
 from press.backend import math_module
 from press.jets import Jet
 
@@ -208,8 +209,8 @@ def envelope_torque(motor_speed_rad_s: Any, peak_torque_Nm: float, base_speed_ra
     n = motor_speed_rad_s
     if m is np:
         n = np.asarray(n, dtype=float)
-        return peak_torque_Nm * np.minimum(1.0, base_speed_rad_s / np.maximum(np.abs(n), 1e-300))
-    return peak_torque_Nm * m.fmin(1.0, base_speed_rad_s / m.fmax(m.fabs(n), 1e-300))
+        return peak_torque_Nm * np.minimum(1.0, base_speed_rad_s / np.maximum(np.abs(n), TINY))
+    return peak_torque_Nm * m.fmin(1.0, base_speed_rad_s / m.fmax(m.fabs(n), TINY))
 
 
 def forming_work(h_start_mm: float, h_end_mm: float, drive: DriveModel) -> float:

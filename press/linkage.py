@@ -8,7 +8,7 @@ the intersection of two circles (``press.jets.circle_intersection``), always on 
 oracles' assembly mode); the slide moves on a vertical line and hangs below the joint that drives it.
 The project's crank angle ``theta`` counts from TDC, ``phi = theta + phi_TDC``; the height counts from
 BDC, ``h = y_slide - y_BDC``; ``phi_TDC`` (the slide's highest point) and ``y_BDC`` are found once per
-geometry by a scan and bisection on the closed form's derivative (:data:`DEAD_CENTRE_TOL`).
+geometry by a scan and bisection on the closed form's derivative (:data:`DEAD_CENTRE_BRACKET_RAD`).
 
 - **Link drive** (``mechpress.ld.LD``; a six-bar): crank ``a``; the ternary link on the crank pin A, its
   side ``b`` to the rocker joint B and its side ``m`` to the rod joint C, the angle ``tht`` between them
@@ -33,16 +33,15 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from planning.tolerances import DEAD_CENTRE_BRACKET_RAD, MIN_LOOP_ROOM
 from press.jets import ORDER, Jet, Point, circle_intersection
 from press.mechanism import Formula, Jets, Mechanism
 
 DWELL_SHARE = 5e-3  # a slide may turn back within this share of the stroke above BDC (a knuckle joint's dwell)
 SIDE = -1.0  # the closing joint lies to the right of the line from the crank pin to the rocker pivot
 SCAN = 7200  # crank angles of the scans (dead centres, assembly, one stroke per turn)
-DEAD_CENTRE_TOL = 1e-13  # [rad] the bisection for TDC stops at this bracket width
 MEMO_SIZE = 4  # arrays of crank angles whose evaluation a linkage remembers
 MEMO_MIN_SIZE = 64  # smaller arrays are evaluated again (cheaper than a look-up)
-MIN_ROOM = 1e-6  # a loop whose closing room (a squared sine of the transmission angle) falls below this locks
 
 
 class LinkageError(ValueError):
@@ -240,7 +239,7 @@ class Linkage(Mechanism):
         """``(phi_TDC, y_TDC, y_BDC, phi_BDC)``: the oracles' crank angle of the slide's highest point [rad],
         the slide's highest and lowest positions [mm] and the crank angle of the lowest [rad]. Raises
         :class:`LinkageError` where the rocker's pivot lies within the crank's reach, where a loop cannot close
-        (its room below :data:`MIN_ROOM`) and where the slide turns back anywhere but in a dwell at BDC
+        (its room below :data:`MIN_LOOP_ROOM`) and where the slide turns back anywhere but in a dwell at BDC
         (within :data:`DWELL_SHARE` of the stroke above it: a knuckle joint may wobble there)."""
         self._check_pivot()
         phi = np.linspace(0.0, 2 * math.pi, SCAN, endpoint=False)
@@ -248,7 +247,7 @@ class Linkage(Mechanism):
             points, rooms = type(self).chain(Jet.angle(phi), self.dimensions)
         for room, names in rooms:
             k = int(np.argmin(room.value))
-            if not room.value[k] > MIN_ROOM:
+            if not room.value[k] > MIN_LOOP_ROOM:
                 raise LinkageError(
                     f"the links cannot close at crank angle {math.degrees(phi[k]):.1f} deg (counted from +x, "
                     "counter-clockwise)",
@@ -308,7 +307,7 @@ class Linkage(Mechanism):
         """The zero of dy/dphi next to the scan's extreme ``phi0`` (bisection)."""
         step = 2 * math.pi / SCAN
         lo, hi = phi0 - step, phi0 + step
-        while hi - lo > DEAD_CENTRE_TOL:
+        while hi - lo > DEAD_CENTRE_BRACKET_RAD:
             mid = 0.5 * (lo + hi)
             slope = float(self._slide_y(mid).c[1])
             if (slope > 0) == falling_after:  # still rising towards TDC (or falling towards BDC)

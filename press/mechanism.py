@@ -29,13 +29,11 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from planning.tolerances import DEAD_CENTRE_BRACKET_RAD, ROOT_STEP_RAD, SAME_HEIGHT_MM
 from press.jets import ORDER
 
 TWO_PI = 2.0 * math.pi
 CURVATURE_GRID = 7200  # angles [one turn] on which the generic peak curvature is sought
-DEAD_CENTRE_TOL = 1e-13  # [rad] the generic BDC search stops at this bracket width
-HEIGHT_TOL = 1e-9  # [mm] a height this far outside the stroke still counts as its end
-ROOT_TOL = 1e-14  # [rad] the generic crossing search stops when its steps are this small
 ROOT_ITERATIONS = 100  # at most (bisection alone would need about 40 from a grid interval)
 
 
@@ -141,7 +139,7 @@ class Mechanism(ABC):
         grid = np.linspace(0.0, TWO_PI, CURVATURE_GRID + 1)
         k = int(np.argmin(self.height(grid)))
         lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, CURVATURE_GRID)]
-        while hi - lo > DEAD_CENTRE_TOL:
+        while hi - lo > DEAD_CENTRE_BRACKET_RAD:
             mid = 0.5 * (lo + hi)
             if float(self.derivatives(mid)[0]) < 0:
                 lo = mid
@@ -221,7 +219,7 @@ class Mechanism(ABC):
     # ---- helpers ----
     def _within_stroke(self, h: Any) -> np.ndarray:
         target = np.asarray(h, dtype=float)
-        if np.any(target < -HEIGHT_TOL) or np.any(target > self.stroke + HEIGHT_TOL):
+        if np.any(target < -SAME_HEIGHT_MM) or np.any(target > self.stroke + SAME_HEIGHT_MM):
             raise ValueError(f"height {h} mm is outside the stroke 0 ... {self.stroke:g} mm")
         return np.clip(target, 0.0, self.stroke)
 
@@ -242,7 +240,7 @@ class Mechanism(ABC):
                 newton = x - f / d1
             inside = np.isfinite(newton) & (newton > lo) & (newton < hi)
             step = np.where(inside, newton, 0.5 * (lo + hi))
-            done = np.abs(step - x) <= ROOT_TOL
+            done = np.abs(step - x) <= ROOT_STEP_RAD
             x = step
             if np.all(done):
                 break

@@ -14,7 +14,7 @@ scale of its key in the file (a value that is zero up to round-off). Lists of na
 verification's checks) compare by name; a point at a knot named as the end of one segment or the start
 of the next is the same point. ``--rename PATH=NEW``: a key renamed on purpose (``PATH``, dotted from the
 top of a JSON file or a CSV column, in the first folder reads as ``NEW``); ``--allow PATH``: a key added
-or removed on purpose.
+or removed on purpose (``--allow '*.KEY'``: the key KEY wherever it is).
 """
 
 from __future__ import annotations
@@ -29,8 +29,8 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-TIMING_KEYS = {"wall_time_s", "solve_time_s"}
-REL_TOL = 1e-8  # relative agreement of every number
+TIMING_KEYS = {"wall_time_s", "solve_time_s", "timeline"}  # a run's times (a sweep's timeline: all times)
+REL_TOL = 1e-9  # relative agreement of every number
 ABS_TOL = 1e-12  # absolute floor (numbers that are zero up to round-off)
 NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
 
@@ -115,7 +115,7 @@ def _same(a, b, path: str, allowed: set[str], scales: dict[str, float]) -> list[
         out = []
         for k in sorted(set(a) | set(b), key=str):
             here = f"{path}.{k}" if path else str(k)
-            if (k not in a or k not in b) and here in allowed:
+            if (k not in a or k not in b) and (here in allowed or f"*.{k}" in allowed):
                 continue
             if k not in a or k not in b:
                 out.append(f"{here}: only in {'first' if k in a else 'second'}")

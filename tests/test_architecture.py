@@ -1,6 +1,7 @@
 """The folder tree is the architecture: the import graph built from the source has no cycle and no import
 from a lower layer to a higher one (``press`` < ``planning.model`` < ``planning.solver`` < the edges:
-reports, sweep, trade-off, web, CLI); nothing outside ``press/`` knows a link length."""
+reports, sweep, trade-off, web, CLI); nothing outside ``press/`` knows a link length; tolerances live in
+one module, and no function is longer than 80 lines."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGES = ("press", "planning")
 LAYERS = (  # module prefix -> layer, the most specific prefix wins
+    ("planning.tolerances", -1),  # the numbers every layer shares (the machine's geometry too)
     ("press", 0),
     ("planning.model", 1),
     ("planning.solver", 2),
@@ -188,3 +190,33 @@ def test_only_the_solver_wrapper_and_the_nlp_builders_import_casadi():
             if isinstance(node, ast.ImportFrom) and (node.module or "").split(".")[0] == "casadi":
                 importers.add(name)
     assert importers == CASADI_MODULES
+
+
+SMALLEST_LITERAL = 1e-4  # a float literal below this is a tolerance (or a floor against division by zero)
+MAX_FUNCTION_LINES = 80
+
+
+def test_tolerances_live_in_their_module():
+    """``planning/tolerances.py`` holds every tolerance, each named with its unit and reason; nothing else in
+    ``planning/`` or ``press/`` writes one as a literal, and the module imports nothing of the project's."""
+    found = []
+    for name, path in _modules().items():
+        if name == "planning.tolerances":
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Constant) and isinstance(node.value, float) and 0 < abs(node.value) < SMALLEST_LITERAL:
+                found.append(f"{path.relative_to(ROOT)}:{node.lineno}: {node.value!r}")
+    assert found == []
+    assert _graph()["planning.tolerances"] == set()
+
+
+def test_no_function_is_longer_than_80_lines():
+    """A function that does one thing fits on a screen (the style guide)."""
+    long = []
+    for path in sorted((ROOT / "planning").rglob("*.py")) + sorted((ROOT / "press").rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                lines = node.end_lineno - node.lineno + 1
+                if lines > MAX_FUNCTION_LINES:
+                    long.append(f"{path.relative_to(ROOT)}:{node.lineno} {node.name}: {lines} lines")
+    assert long == []

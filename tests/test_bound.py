@@ -13,6 +13,7 @@ from planning.cli import main
 from planning.model.case import RPM
 from planning.model.case_file import case_from_data, read_case
 from planning.model.laws import LAWS
+from planning.model.outcome import Outcome
 from planning.solver.bound import time_optimal_bound
 from planning.solver.optimize import solve
 
@@ -74,7 +75,7 @@ def test_laws_against_the_jerk_limited_bound(servo_case):
     from planning.reports.law_comparison import compare_laws
 
     data, _ = compare_laws(servo_case)
-    shares = [r["share_of_bound_pct"] for r in data["laws"] if r["status"] == "verified"]
+    shares = [r["share_of_bound_pct"] for r in data["laws"] if r["status"] == Outcome.VERIFIED]
     assert len(shares) == len(LAWS) and data["jerk_limited_bound"]
     assert max(shares) >= 95.0 and max(shares) <= 100.0
 

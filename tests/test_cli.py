@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from planning.cli import main
+from planning.model.outcome import Outcome
 from planning.reports.report import TRAJECTORY_COLUMNS
 
 from .conftest import PUBLISHED_CASE
@@ -65,7 +66,7 @@ def test_solve_writes_result_json(solved):
         "solver",
     ):
         assert key in r
-    assert r["verified"] is True and r["status"] == "verified"
+    assert r["verified"] is True and r["status"] == Outcome.VERIFIED
     assert 11.6 <= r["spm"] <= 11.8
     assert r["cycle_time_s"] == pytest.approx(60 / r["spm"])
     assert set(r["solver"]) >= {"iterations", "wall_time_s"}
@@ -145,13 +146,13 @@ def test_case_file_is_never_written(tmp_path):
 def test_solver_success_but_failed_verification_is_exit_3(monkeypatch, tmp_path, capsys):
     """No false successes: when every plan fails the dense check, nothing is written and exit is 3."""
     import planning.solver.search as search
-    from planning.solver.verify import Check, Verification
+    from planning.solver.verify import Check, Evaluation, Verification
 
     def failing(plan, case, **_):
         check = Check("|slider acceleration|", 9999.0, 3500.0, "mm/s^2", "max", False, "slider_accel")
-        return Verification((check,), 1e-3, 10), None
+        return Evaluation(None, None, Verification((check,), 1e-3, 10))
 
-    monkeypatch.setattr(search, "assess", failing)
+    monkeypatch.setattr(search, "evaluate", failing)
     out = tmp_path / "o"
     assert main(["solve", str(PUBLISHED_CASE), "--out", str(out)]) == 3
     err = capsys.readouterr().err

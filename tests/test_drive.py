@@ -117,7 +117,7 @@ def test_trajectory_integrated_independently_gives_the_drive_figures(solved):
     assert float(np.max(rows["motor_speed_rpm"])) <= drive["motor"]["max_speed_rpm"] * (1 + 1e-6)
 
 
-def test_plan_respects_the_envelope_and_the_rms_limit_on_the_dense_grid(solved):
+def test_plan_respects_the_envelope_and_the_rms_limit_on_the_sample_times(solved):
     path, out = solved
     result = json.loads((out / "result.json").read_text())
     checks = {c["name"]: c for c in result["verification"]["checks"]}

@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 from planning.model.case_file import read_case
 from planning.model.laws import LAWS, SHAPED_LAWS
 from planning.model.laws.shapes import Cycloidal, Logistic, Quintic
+from planning.model.outcome import Outcome
 from planning.model.profile import Profile, max_abs_jerk, split_segment
 from planning.solver.optimize import solve
 
@@ -159,7 +160,7 @@ def test_laws_command_and_the_readme_table(tmp_path, capsys):
     data = json.loads(capsys.readouterr().out)
     assert {p.name for p in tmp_path.iterdir()} == {"laws.json", "laws.md", "laws_overlay.png"}
     rows = {r["law"]: r for r in data["laws"]}
-    assert set(rows) == set(LAWS) and all(r["status"] == "verified" for r in rows.values())
+    assert set(rows) == set(LAWS) and all(r["status"] == Outcome.VERIFIED for r in rows.values())
     assert all(r["spm"] <= data["upper_bound"]["spm"] for r in rows.values())  # certified: no motion above
     assert all(0 < r["share_of_upper_bound_pct"] <= 100.0 for r in rows.values())
     best = max(rows.values(), key=lambda r: r["spm"])
@@ -231,7 +232,7 @@ def test_laws_go_on_when_the_bound_has_no_answer(monkeypatch, tmp_path, capsys):
     assert main(["laws", str(PUBLISHED_CASE), "--out", str(out), "--json"]) == 0
     data = json.loads((out / "laws.json").read_text())
     assert data["bound"] is None and "did not converge" in data["bound_failure"]
-    assert all(r["status"] == "verified" and r["share_of_bound_pct"] is None for r in data["laws"])
+    assert all(r["status"] == Outcome.VERIFIED and r["share_of_bound_pct"] is None for r in data["laws"])
     assert data["upper_bound"] is None and data["bracket"] is None
     assert all(r["share_of_upper_bound_pct"] is None for r in data["laws"])
     text = (out / "laws.md").read_text()

@@ -21,7 +21,7 @@ def limited():
     return case, solve(case)
 
 
-def test_motor_limits_hold_on_the_dense_grid(limited):
+def test_motor_limits_hold_on_the_sample_times(limited):
     case, sol = limited
     lim = case.limits
     for limit_id in ("crank_speed", "crank_accel", "crank_jerk"):

@@ -13,6 +13,7 @@ import pytest
 
 from planning.cli import main
 from planning.model.case_file import case_from_data, load_yaml, read_case
+from planning.model.outcome import Outcome
 from planning.solver.bound import time_optimal_bound
 from planning.solver.optimize import solve
 
@@ -66,7 +67,7 @@ def test_the_bound_lies_above_the_plan(offset_solution):
 def test_laws_sweep_tradeoff_and_compare_run(tmp_path, capsys):
     assert main(["laws", str(OFFSET_CASE), "--out", str(tmp_path / "laws")]) == 0
     laws = json.loads((tmp_path / "laws" / "laws.json").read_text())
-    assert all(row["status"] == "verified" for row in laws["laws"])
+    assert all(row["status"] == Outcome.VERIFIED for row in laws["laws"])
     vary = "press.offset_mm=0:40:2"
     assert main(["sweep", str(OFFSET_CASE), "--vary", vary, "--workers", "1", "--out", str(tmp_path / "sw")]) == 0
     with open(tmp_path / "sw" / "sweep.csv") as fh:
@@ -84,9 +85,9 @@ def test_the_web_api_solves_it():
 
     client = create_app(ROOT / "cases").test_client()
     loaded = client.get(f"/api/case/{OFFSET_CASE.name}").get_json()
-    assert loaded["status"] == "ok" and loaded["case"]["press"]["offset_mm"] == 40
+    assert "case" in loaded and loaded["case"]["press"]["offset_mm"] == 40
     answer = client.post("/api/solve", json={"session": "s", "seq": 1, "case": loaded["case"]}).get_json()
-    assert answer["status"] == "verified"
+    assert answer["status"] == Outcome.VERIFIED
 
 
 def test_a_bad_offset_names_its_field(tmp_path, capsys):

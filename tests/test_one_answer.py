@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 from planning.model.case_file import CaseFileError, case_from_data, read_case
+from planning.model.outcome import Outcome
 from planning.solver.optimize import solve
 from planning.solver.outcomes import PlanningError
 
@@ -78,7 +79,7 @@ def test_a_sweep_point_is_its_cold_solve_or_better(tmp_path, capsys):
     for line in rows[1:]:
         row = dict(zip(header, line.split(","), strict=False))
         point = _edited(case, process={"transfer_time_s": float(row["process.transfer_time_s"])})
-        assert row["status"] == "verified"
+        assert row["status"] == Outcome.VERIFIED
         assert float(row["spm"]) >= solve(point).plan.spm * (1 - SAME), row
 
 
@@ -111,7 +112,7 @@ def _page_answer(client, data: dict, seq: int) -> dict:  # noqa: ANN001 - a Flas
     """What the page shows at rest after an edit: the fast answer, then the confirmed one."""
     body = {"session": "tab", "seq": seq, "label": "case", "case": data}
     answer = client.post("/api/solve", json={**body, "confirm": False}).get_json()
-    if answer["status"] == "verified" and not answer["confirmed"]:
+    if answer["status"] == Outcome.VERIFIED and not answer["confirmed"]:
         answer = client.post("/api/solve", json={**body, "confirm": True}).get_json()
     return answer
 
@@ -142,12 +143,12 @@ def _run_sequences(count: int, seed: int) -> None:
         try:
             cold = solve(case_from_data(data))
         except CaseFileError:
-            assert answer["status"] == "bad input", (n, data)
+            assert answer["status"] == Outcome.BAD_INPUT, (n, data)
             continue
         except PlanningError:
             assert answer["status"] != "verified", (n, data)
             continue
-        assert answer["status"] == "verified", (n, answer.get("message"))
+        assert answer["status"] == Outcome.VERIFIED, (n, answer.get("message"))
         shown = answer["result"]["spm"]
         assert shown >= cold.plan.spm * (1 - SAME), (n, sequence, shown, cold.plan.spm)
 

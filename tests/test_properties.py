@@ -57,9 +57,9 @@ def outcome(data: dict, spms: list[float] | None = None) -> str:
     try:
         sol = solve(case)
     except PlanningError as exc:
-        assert exc.kind in ("infeasible", "unverified", "no verified plan") and "\n" not in str(exc)
+        assert exc.outcome.without_plan and "\n" not in str(exc)
         assert CASE_FIELD.search(str(exc)), f"exit 3 without the case field it could not meet: {exc}"
-        return f"{exc.kind} (exit 3)"
+        return f"{exc.outcome} (exit {exc.outcome.exit_code})"
     assert sol.verification.passed
     json.dumps(result_dict(sol, case), allow_nan=False)  # raises on NaN or infinity
     tab = trajectory(sol, case)
@@ -141,7 +141,7 @@ def _file_bytes(data: dict) -> dict[str, bytes]:
     case = case_from_data(data)
     sol = solve(case)
     out = {}
-    for name, write in solution_writers(sol, case, plot_format=None).items():
+    for name, write in solution_writers(sol, case, figures=False).items():
         if name == "result.json":
             r = result_dict(sol, case)
             r["solver"]["wall_time_s"] = 0.0

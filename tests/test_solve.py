@@ -45,7 +45,7 @@ def test_free_placement_beats_the_published_structure(free_solution, published_s
 
 
 @pytest.mark.parametrize("which", ["published_solution", "free_solution"])
-def test_dense_grid_meets_every_limit(which, case, request):
+def test_sample_times_meets_every_limit(which, case, request):
     """Constraint checks straight from the written trajectory (<= 1 ms grid), not via verify()."""
     sol = request.getfixturevalue(which)
     tab = trajectory(sol, case)

@@ -15,7 +15,8 @@ import pytest
 
 from planning.cli import main
 from planning.model.case_file import read_case
-from planning.sweep import SweepError, Vary, grid, neighbours, parse_vary, run_sweep
+from planning.model.outcome import Outcome
+from planning.sweep import SweepError, Vary, neighbours, parse_vary, points_of, run_sweep
 
 from .conftest import PUBLISHED_CASE
 
@@ -29,7 +30,7 @@ def test_parse_vary_and_grid():
     v = parse_vary("process.transfer_time_s=1.0:3.0:41")
     assert (v.field, v.start, v.stop, v.count) == ("process.transfer_time_s", 1.0, 3.0, 41)
     assert list(v.values[:3]) == [1.0, 1.05, 1.1] and v.values[14] == 1.7
-    g = grid([Vary("a", 0, 1, 2), Vary("b", 0, 2, 3)])
+    g = points_of([Vary("a", 0, 1, 2), Vary("b", 0, 2, 3)])
     assert g == [(0, 0), (0, 1), (0, 2), (1, 0), (1, 1), (1, 2)]  # the last field varies fastest
     assert sorted(neighbours(4, (2, 3))) == [1, 3, 5]
 
@@ -94,7 +95,7 @@ def test_two_field_sweep_heat_map(tmp_path):
     )
     assert code == 0
     rows = rows_of(out / "sweep.csv")
-    assert len(rows) == 4 and all(r["status"] == "verified" for r in rows)
+    assert len(rows) == 4 and all(r["status"] == Outcome.VERIFIED for r in rows)
     spm = {(float(r["process.transfer_time_s"]), float(r["limits.slider_accel_mm_s2"])): float(r["spm"]) for r in rows}
     assert spm[(1.8, 4000)] > spm[(1.8, 3000)] and spm[(1.8, 3000)] > spm[(2.2, 3000)]
     assert (out / "sweep_spm.png").exists()
@@ -135,7 +136,7 @@ def test_interrupted_sweep_resumes_without_redoing_points(tmp_path):
     assert result.resumed == len(done_before)
     rows = rows_of(csv_path)
     assert [int(r["index"]) for r in rows] == list(range(24))
-    assert all(r["status"] == "verified" for r in rows)
+    assert all(r["status"] == Outcome.VERIFIED for r in rows)
 
 
 def test_other_sweep_in_the_same_folder_is_refused(tmp_path, capsys):
@@ -193,7 +194,7 @@ def test_dask_cluster_gives_the_local_results(tmp_path):
         assert len(reports) == 2  # 8 points in blocks of 6: two blocks
     keys = ("index", "process.transfer_time_s", "spm", "status", "binding")
     assert [[r[k] for k in keys] for r in local.rows] == [[r[k] for k in keys] for r in remote.rows]
-    assert all(r["status"] == "verified" for r in remote.rows)
+    assert all(r["status"] == Outcome.VERIFIED for r in remote.rows)
     # the timeline of both: every point stamped by one of two workers, the serial part apart
     for result in (local, remote):
         t = result.timeline

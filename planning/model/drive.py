@@ -22,6 +22,7 @@ import numpy as np
 
 from planning.model.case import RPM, Case
 from planning.model.profile import Profile, dense_times
+from planning.tolerances import SAME_TIME_S
 from press.dynamics import drive_state, envelope_torque, forming_work
 
 GAUSS_NODES = 4
@@ -126,7 +127,7 @@ def quadrature(profile: Profile, case: Case, extra_edges: np.ndarray | None = No
     edges = _breakpoints(profile, case)
     if extra_edges is not None:
         edges = np.unique(np.concatenate([edges, np.clip(extra_edges, profile.t0, profile.t0 + profile.duration)]))
-        edges = edges[np.concatenate([[True], np.diff(edges) > 1e-12])]
+        edges = edges[np.concatenate([[True], np.diff(edges) > SAME_TIME_S])]
     span = np.diff(edges)
     step = max(MAX_PIECE_S, profile.duration / MAX_PIECES)
     counts = np.maximum(MIN_PIECES, np.ceil(span / step).astype(int))

@@ -13,8 +13,7 @@ from planning.model.free_profile import FreeProfileParameters
 from planning.model.laws import DEFAULT_LAW
 from planning.model.laws import improved_scurve as sc
 from planning.model.profile import Profile, advance_segment, knot_states, split_segment
-
-KNOT_TOL_S = 1e-9  # [s] a time this close after a knot is the knot (where a key point falls)
+from planning.tolerances import KNOT_TIME_S, TINY
 
 
 @dataclass(frozen=True)
@@ -68,10 +67,10 @@ class Plan:
         """Where time ``t`` [s] lies, in words: ``stage, segment, NN % in`` (:func:`segment_in_words`); a knot
         counts as the end of the earlier segment (``feed, 1st acceleration sub-segment, 100 % in`` is the
         knot where the second sub-segment starts), also when ``t``
-        lies within :data:`KNOT_TOL_S` after it (round-off)."""
+        lies within :data:`KNOT_TIME_S` after it (round-off)."""
         tk = self.profile.knot_times
-        k = int(np.clip(np.searchsorted(tk, t - KNOT_TOL_S, side="left") - 1, 0, len(self.profile.segments) - 1))
-        share = (t - tk[k]) / max(tk[k + 1] - tk[k], 1e-300)
+        k = int(np.clip(np.searchsorted(tk, t - KNOT_TIME_S, side="left") - 1, 0, len(self.profile.segments) - 1))
+        share = (t - tk[k]) / max(tk[k + 1] - tk[k], TINY)
         return f"{segment_in_words(self.profile.segments[k].name)}, {100 * share:.0f} % in"
 
     def transfer_window(self) -> float:

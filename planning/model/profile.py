@@ -33,9 +33,10 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from planning.tolerances import ANGLE_ROUND_OFF_RAD, SAME_TIME_S
+
 MAX_STEP_S = 1e-3  # [s] dense grid step (at most), for cycles up to MAX_SAMPLES * MAX_STEP_S = 1000 s
 MAX_SAMPLES = 1_000_000  # grid points at most: a longer cycle gets a uniform step of period / MAX_SAMPLES
-SAME_TIME_S = 1e-12  # [s] a grid point this close to a knot is dropped for the knot
 
 
 class Segment(NamedTuple):
@@ -188,7 +189,7 @@ class Profile:
         for _ in range(100):
             th, om, _, _ = advance_segment(seg, *knots[k], tau)
             err = th - theta
-            if abs(err) < 1e-14:
+            if abs(err) < ANGLE_ROUND_OFF_RAD:
                 break
             if err > 0:
                 hi = tau
@@ -203,6 +204,12 @@ def dense_times(period: float, knot_times: np.ndarray, max_step: float = MAX_STE
     """A uniform grid over ``[0, period]`` [s] with step <= ``max_step`` (at most :data:`MAX_SAMPLES`
     points: a coarser uniform step for a cycle longer than 1000 s), merged with the knots: the grid of
     the dense verification and of the drive's peaks."""
+    return sample_times(period, knot_times, max_step)[0]
+
+
+def sample_times(period: float, knot_times: np.ndarray, max_step: float = MAX_STEP_S) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`dense_times` and, for each point of its uniform grid, the index of that point among them
+    (a grid point within :data:`SAME_TIME_S` of a knot is that knot): ``(times [s], uniform indices)``."""
     n = min(int(math.ceil(period / max_step)), MAX_SAMPLES)
     grid = np.linspace(0.0, period, n + 1)
     knots = np.asarray(knot_times, dtype=float)
@@ -212,7 +219,11 @@ def dense_times(period: float, knot_times: np.ndarray, max_step: float = MAX_STE
     for j in (np.clip(at - 1, 0, n), np.clip(at, 0, n)):
         near[j[np.abs(grid[j] - knots) <= SAME_TIME_S]] = True
     near[[0, n]] = False  # the ends stay
-    return np.unique(np.concatenate([grid[~near], knots]))
+    times = np.unique(np.concatenate([grid[~near], knots]))
+    right = np.clip(np.searchsorted(times, grid), 0, times.size - 1)
+    left = np.clip(right - 1, 0, times.size - 1)
+    uniform = np.where(np.abs(times[left] - grid) < np.abs(times[right] - grid), left, right)
+    return times, uniform
 
 
 def max_abs_jerk(prof: Profile) -> float:

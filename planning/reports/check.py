@@ -11,8 +11,9 @@ from planning.model.case import KEY_POINT_NAMES, RPM, Case
 from planning.model.limits import draw_speed_bounds, limits_of
 from planning.model.limits.base import Check, Draw
 from planning.model.limits.robot_window import radians_hint
+from planning.tolerances import SAME_SCORE
 
-ROUND_OFF = 1e-9  # relative: a check at the highest draw speed sits on its limit up to floating-point round-off
+ROUND_OFF = SAME_SCORE  # relative: a check at the highest draw speed sits on its limit up to floating-point round-off
 
 
 def check_case(case: Case) -> dict[str, Any]:

@@ -33,7 +33,7 @@ SYMBOLS = {
 def comparison(case: Case, ours_published: Solution, ours_free: Solution) -> dict[str, Any]:
     """Plain data for the comparison (engineering units)."""
     pub = case.published
-    kp_ours = key_points(ours_published, case)
+    kp_ours = key_points(ours_published)
     rows_kp = []
     for i, name in enumerate(KEY_POINT_NAMES):
         ref = getattr(pub.key_points, name) if pub and pub.key_points else None

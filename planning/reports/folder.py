@@ -1,6 +1,7 @@
 """The output folder: checked before solving, replaced as a whole, never half old and half new.
 
-A command owns a set of file names in its folder (:data:`SOLVE_FILES`, :data:`COMPARE_FILES`, ...).
+A command owns a set of file names in its folder (``solve``'s from the outputs' registry,
+``planning.reports.outputs.owned_files``; :data:`COMPARE_FILES`, ...).
 :func:`write_atomic` builds the folder's next state beside it, in a hidden sibling folder
 ``.NAME.pressplan-PID-TOKEN``: the command's new files, plus hard links to every file in the folder
 that the command does not own (another command's results, a note of the user's). Files the command
@@ -32,17 +33,6 @@ from pathlib import Path
 
 import numpy as np
 
-SOLVE_FILES = (
-    "result.json",
-    "trajectory.csv",
-    "cam_table.csv",
-    "summary.txt",
-    "published_profile.csv",
-    "motion_vs_time.*",
-    "motion_vs_angle.*",
-    "drive.*",
-    "energy.*",
-)
 COMPARE_FILES = ("comparison.json", "comparison.md")
 LAWS_FILES = ("laws.json", "laws.md", "laws_overlay.*")
 TRADEOFF_FILES = ("tradeoff.csv", "tradeoff.json", "tradeoff.png")

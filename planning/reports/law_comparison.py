@@ -19,8 +19,9 @@ import numpy as np
 from planning.model.case import RPM, Case, CaseError
 from planning.model.case_file import CaseFileError
 from planning.model.laws import LAWS
+from planning.model.outcome import Outcome
 from planning.model.profile import max_abs_jerk
-from planning.reports.report import binding, sample_profile
+from planning.reports.report import MAX_ROWS, TRAJECTORY_COLUMNS, binding, trajectory
 from planning.solver.bound import Bound, time_optimal_bound
 from planning.solver.optimize import solve
 from planning.solver.outcomes import PlanningError
@@ -51,19 +52,19 @@ DRIVE_COLUMNS = (  # with a drive, after the others
 
 
 def law_row(
-    law: str, solution: Solution, case: Case, bound: Bound | None, table: np.ndarray, upper: UpperBound | None = None
+    law: str, solution: Solution, case: Case, bound: Bound | None, upper: UpperBound | None = None
 ) -> dict[str, Any]:
-    """The figures of merit of one verified plan (engineering units in the keys); ``table``: its
-    trajectory from :func:`planning.reports.report.sample_profile`; its share of the grid ``bound`` and of
-    the certified ``upper`` bound (never above 100 %)."""
+    """The figures of merit of one verified plan (engineering units in the keys), from its evaluation's
+    uniform samples; its share of the grid ``bound`` and of the certified ``upper`` bound (never above 100 %)."""
     plan = solution.plan
-    t, om, al = table[:, 0], table[:, 2], table[:, 3]
-    _, _, _, slider_jerk = case.machine.slider(np.radians(table[:, 1]), om * RPM, al, table[:, 4])
+    dense, rows = solution.evaluation.samples, solution.evaluation.rows(MAX_ROWS)
+    t, om, al = dense.t[rows], dense.omega[rows] / RPM, dense.alpha[rows]
+    slider_jerk = dense.slide_jerk[rows]
     sq = al**2
     mean_sq = float(np.sum(np.diff(t) * (sq[1:] + sq[:-1]) / 2)) / plan.period  # time average (trapezoids)
     return {
         "law": law,
-        "status": "verified",
+        "status": Outcome.VERIFIED,
         "spm": plan.spm,
         "cycle_time_s": plan.period,
         "share_of_bound_pct": 100.0 * plan.spm / bound.spm if bound is not None else None,
@@ -98,7 +99,7 @@ def compare_laws(case: Case, laws: tuple[str, ...] = tuple(LAWS)) -> tuple[dict[
     """Solve ``case`` under each law; returns the comparison dictionary and, per law with a verified
     plan, its trajectory (columns :data:`planning.reports.report.TRAJECTORY_COLUMNS`).
 
-    A law without a verified plan gets a row with ``status`` ``failed: <reason>`` and no numbers;
+    A law without a verified plan gets a row with its ``status`` (the outcome) and ``message`` and no numbers;
     when the bound has no answer the laws are still compared (``bound`` None, ``bound_failure`` says why)."""
     try:
         bound, bound_failure = time_optimal_bound(case), None
@@ -118,16 +119,22 @@ def compare_laws(case: Case, laws: tuple[str, ...] = tuple(LAWS)) -> tuple[dict[
                 variant, note = None, {"reason": str(exc)}
         else:
             variant = case.with_law(law)
-        try:
-            if variant is None:
-                raise PlanningError(note.pop("reason"))
-            sol = solve(variant)
-        except PlanningError as exc:
-            rows.append({"law": law, "status": f"failed: {exc}", "continuity": LAWS[law].continuity, **note})
+        outcome, message = Outcome.VERIFIED, ""
+        if variant is None:
+            outcome, message = Outcome.BAD_INPUT, note.pop("reason")
+        else:
+            try:
+                sol = solve(variant)
+            except PlanningError as exc:
+                outcome, message = exc.outcome, str(exc)
+        if not outcome.succeeded:
+            row = {"law": law, "status": outcome, "message": message, "continuity": LAWS[law].continuity}
+            rows.append({**row, **note})
             continue
-        tables[law] = sample_profile(sol.plan.profile, variant.machine)
-        rows.append({**law_row(law, sol, variant, bound, tables[law], upper), **note})
-    verified = [r for r in rows if r["status"] == "verified"]
+        columns = trajectory(sol, variant)
+        tables[law] = np.column_stack([columns[name] for name in TRAJECTORY_COLUMNS])
+        rows.append({**law_row(law, sol, variant, bound, upper), **note})
+    verified = [r for r in rows if Outcome.of(r["status"]).succeeded]
     best = max(verified, key=lambda r: r["spm"]) if verified else None
     bracket = None
     if best is not None and upper is not None:
@@ -154,7 +161,7 @@ def _jerk_limited(case: Case, law: str, rows: list[dict[str, Any]]) -> tuple[Cas
 
     if case.limits.crank_jerk_rad_s3 is not None:
         return case.with_law(law), {"jerk_limit_rad_s3": case.limits.crank_jerk_rad_s3, "jerk_limit_from": "case"}
-    ref = next((r for r in rows if r["law"] == DEFAULT_LAW and r["status"] == "verified"), None)
+    ref = next((r for r in rows if r["law"] == DEFAULT_LAW and Outcome.of(r["status"]).succeeded), None)
     if ref is None:
         return None, {"reason": f"no jerk limit: the case sets none and the {DEFAULT_LAW} law has no plan"}
     data = case.model_dump(exclude_none=True)
@@ -179,8 +186,8 @@ def laws_markdown(data: dict[str, Any]) -> str:
     rule = "|" + "|".join("---" if fmt == "" else "---:" for _, _, fmt in columns) + "|"
     lines = [head, rule]
     for row in data["laws"]:
-        if row["status"] != "verified":
-            lines.append(f"| {row['law']} | {row['status']} |" + " |" * (len(columns) - 2))
+        if not Outcome.of(row["status"]).succeeded:
+            lines.append(f"| {row['law']} | failed: {row['message']} |" + " |" * (len(columns) - 2))
             continue
         cells = [_cell(row[key], fmt) for key, _, fmt in columns]
         lines.append("| " + " | ".join(cells) + " |")
@@ -210,8 +217,8 @@ def laws_text(data: dict[str, Any]) -> str:
         f"{'slider jerk':>11} {'acc RMS':>8}  continuous up to",
     ]
     for r in data["laws"]:
-        if r["status"] != "verified":
-            lines.append(f"  {r['law']:<17} {r['status']}")
+        if not Outcome.of(r["status"]).succeeded:
+            lines.append(f"  {r['law']:<17} failed: {r['message']}")
             continue
         lines.append(
             f"  {r['law']:<17} {r['spm']:7.3f} {_cell(r['share_of_upper_bound_pct'], '7.1f')} "

@@ -15,7 +15,9 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from planning.model.outcome import Outcome
 from planning.reports.limit_lines import LimitLine, limit_lines, robot_windows
+from planning.tolerances import TINY_RATE
 
 WINDOW_COLOUR, DRAW_COLOUR = "#d9ecff", "#e2f0d9"  # the robot's window, the draw
 KEY_TICKS = {"closing": "θ1", "draw_start": "θ2", "draw_end": "θ3", "opening": "θ4"}
@@ -295,7 +297,7 @@ def drive_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
     plane = fig.add_subplot(grid[:, 0])
     n_top = max(motor["max_speed_rpm"], float(np.max(np.abs(t["motor_speed_rpm"])))) * 1.05
     n = np.linspace(0.0, motor["max_speed_rpm"], 400)
-    envelope = motor["peak_torque_Nm"] * np.minimum(1.0, motor["base_speed_rpm"] / np.maximum(n, 1e-9)) / 1e3
+    envelope = motor["peak_torque_Nm"] * np.minimum(1.0, motor["base_speed_rpm"] / np.maximum(n, TINY_RATE)) / 1e3
     for sign in (1, -1):
         plane.plot(n, sign * envelope, color="#b22222", lw=1.6, label="peak envelope" if sign > 0 else None)
     _plus_minus(plane, motor["rated_torque_Nm"] / 1e3, "rated (RMS limit)", color="#e08000", lw=1.2, ls="--")
@@ -325,7 +327,7 @@ def drive_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
     _key_ticks(torque, result, "angle")
     torque.plot(x, t["motor_torque_Nm"] / 1e3, color="#1f77b4", lw=1.4, label="motor torque")
     speed = np.abs(t["motor_speed_rpm"])
-    at_speed = motor["peak_torque_Nm"] * np.minimum(1.0, motor["base_speed_rpm"] / np.maximum(speed, 1e-9)) / 1e3
+    at_speed = motor["peak_torque_Nm"] * np.minimum(1.0, motor["base_speed_rpm"] / np.maximum(speed, TINY_RATE)) / 1e3
     envelope_label = "drive.motor.peak_torque_Nm: the envelope at the motor's speed"
     _limit(torque, x, at_speed, envelope_label, "#b22222", both=True)  # falls above the base speed
     rated = motor["rated_torque_Nm"] / 1e3
@@ -365,7 +367,7 @@ def sweep_figure(rows: list[dict[str, Any]], fields: list[str], title: str) -> F
     fig = Figure(figsize=(10, 6.5), dpi=90)
     FigureCanvasAgg(fig)
     spm = np.array([float(r["spm"]) if r.get("spm") not in ("", None) else np.nan for r in rows])
-    ok = np.array([r.get("status") == "verified" for r in rows])
+    ok = np.array([Outcome.of(r.get("status")).succeeded for r in rows])
     if len(fields) == 1:
         ax, fails = fig.subplots(2, 1, sharex=True, height_ratios=(1, 0.08))
         fig.subplots_adjust(right=0.75, hspace=0.08)
@@ -467,7 +469,7 @@ def tradeoff_figure(rows: list[dict[str, Any]], case: Any, title: str) -> Figure
     fig.subplots_adjust(left=0.08, right=0.68, top=0.94, bottom=0.07, hspace=0.25)
     FigureCanvasAgg(fig)
     top, middle, bottom = fig.subplots(3, 1, sharex=True)
-    ok = [r for r in rows if r.get("status") == "verified"]
+    ok = [r for r in rows if Outcome.of(r.get("status")).succeeded]
     spm = np.array([float(r["target_spm"]) for r in ok])
 
     def column(name: str) -> np.ndarray:
@@ -513,7 +515,7 @@ def tradeoff_figure(rows: list[dict[str, Any]], case: Any, title: str) -> Figure
     bottom.axhline(0.0, color="#444444", lw=0.6)
     top.axhline(motor.rated_torque_Nm / 1e3, color="tab:blue", lw=1, ls=":", label="drive.motor.rated_torque_Nm")
     top.axhline(motor.peak_torque_Nm / 1e3, color="tab:orange", lw=1, ls=":", label="drive.motor.peak_torque_Nm")
-    failed = [float(r["target_spm"]) for r in rows if r.get("status") != "verified"]
+    failed = [float(r["target_spm"]) for r in rows if not Outcome.of(r.get("status")).succeeded]
     for ax in (top, middle, bottom):
         for i, x in enumerate(failed):
             ax.axvline(x, color="tab:red", lw=0.8, alpha=0.6, label="no plan at this rate" if i == 0 else None)

@@ -15,11 +15,12 @@ from planning.model.case import KEY_POINT_NAMES, RPM, Case
 from planning.model.cycle import HALVES
 from planning.model.laws.improved_scurve import ImprovedSCurve
 from planning.model.limits.slider_accel import SliderAccelLimit
+from planning.model.outcome import Outcome
 from planning.model.profile import MAX_STEP_S, Profile
 from planning.reports.stages import stage_table
-from planning.solver.grid import Schedule, power_columns, schedule_of
 from planning.solver.solution import GRID_PEAK, Solution
-from press.dynamics import drive_state
+from planning.solver.verify import Evaluation
+from planning.tolerances import KNOT_TIME_S, SAME_RELATIVE
 from press.mechanism import Mechanism
 
 TRAJECTORY_COLUMNS = (
@@ -37,32 +38,16 @@ POWER_COLUMNS = ("copper_loss_kW", "bus_power_kW", "grid_power_kW", "storage_ene
 MAX_ROWS = 200_000  # trajectory rows at most: a cycle longer than 200 s gets a step of period / MAX_ROWS
 
 
-def sample_profile(
-    profile: Profile,
-    machine: Mechanism,
-    max_step: float = MAX_STEP_S,
-    case: Case | None = None,
-    schedule: Schedule | None = None,
-) -> np.ndarray:
-    """``profile`` over its whole duration on a uniform time grid with step <= ``max_step`` [s] (at most
-    :data:`MAX_ROWS` + 1 rows: a coarser uniform step for a long cycle); columns as
-    :data:`TRAJECTORY_COLUMNS`, then :data:`DRIVE_COLUMNS` when ``case`` has a drive and
-    :data:`POWER_COLUMNS` when it states the drive's electrical side (the storage's ``schedule``, computed
-    here when not given: ``planning.solver.grid``); the first and last rows are the profile's ends."""
+def sample_profile(profile: Profile, machine: Mechanism, max_step: float = MAX_STEP_S) -> np.ndarray:
+    """A profile that is no solved plan's (the source's published solution, rebuilt) over its whole duration
+    on a uniform time grid with step <= ``max_step`` [s] (at most :data:`MAX_ROWS` + 1 rows); columns as
+    :data:`TRAJECTORY_COLUMNS`; the first and last rows are the profile's ends. A plan's rows come from its
+    evaluation (:func:`trajectory`)."""
     n = min(int(math.ceil(profile.duration / max_step)), MAX_ROWS)
     t = np.linspace(0.0, profile.duration, n + 1)
     th, om, al, je = profile.at_time(profile.t0 + t)
     h, v, a, _ = machine.slider(th, om, al, je)
-    columns = [t, np.degrees(th), om / RPM, al, je, h, v, a]
-    if case is not None and case.drive is not None:
-        s = drive_state(th, om, al, case.machine, case.drive_model)
-        columns += [s["crank_torque_Nm"], s["motor_speed_rad_s"] / RPM, s["motor_torque_Nm"], s["motor_power_W"] / 1e3]
-        if case.electrical:
-            schedule = schedule if schedule is not None else schedule_of(profile, case)
-            c = power_columns(schedule, s, t, case)
-            columns += [c["copper_loss_W"] / 1e3, c["bus_power_W"] / 1e3, c["grid_power_W"] / 1e3]
-            columns.append(c["storage_energy_J"] / 1e3)
-    return np.column_stack(columns)
+    return np.column_stack([t, np.degrees(th), om / RPM, al, je, h, v, a])
 
 
 def trajectory_columns(case: Case) -> tuple[str, ...]:
@@ -72,31 +57,43 @@ def trajectory_columns(case: Case) -> tuple[str, ...]:
     return TRAJECTORY_COLUMNS + DRIVE_COLUMNS + (POWER_COLUMNS if case.electrical else ())
 
 
-def trajectory(solution: Solution, case: Case, max_step: float = MAX_STEP_S) -> dict[str, np.ndarray]:
-    """One full cycle of the plan from TDC (see :func:`sample_profile`), one array per column of
-    ``trajectory.csv`` (:func:`trajectory_columns`: ``time_s``, ``crank_angle_deg``, ...,
-    ``slider_accel_mm_s2``, and the drive's with a drive); the first and last samples are one period apart."""
-    power = solution.drive.power if solution.drive is not None else None
-    table = sample_profile(solution.plan.profile, case.machine, max_step, case, power and power.schedule)
-    return dict(zip(trajectory_columns(case), table.T, strict=True))
+def trajectory(solution: Solution, case: Case, most: int = MAX_ROWS) -> dict[str, np.ndarray]:
+    """One full cycle of the plan from TDC on the uniform grid of its evaluation (at most ``most`` + 1 rows,
+    evenly spaced), one array per column of ``trajectory.csv`` (:func:`trajectory_columns`: ``time_s``,
+    ``crank_angle_deg``, ..., ``slider_accel_mm_s2``, and the drive's with a drive); the first and last
+    samples are one period apart."""
+    return columns_at(solution.evaluation, case, solution.evaluation.rows(most))
 
 
-def key_points(solution: Solution, case: Case) -> list[dict[str, Any]]:
+def columns_at(evaluation: Evaluation, case: Case, rows: np.ndarray) -> dict[str, np.ndarray]:
+    """The columns of ``trajectory.csv`` (:func:`trajectory_columns`) at the evaluation's samples ``rows``."""
+    d = evaluation.samples
+    columns = [d.t, np.degrees(d.theta), d.omega / RPM, d.alpha, d.jerk, d.h, d.v, d.a]
+    if case.drive is not None:
+        s = d.drive_state
+        columns += [s["crank_torque_Nm"], s["motor_speed_rad_s"] / RPM, s["motor_torque_Nm"], s["motor_power_W"] / 1e3]
+        if case.electrical:
+            c = evaluation.power_columns
+            columns += [c["copper_loss_W"] / 1e3, c["bus_power_W"] / 1e3, c["grid_power_W"] / 1e3]
+            columns.append(c["storage_energy_J"] / 1e3)
+    return {name: np.asarray(column)[rows] for name, column in zip(trajectory_columns(case), columns, strict=True)}
+
+
+def key_points(solution: Solution) -> list[dict[str, Any]]:
     """The four key points: name, angle [deg], time from TDC [s], height [mm], slider speed [mm/s]
-    (magnitude; ``direction`` down/up), crank speed [rpm]."""
+    (magnitude; ``direction`` down/up), crank speed [rpm] (the evaluation's, at their exact times)."""
     plan = solution.plan
-    times = plan.key_times()
-    th, om, al, je = plan.profile.at_time(times)
-    h, v, _, _ = case.machine.slider(th, om, al, je)
+    dense = solution.evaluation.samples
+    motion = dense.key_motion
     return [
         {
             "name": name,
             "angle_deg": float(math.degrees(plan.key_angles[i])),
-            "time_s": float(times[i]),
-            "height_mm": float(h[i]),
-            "slider_speed_mm_s": float(abs(v[i])),
-            "direction": "down" if v[i] < 0 else "up",
-            "crank_speed_rpm": float(om[i] / RPM),
+            "time_s": float(dense.key_times[i]),
+            "height_mm": float(motion["h"][i]),
+            "slider_speed_mm_s": float(abs(motion["v"][i])),
+            "direction": "down" if motion["v"][i] < 0 else "up",
+            "crank_speed_rpm": float(motion["omega"][i] / RPM),
         }
         for i, name in enumerate(KEY_POINT_NAMES)
     ]
@@ -108,7 +105,7 @@ def segments(solution: Solution) -> list[dict[str, Any]]:
     knots = prof.knots()
     out = []
     jerk = prof.at_time(prof.knot_times)[3]  # right-continuous: the start of each segment
-    jerk_end = prof.at_time(prof.knot_times[1:] - 1e-12 * np.maximum(prof.durations, 1e-9))[3]
+    jerk_end = prof.at_time(prof.knot_times[1:] - SAME_RELATIVE * np.maximum(prof.durations, KNOT_TIME_S))[3]
     for k, seg in enumerate(prof.segments):
         T = float(seg.duration)
         j_start, j_end = float(jerk[k]), float(jerk_end[k])
@@ -142,7 +139,7 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
         "case": case.name,
         "spm": plan.spm,
         "cycle_time_s": plan.period,
-        "status": "verified" if ver.passed else "failed",
+        "status": Outcome.VERIFIED if ver.passed else Outcome.UNVERIFIED,
         "verified": ver.passed,
         "placement": plan.placement,
         "motion_law": plan.motion_law,
@@ -162,7 +159,7 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
         "binding_constraints": binding(solution),
         "process": case.process.model_dump(),
         "limits": case.limits.model_dump(),
-        "key_points": key_points(solution, case),
+        "key_points": key_points(solution),
         "segments": segments(solution),
         "paper_solution": plan.paper_solution() if plan.motion_law == ImprovedSCurve.name else None,
         **({"drive": drive_block(solution, case)} if case.drive is not None else {}),
@@ -181,7 +178,8 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
             "status": plan.solver.status,
         },
     }
-    table = stage_table(result, trajectory(solution, case))  # after the segments: the stages they make
+    evaluation = solution.evaluation
+    table = stage_table(result["segments"], evaluation, evaluation.rows(MAX_ROWS))  # after the segments: their stages
     ordered = {}
     for key, value in result.items():
         ordered[key] = value
@@ -230,8 +228,25 @@ def objective_block(solution: Solution, case: Case) -> dict[str, Any]:
 def summary_text(result: dict[str, Any]) -> str:
     """The console summary of a result dictionary."""
     r = result
+    lines = _plan_lines(r) + _key_point_lines(r) + _stage_lines(r) + _drive_lines(r) + _objective_lines(r)
+    lines.append("")
+    lines.append("  binding: " + (", ".join(r["binding_constraints"]) or "none"))
+    v = r["verification"]
+    lines.append(
+        f"  verified on {v['samples']} points (step {v['step_s'] * 1e3:.3f} ms): "
+        + ("all checks pass" if v["passed"] else "FAILED")
+    )
+    lines.append(
+        f"  solver: {r['solver']['iterations']} iterations, {r['solver']['starts']} starts, "
+        f"{r['solver']['wall_time_s']:.3f} s"
+    )
+    return "\n".join(lines)
+
+
+def _plan_lines(r: dict[str, Any]) -> list[str]:
+    """The plan in a few lines: strokes, where theta1 and theta4 fall, speeds, peaks, the halves, the window."""
     hd = r["half_durations_s"]
-    lines = [
+    return [
         f"{r['case']}: {r['spm']:.3f} strokes/min, cycle {r['cycle_time_s']:.4f} s "
         f"({r['motion_law']}, {r['placement']} placement, {r['status']})",
         f"  theta1 (closing) in {r['structure']['closing']}, theta4 (opening) in {r['structure']['opening']}",
@@ -246,6 +261,11 @@ def summary_text(result: dict[str, Any]) -> str:
         f"|jerk| <= {r['limits']['crank_jerk_rad_s3']:g} rad/s^3",
         f"  transfer window theta4 -> theta1: {r['transfer_window_s']:.4f} s; "
         f"max |slider accel| {r['max_abs_slider_accel_mm_s2']:.1f} mm/s^2",
+    ]
+
+
+def _key_point_lines(r: dict[str, Any]) -> list[str]:
+    lines = [
         "",
         f"  {'key point':<11} {'angle deg':>9} {'time s':>8} {'height mm':>9} {'slider mm/s':>11} {'crank rpm':>9}",
     ]
@@ -254,15 +274,26 @@ def summary_text(result: dict[str, Any]) -> str:
             f"  {k['name']:<11} {k['angle_deg']:9.2f} {k['time_s']:8.4f} {k['height_mm']:9.1f} "
             f"{k['slider_speed_mm_s']:8.1f} {k['direction']:<2} {k['crank_speed_rpm']:9.3f}"
         )
-    if r.get("stages"):
-        lines += ["", f"  {'stage':<11} {'from deg':>9} {'to deg':>8} {'time s':>9} {'peak rpm':>9}  binding there"]
-        for st in r["stages"]:
-            lines.append(
-                f"  {st['name']:<11} {st['start_angle_deg']:9.2f} {st['end_angle_deg']:8.2f} "
-                f"{st['duration_s']:9.4f} {st['peak_crank_speed_rpm']:9.3f}  {', '.join(st['binding']) or '-'}"
-            )
-        if r["binding_over_cycle"]:
-            lines.append(f"  {'the cycle':<11} {'':>9} {'':>8} {'':>9} {'':>9}  {', '.join(r['binding_over_cycle'])}")
+    return lines
+
+
+def _stage_lines(r: dict[str, Any]) -> list[str]:
+    if not r.get("stages"):
+        return []
+    lines = ["", f"  {'stage':<11} {'from deg':>9} {'to deg':>8} {'time s':>9} {'peak rpm':>9}  binding there"]
+    for st in r["stages"]:
+        lines.append(
+            f"  {st['name']:<11} {st['start_angle_deg']:9.2f} {st['end_angle_deg']:8.2f} "
+            f"{st['duration_s']:9.4f} {st['peak_crank_speed_rpm']:9.3f}  {', '.join(st['binding']) or '-'}"
+        )
+    if r["binding_over_cycle"]:
+        lines.append(f"  {'the cycle':<11} {'':>9} {'':>8} {'':>9} {'':>9}  {', '.join(r['binding_over_cycle'])}")
+    return lines
+
+
+def _drive_lines(r: dict[str, Any]) -> list[str]:
+    """The motor's figures and, with the drive's electrical side, the grid's."""
+    lines = []
     if "drive" in r:
         d = r["drive"]
         lines += [
@@ -294,34 +325,28 @@ def summary_text(result: dict[str, Any]) -> str:
             f"{p['gear_loss_kJ']:.1f}, storage {p['storage_loss_kJ']:.1f}, braking resistor "
             f"{p['resistor_loss_kJ']:.1f} kJ",
         ]
-    if r.get("baseline"):
-        b, saving, d = r["baseline"], r["saving_pct"], r["drive"]
-        lines += [
-            "",
-            f"  objective {r['objective']} at {r['target_spm']:g} strokes/min (the limits allow up to "
-            f"{r['fastest_spm']:.3f}): RMS motor torque {d['rms_motor_torque_Nm'] / 1e3:.2f} kN m, "
-            f"energy from the supply {d['supply_energy_kJ']:.1f} kJ per stroke",
-            f"  baseline (max-SPM plan, spare time in the transfer dwell; window {b['transfer_window_s']:.3f} s): "
-            f"RMS {b['rms_motor_torque_Nm'] / 1e3:.2f} kN m, energy {b['supply_energy_kJ']:.1f} kJ; "
-            f"saving {saving['rms_torque']:.1f} % "
-            f"RMS torque, {saving['energy']:.1f} % energy"
-            + (
-                f", {saving['grid_peak']:.1f} % grid peak "
-                f"({b['grid_peak_kW']:.0f} -> {r['power']['grid_peak_kW']:.0f} kW)"
-                if "grid_peak" in saving
-                else ""
-            )
-            + ("" if r["improved_on_baseline"] else " (no solve beat the baseline: it is the plan)"),
-        ]
-    lines.append("")
-    lines.append("  binding: " + (", ".join(r["binding_constraints"]) or "none"))
-    v = r["verification"]
-    lines.append(
-        f"  verified on {v['samples']} points (step {v['step_s'] * 1e3:.3f} ms): "
-        + ("all checks pass" if v["passed"] else "FAILED")
-    )
-    lines.append(
-        f"  solver: {r['solver']['iterations']} iterations, {r['solver']['starts']} starts, "
-        f"{r['solver']['wall_time_s']:.3f} s"
-    )
-    return "\n".join(lines)
+    return lines
+
+
+def _objective_lines(r: dict[str, Any]) -> list[str]:
+    """At the line's rate: the objective's figures against the baseline's."""
+    if not r.get("baseline"):
+        return []
+    b, saving, d = r["baseline"], r["saving_pct"], r["drive"]
+    return [
+        "",
+        f"  objective {r['objective']} at {r['target_spm']:g} strokes/min (the limits allow up to "
+        f"{r['fastest_spm']:.3f}): RMS motor torque {d['rms_motor_torque_Nm'] / 1e3:.2f} kN m, "
+        f"energy from the supply {d['supply_energy_kJ']:.1f} kJ per stroke",
+        f"  baseline (max-SPM plan, spare time in the transfer dwell; window {b['transfer_window_s']:.3f} s): "
+        f"RMS {b['rms_motor_torque_Nm'] / 1e3:.2f} kN m, energy {b['supply_energy_kJ']:.1f} kJ; "
+        f"saving {saving['rms_torque']:.1f} % "
+        f"RMS torque, {saving['energy']:.1f} % energy"
+        + (
+            f", {saving['grid_peak']:.1f} % grid peak "
+            f"({b['grid_peak_kW']:.0f} -> {r['power']['grid_peak_kW']:.0f} kW)"
+            if "grid_peak" in saving
+            else ""
+        )
+        + ("" if r["improved_on_baseline"] else " (no solve beat the baseline: it is the plan)"),
+    ]

@@ -18,19 +18,21 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from planning.model.case import RPM, Case, PublishedSolution
 from planning.model.laws import improved_scurve as sc
 from planning.model.profile import Profile, Segment
+from planning.tolerances import HALF_ULP_REL, SAME_RELATIVE
 
 
 def half_unit(value: float) -> float:
     """Half a unit of the last printed digit of ``value`` (as written in the case file)."""
     text = repr(float(value))
     if "e" in text or "E" in text:
-        return abs(value) * 5e-16
+        return abs(value) * HALF_ULP_REL
     decimals = len(text.split(".")[1].rstrip("0")) if "." in text else 0
     return 0.5 * 10.0 ** (-decimals)
 
@@ -57,8 +59,8 @@ class Consistency:
     @property
     def consistent(self) -> bool:
         if self.kind == "at least":
-            return self.difference >= -self.allowance - 1e-12
-        return abs(self.difference) <= self.allowance + 1e-12
+            return self.difference >= -self.allowance - SAME_RELATIVE
+        return abs(self.difference) <= self.allowance + SAME_RELATIVE
 
     @property
     def verdict(self) -> str:
@@ -140,132 +142,115 @@ def rebuild_profile(case: Case) -> Profile | None:
     return Profile(tuple(segs), 0.0, w1)
 
 
+def _draw_time(u: dict[str, float]) -> float:
+    return math.radians(u["theta3"] - u["theta2"]) / (u["w2_rpm"] * RPM)
+
+
+class Relation(NamedTuple):
+    """A relation under the paper's Fig. 6: ``name``, the ``printed`` value (a function of the printed
+    numbers; ``printed_key`` the number itself, None when it is a difference), ``unit``, the ``relation``
+    giving it from other printed numbers ``uses``, the ``formula`` in words, and whether it ``needs_w2``
+    (the draw speed)."""
+
+    name: str
+    printed_key: str | None
+    printed: Callable[[dict[str, float]], float]
+    unit: str
+    relation: Callable[[dict[str, float]], float]
+    uses: list[str]
+    formula: str
+    needs_w2: bool = False
+
+
+RELATIONS = (
+    Relation("T9 (draw time)", "T9_s", lambda v: v["T9_s"], "s", _draw_time, ["theta2", "theta3", "w2_rpm"],
+             "(theta3 - theta2) / w2", needs_w2=True),
+    Relation("x2 (feed peak)", "x2_s", lambda v: v["x2_s"], "s", lambda u: u["x1_s"] + 4 * u["T1_s"],
+             ["x1_s", "T1_s"], "x1 + 4 T1"),
+    Relation("x3 (return peak)", "x3_s", lambda v: v["x3_s"], "s",
+             lambda u: u["x2_s"] + 4 * u["T5_s"] + u["T9_s"] + 4 * u["T10_s"], ["x2_s", "T5_s", "T9_s", "T10_s"],
+             "x2 + 4 T5 + T9 + 4 T10 (t2 = x2 + 4 T5, t3 = t2 + T9, x3 = t3 + 4 T10)"),
+    Relation("x4 (end of return)", "x4_s", lambda v: v["x4_s"], "s", lambda u: u["x3_s"] + 4 * u["T14_s"],
+             ["x3_s", "T14_s"], "x3 + 4 T14 (t4 = x3 + 3 T14, x4 = t4 + T14)"),
+    Relation("SPM", "spm", lambda v: v["spm"], "1/min", lambda u: 60.0 / u["x5_s"], ["x5_s"], "60 / x5"),
+    Relation("wm1 - w2 (feed deceleration)", None, lambda v: v["wm1_rpm"] - v["w2_rpm"], "rpm",
+             lambda u: sc.speed_change(u["J_rpm_s2"], u["T5_s"]), ["J_rpm_s2", "T5_s"], "11/3 J T5^2 (Eq. 13)",
+             needs_w2=True),
+    Relation("wm2 - w2 (return acceleration)", None, lambda v: v["wm2_rpm"] - v["w2_rpm"], "rpm",
+             lambda u: sc.speed_change(u["J_rpm_s2"], u["T10_s"]), ["J_rpm_s2", "T10_s"], "11/3 J T10^2 (Eq. 13)",
+             needs_w2=True),
+    Relation("wm2 - w1 (return deceleration)", None, lambda v: v["wm2_rpm"] - transfer_speed_rpm(v), "rpm",
+             lambda u: sc.speed_change(u["J_rpm_s2"], u["T14_s"]), ["J_rpm_s2", "T14_s"],
+             "11/3 J T14^2, with w1 = wm1 - 11/3 J T1^2"),
+)  # fmt: skip
+
+
 def consistency(case: Case) -> list[Consistency]:
     """Every published quantity that other published quantities also determine."""
     if case.published is None or case.published.solution is None:
         return []
     v = _inputs(case)
     out: list[Consistency] = []
-
-    def add(name: str, printed_key: str | None, printed: float, unit: str, f, names: list[str], formula: str):
-        allowance = _propagate(f, v, names) + (half_unit(v[printed_key]) if printed_key else 0.0)
-        out.append(Consistency(name, printed, float(f(v)), unit, allowance, formula))
-
-    def draw_time(u):
-        return math.radians(u["theta3"] - u["theta2"]) / (u["w2_rpm"] * RPM)
-
-    if not math.isnan(v["w2_rpm"]):
-        add(
-            "T9 (draw time)",
-            "T9_s",
-            v["T9_s"],
-            "s",
-            draw_time,
-            ["theta2", "theta3", "w2_rpm"],
-            "(theta3 - theta2) / w2",
-        )
-    add("x2 (feed peak)", "x2_s", v["x2_s"], "s", lambda u: u["x1_s"] + 4 * u["T1_s"], ["x1_s", "T1_s"], "x1 + 4 T1")
-    add(
-        "x3 (return peak)",
-        "x3_s",
-        v["x3_s"],
-        "s",
-        lambda u: u["x2_s"] + 4 * u["T5_s"] + u["T9_s"] + 4 * u["T10_s"],
-        ["x2_s", "T5_s", "T9_s", "T10_s"],
-        "x2 + 4 T5 + T9 + 4 T10 (t2 = x2 + 4 T5, t3 = t2 + T9, x3 = t3 + 4 T10)",
-    )
-    add(
-        "x4 (end of return)",
-        "x4_s",
-        v["x4_s"],
-        "s",
-        lambda u: u["x3_s"] + 4 * u["T14_s"],
-        ["x3_s", "T14_s"],
-        "x3 + 4 T14 (t4 = x3 + 3 T14, x4 = t4 + T14)",
-    )
-    if "spm" in v:
-        add("SPM", "spm", v["spm"], "1/min", lambda u: 60.0 / u["x5_s"], ["x5_s"], "60 / x5")
-    if not math.isnan(v["w2_rpm"]):
-        add(
-            "wm1 - w2 (feed deceleration)",
-            None,
-            v["wm1_rpm"] - v["w2_rpm"],
-            "rpm",
-            lambda u: sc.speed_change(u["J_rpm_s2"], u["T5_s"]),
-            ["J_rpm_s2", "T5_s"],
-            "11/3 J T5^2 (Eq. 13)",
-        )
-        add(
-            "wm2 - w2 (return acceleration)",
-            None,
-            v["wm2_rpm"] - v["w2_rpm"],
-            "rpm",
-            lambda u: sc.speed_change(u["J_rpm_s2"], u["T10_s"]),
-            ["J_rpm_s2", "T10_s"],
-            "11/3 J T10^2 (Eq. 13)",
-        )
-    add(
-        "wm2 - w1 (return deceleration)",
-        None,
-        v["wm2_rpm"] - transfer_speed_rpm(v),
-        "rpm",
-        lambda u: sc.speed_change(u["J_rpm_s2"], u["T14_s"]),
-        ["J_rpm_s2", "T14_s"],
-        "11/3 J T14^2, with w1 = wm1 - 11/3 J T1^2",
-    )
+    for r in RELATIONS:
+        if (r.needs_w2 and math.isnan(v["w2_rpm"])) or (r.printed_key == "spm" and "spm" not in v):
+            continue
+        allowance = _propagate(r.relation, v, r.uses) + (half_unit(v[r.printed_key]) if r.printed_key else 0.0)
+        out.append(Consistency(r.name, r.printed(v), float(r.relation(v)), r.unit, allowance, r.formula))
     prof = rebuild_profile(case)
     if prof is not None:
-        end = prof.at_time(np.array([prof.duration]))[0][0]
-        add_angle = Consistency(
+        out += _rebuilt_checks(case, v, prof)
+    return out
+
+
+def _rebuilt_checks(case: Case, v: dict[str, float], prof: Profile) -> list[Consistency]:
+    """The rebuilt profile against the published angles and transfer time."""
+    allowance = _angle_allowance(case)
+
+    def angle_at(t: float) -> float:
+        return math.degrees(float(prof.at_time(np.array([t]))[0][0]))
+
+    t1 = v["x1_s"] + v["T1_s"]
+    t2 = v["x2_s"] + 4 * v["T5_s"]
+    t4 = v["x3_s"] + 3 * v["T14_s"]
+    return [
+        Consistency(
             "angle swept by the rebuilt profile",
             360.0,
-            float(math.degrees(end)),
+            angle_at(prof.duration),
             "deg",
-            _angle_allowance(case),
+            allowance,
             "integral of the rebuilt crank speed over x5",
-        )
-        out.append(add_angle)
-        t1 = v["x1_s"] + v["T1_s"]
-        th1 = math.degrees(float(prof.at_time(np.array([t1]))[0][0]))
-        out.append(
-            Consistency(
-                "theta1 at t1 = x1 + T1",
-                v["theta1"],
-                th1,
-                "deg",
-                _angle_allowance(case),
-                "rebuilt profile at the published closing time",
-            )
-        )
-        t2 = v["x2_s"] + 4 * v["T5_s"]
-        th2 = math.degrees(float(prof.at_time(np.array([t2]))[0][0]))
-        out.append(
-            Consistency(
-                "theta2 at t2 = x2 + 4 T5",
-                v["theta2"],
-                th2,
-                "deg",
-                _angle_allowance(case),
-                "rebuilt profile at the published draw start",
-            )
-        )
-        t4 = v["x3_s"] + 3 * v["T14_s"]
-        out.append(
-            Consistency(
-                "transfer time theta4 -> theta1",
-                v["T0_s"],
-                v["x5_s"] - t4 + t1,
-                "s",
-                _propagate(
-                    lambda u: u["x5_s"] - u["x3_s"] - 3 * u["T14_s"] + u["x1_s"] + u["T1_s"],
-                    v,
-                    ["x5_s", "x3_s", "T14_s", "x1_s", "T1_s"],
-                ),
-                "x5 - (x3 + 3 T14) + (x1 + T1), at least T0",
-                kind="at least",
-            )
-        )
-    return out
+        ),
+        Consistency(
+            "theta1 at t1 = x1 + T1",
+            v["theta1"],
+            angle_at(t1),
+            "deg",
+            allowance,
+            "rebuilt profile at the published closing time",
+        ),
+        Consistency(
+            "theta2 at t2 = x2 + 4 T5",
+            v["theta2"],
+            angle_at(t2),
+            "deg",
+            allowance,
+            "rebuilt profile at the published draw start",
+        ),
+        Consistency(
+            "transfer time theta4 -> theta1",
+            v["T0_s"],
+            v["x5_s"] - t4 + t1,
+            "s",
+            _propagate(
+                lambda u: u["x5_s"] - u["x3_s"] - 3 * u["T14_s"] + u["x1_s"] + u["T1_s"],
+                v,
+                ["x5_s", "x3_s", "T14_s", "x1_s", "T1_s"],
+            ),
+            "x5 - (x3 + 3 T14) + (x1 + T1), at least T0",
+            kind="at least",
+        ),
+    ]
 
 
 def _angle_allowance(case: Case) -> float:

@@ -3,12 +3,11 @@ how long it takes, its peak crank speed, and which limits bind in it.
 
 A stage is the run of the law's segments with one stage name (``feed:accel1`` ... ``feed:decel4`` is the
 feed); a run through TDC (the return's end and its start in the next cycle) is one stage, its end angle
-past 360 deg. Which limits bind where is read off the dense samples (``trajectory.csv``'s columns) with
-the limits' own lines (``planning.reports.limit_lines``): a limit the verification finds binding
-(``Check.binds``) is placed in the stage where the curve comes closest to its line, and in any other
-stage that comes as close within :data:`BINDING_SHARE`; the motor's peak torque likewise against its
-envelope at the motor's speed. A binding limit with no curve to place it on (the robot's transfer time,
-the RMS torque, a limit of the whole cycle) is listed apart, as binding over the cycle.
+past 360 deg. Which limits bind where is what the verification recorded: a check that binds
+(``Check.binds``) is placed in every stage where its quantity came within ``BINDING_SHARE`` of its
+extreme (``Check.peak``, on the dense samples); a binding check with no place on the cycle (the robot's
+transfer time, the RMS torque, the motor's top speed, a figure of the whole cycle) is listed apart, as
+binding over the cycle.
 """
 
 from __future__ import annotations
@@ -17,12 +16,10 @@ from typing import Any
 
 import numpy as np
 
-from planning.model.limits.base import BINDING_SHARE
 from planning.model.units import RPM
-from planning.reports.limit_lines import limit_lines
-from press.dynamics import envelope_torque
+from planning.solver.verify import Evaluation
+from planning.tolerances import KNOT_TIME_S
 
-PEAK_TORQUE_FIELD = "drive.motor.peak_torque_Nm"
 STAGE_ORDER = ("transfer", "feed", "draw", "return")  # the table starts with the transfer
 
 
@@ -53,31 +50,28 @@ def stage_runs(segments: list[dict[str, Any]]) -> list[dict[str, Any]]:
     return runs[start:] + runs[:start]
 
 
-def stage_table(result: dict[str, Any], columns: dict[str, np.ndarray]) -> dict[str, Any]:
-    """``{"stages": [...], "binding_over_cycle": [...]}`` for ``result.json``: each stage of
-    :func:`stage_runs` with ``peak_crank_speed_rpm`` and ``binding`` (case fields), from the dense
-    ``columns``; the binding limits placed on no stage by case field."""
-    angle = np.asarray(columns["crank_angle_deg"], dtype=float)
-    speed = np.asarray(columns["crank_speed_rpm"], dtype=float)
-    runs = stage_runs(result["segments"])
-    masks = [_in_arc(angle, r["start_angle_deg"], r["end_angle_deg"]) for r in runs]
-    inner = [_inside(m) for m in masks]  # a curve continuous across a boundary binds where it stays, not there
-    closeness = _closeness(result, columns)  # field -> per sample: 1 on the limit's line, lower away from it
+def stage_table(segments: list[dict[str, Any]], evaluation: Evaluation, rows: np.ndarray) -> dict[str, Any]:
+    """``{"stages": [...], "binding_over_cycle": [...]}`` for ``result.json``: each stage of :func:`stage_runs`
+    (``segments`` as ``result.json`` writes them) with ``peak_crank_speed_rpm`` (on the evaluation's samples
+    ``rows``) and ``binding`` (case fields: the binding checks that peaked in the stage); the binding checks
+    of the whole cycle (no place on it) by case field."""
+    dense = evaluation.samples
+    angle = np.degrees(dense.theta[rows])
+    speed = dense.omega[rows] / RPM
+    runs = stage_runs(segments)
+    step = evaluation.verification.step_s
     placed: dict[int, list[str]] = {k: [] for k in range(len(runs))}
-    over_cycle = []
-    for name in _binding_fields(result):
-        near = closeness.get(name)
-        if near is None:
-            over_cycle.append(name)
+    over_cycle: list[str] = []
+    for field, check in _binding(evaluation):
+        if check.peak is None:
+            over_cycle.append(field)
             continue
-        point = np.count_nonzero(np.isfinite(near)) == 1  # a limit at one crank angle: its stage
-        best = [_nanmax(near[m if point else i]) for m, i in zip(masks, inner, strict=True)]
-        top = max(best)
-        for k, value in enumerate(best):
-            if value >= top - BINDING_SHARE:
-                placed[k].append(name)
+        for k, run in enumerate(runs):
+            if field not in placed[k] and _peaks_in(check.peak.spans, run, dense.plan.period, step):
+                placed[k].append(field)
     stages = []
-    for k, (run, mask) in enumerate(zip(runs, masks, strict=True)):
+    for k, run in enumerate(runs):
+        mask = _in_arc(angle, run["start_angle_deg"], run["end_angle_deg"])
         if not mask.any():  # a stage shorter than a step: the sample nearest its start
             distance = np.abs((angle - run["start_angle_deg"] + 180.0) % 360.0 - 180.0)
             mask = distance == np.min(distance)
@@ -92,57 +86,32 @@ def _in_arc(angle: np.ndarray, start: float, end: float) -> np.ndarray:
     return (angle - start) % 360.0 < (end - start)
 
 
-def _inside(mask: np.ndarray) -> np.ndarray:
-    """``mask`` without its first and last sample of each run (a stage's ends, shared with its neighbours)."""
-    edges = mask & ~(np.roll(mask, 1) & np.roll(mask, -1))
-    return mask & ~edges
+def _peaks_in(spans: tuple[tuple[float, float], ...], run: dict[str, Any], period: float, step: float) -> bool:
+    """Whether a check that peaks over ``spans`` [s from TDC] peaks in the stage ``run``: a span of samples
+    lies in the stage or reaches more than a sampling ``step`` [s] into it (a curve continuous across a
+    boundary binds where it stays, not in the first sample past it); a single instant (a limit at one crank
+    angle, a sharp peak) belongs to the stage it lies in, a boundary to the stage it begins."""
+    start = run["start_time_s"]
+    end = start + run["duration_s"]
+    for a, b in spans:
+        for shift in (0.0, period):  # a stage through TDC ends past the period
+            a_, b_ = a + shift, b + shift
+            if a_ == b_ or (a_ >= start and b_ <= end):
+                if start - KNOT_TIME_S <= a_ < end - KNOT_TIME_S:
+                    return True
+            elif min(b_, end) - max(a_, start) > step:
+                return True
+    return False
 
 
-def _nanmax(values: np.ndarray) -> float:
-    finite = values[np.isfinite(values)]
-    return float(np.max(finite)) if finite.size else -np.inf
-
-
-def _binding_fields(result: dict[str, Any]) -> list[str]:
-    """The case fields of the checks that bind (``result.json``'s verification), in its order; the storage
-    schedule's bounds apart (``planning.solver.verify.SCHEDULE_CHECKS``)."""
+def _binding(evaluation: Evaluation) -> list[tuple[str, Any]]:
+    """The checks that bind, with their case fields, in the verification's order; a field once (its first
+    check); the storage schedule's bounds apart (``planning.solver.verify.SCHEDULE_CHECKS``)."""
     from planning.solver.verify import SCHEDULE_CHECKS, field_of_check
 
-    fields = []
-    for check in result["verification"]["checks"]:
-        if check["kind"] == "equal" or check["margin"] > BINDING_SHARE * max(abs(check["limit"]), 1e-12):
+    out: dict[str, Any] = {}
+    for check in evaluation.verification.checks:
+        if not check.binds or check.id in SCHEDULE_CHECKS:
             continue
-        if check["id"] in SCHEDULE_CHECKS:
-            continue
-        name = field_of_check(check["id"]) or check["name"]
-        if name not in fields:
-            fields.append(name)
-    return fields
-
-
-def _closeness(result: dict[str, Any], columns: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-    """Per case field with a curve: ``1 - |distance to the limit's line| / |limit|`` at each sample (NaN
-    where it does not apply); the lines on the slide's height (where the key points and the die zone
-    begin, not limits a curve presses on) left out."""
-    n = len(columns["crank_angle_deg"])
-    out: dict[str, np.ndarray] = {}
-    for line in limit_lines(result, columns, "angle"):
-        if line.quantity == "slider_height_mm":
-            continue
-        q = np.asarray(columns[line.quantity], dtype=float)
-        if line.point:
-            near = np.full(n, np.nan)
-            k = min(int(np.searchsorted(columns["crank_angle_deg"], line.x[0])), n - 1)  # first at or after
-            near[k] = 1.0 - abs(abs(q[k]) - abs(line.upper[0])) / abs(line.upper[0])
-        else:
-            lines = [line.upper] + ([line.lower] if line.lower is not None else [])
-            with np.errstate(invalid="ignore"):
-                near = np.fmax.reduce([1.0 - np.abs(q - y) / np.abs(y) for y in lines])
-        out[line.field] = near
-    drive = result.get("drive")
-    if drive is not None and "motor_torque_Nm" in columns:
-        motor = drive["motor"]
-        n_motor = np.asarray(columns["motor_speed_rpm"], dtype=float) * RPM
-        envelope = envelope_torque(n_motor, motor["peak_torque_Nm"], motor["base_speed_rpm"] * RPM)
-        out[PEAK_TORQUE_FIELD] = np.abs(np.asarray(columns["motor_torque_Nm"], dtype=float)) / envelope
-    return out
+        out.setdefault(field_of_check(check.id) or check.name, check)
+    return list(out.items())

@@ -46,6 +46,7 @@ from planning.model.limits.base import BoundGrid
 from planning.solver.ipopt import NLPSolver
 from planning.solver.outcomes import Infeasible, NoPlanFound
 from planning.solver.precheck import precheck
+from planning.tolerances import SAME_ANGLE_RAD, SAME_NODE_RAD
 
 DEFAULT_POINTS = 1440
 BOUND_OPTIONS = {"ipopt.max_iter": 3000}  # added to the wrapper's base options
@@ -95,7 +96,7 @@ def angle_grid(case: Case, points: int, extra: tuple[float, ...] = ()) -> np.nda
     if 0 < die < case.machine.stroke:
         breaks |= {float(a) for a in case.machine.angles_at_height(die)}
     inside = sorted(a + two_pi if a <= th1 else a for a in breaks)
-    inside = [a for a in inside if th1 + 1e-9 < a < th1 + two_pi - 1e-9]
+    inside = [a for a in inside if th1 + SAME_NODE_RAD < a < th1 + two_pi - SAME_NODE_RAD]
     arcs = [th1, *sorted(set(inside)), th1 + two_pi]
     spans = np.diff(arcs)
     nodes = [np.array([th1])]
@@ -141,8 +142,8 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
     th1, th2, th3, th4 = case.key_angles
     limits = limits_of(case)
 
-    draw = np.flatnonzero((th[:-1] >= th2 - 1e-12) & (th[:-1] <= th3 + 1e-12))
-    window = th[:-1] >= th4 - 1e-12  # the grid starts at theta1: the robot window is [theta4, theta1 + 2 pi)
+    draw = np.flatnonzero((th[:-1] >= th2 - SAME_ANGLE_RAD) & (th[:-1] <= th3 + SAME_ANGLE_RAD))
+    window = th[:-1] >= th4 - SAME_ANGLE_RAD  # the grid starts at theta1: the robot window is [theta4, theta1 + 2 pi)
     grid = BoundGrid(case, th, h, d1, d2, dth, window)
     lbx_s, ubx_s = node_speed_bounds(grid, limits, draw, w2_lo, w2_hi)
     # scales: each node's speed^2 near the speed the slider-acceleration limit allows at constant speed,

@@ -32,13 +32,13 @@ from planning.solver.optimal import on_layout, solve_optimal
 from planning.solver.outcomes import NoPlanFound, PlanningError
 from planning.solver.solution import Solution
 from planning.solver.upper_bound import UpperBound, upper_bound
-from planning.solver.verify import assess
+from planning.solver.verify import evaluate
+from planning.tolerances import CROSSED_PCT
 
 BRACKET_TOL_PCT = 0.05  # [%] the gap the bracket refines down to by default
 UPPER_GRIDS = (1440, 2880, 5760)  # intervals of the upper bound's grid, coarse to fine (one piece each)
 LAYOUT_FACTORS = (6.0, 15.0)  # the verified motion's refinements: this many times the first layout's segments
 STALL_SHARE = 0.1  # a refinement that closes less than this share of the gap ends that side's refinements
-CROSSED_PCT = 1e-4  # [%] a verified motion this far above the upper bound is within the verification's tolerance
 JERK_ALLOWANCE = 2000.0  # x the press's characteristic jerk: the verified motion's jerk without a case limit
 
 
@@ -155,9 +155,10 @@ def bracket(case: Case, tolerance_pct: float = BRACKET_TOL_PCT) -> Bracket:
 def _checked(case: Case, solution: Solution, previous: Solution | None = None) -> Solution:
     """``solution`` verified against ``case``'s own limits (it was planned under the jerk allowance too),
     or ``previous`` when it does not pass."""
-    verification, drive = assess(solution.plan, case)
+    evaluation = evaluate(solution.plan, case)
+    verification = evaluation.verification
     if verification.passed:
-        return Solution(solution.plan, verification, drive)
+        return Solution(solution.plan, evaluation)
     if previous is not None:
         return previous
     raise NoPlanFound(

@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 from functools import cache, partial
+from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -44,6 +45,7 @@ from planning.solver.nlp import (
     sample_states,
 )
 from planning.solver.parameters import DRAW_SAMPLES_DRIVE, ParameterLayout, drive_links, time_limit
+from planning.tolerances import IPOPT_FREE_WARM_MU_INIT
 from press.mechanism import Formula
 
 # the limits are held at every knot and at evenly spaced points inside each segment, this many per
@@ -54,7 +56,7 @@ STATES = ("angle", "speed", "accel")
 TOP_SPEED = 1e3  # [rad/s] upper bound of the crank speeds (far above any press)
 # a re-solve with a refined limit starts nearer the optimum than the laws' (about half the iterations
 # with this barrier parameter; the laws keep the wrapper's, which finds their optima as before)
-WARM_OPTIONS = {"ipopt.mu_init": 1e-8}
+WARM_OPTIONS = {"ipopt.mu_init": IPOPT_FREE_WARM_MU_INIT}
 
 
 @cache
@@ -150,26 +152,13 @@ def make_plan(
     return replace(plan, structure=structure, nlp_values=dict(values))
 
 
-def _build(
-    formula: Formula, limit_ids: tuple[str, ...], drive: bool, links: tuple[str, ...] = (), phases: Layout = PHASES
-) -> CycleNLP:
-    # MX with vector operations (every segment of a phase at once): CasADi derives the Jacobian and the
-    # Hessian of this graph in a fraction of the time a scalar SX graph of the same problem takes, and
-    # evaluates them about as fast
-    layout = ParameterLayout(formula, limit_ids, drive, False, links if drive else ())
-    variables, index = variables_of(phases), index_of(phases)
-    x = ca.MX.sym("x", len(variables))
-    p_case = ca.MX.sym("p", layout.size)
-    p_scale = ca.MX.sym("scale", len(variables))
-    physical = x * p_scale
-    v = {name: physical[i] for name, i in index.items()}
-    unit = {name: p_scale[i] for name, i in index.items()}
-    q = layout.symbols(p_case)
-    w2 = v["draw_speed"]
-
-    rows = Rows()
+def _shooting(phases: Layout, physical: ca.MX, v: dict, unit: dict, q: dict, index: dict) -> dict[str, Any]:
+    """Multiple shooting over the phases from theta3 (each phase's segments at once, MX vectors): the rows
+    joining the segments in closed form and meeting each phase's end angle, the samples (every knot and
+    points inside each segment, in time order) and their times, the knot accelerations, the die-height
+    crossings in closed form (clip), the last state and the time at the feed's end."""
     ends = {"return": q["theta4"], "transfer": q["theta1"] + 2 * np.pi, "feed": q["theta2"] + 2 * np.pi}
-    start = (q["theta3"], w2, ca.MX(0.0))
+    start = (q["theta3"], v["draw_speed"], ca.MX(0.0))
     t0 = ca.MX(0.0)
     shooting, boundary, samples, times, knot_accels = [], [], [], [], []
     crossings = {}
@@ -200,40 +189,83 @@ def _build(
         knot_accels.append(ca.vertcat(al0, end[2]))
         t0 = t0 + n * h
         start = end
-    rows.add("segments join (closed form)", ca.vertcat(*shooting), 0.0, 0.0, "planner.motion_law")
-    rows.add("key angles", ca.vertcat(*boundary[:2]), 0.0, 0.0, "key_points")
-    closes = ca.vertcat(boundary[2], (start[1] - w2) / unit["draw_speed"], start[2] / unit["feed_accel_1"])
+    return {
+        "shooting": shooting,
+        "boundary": boundary,
+        "samples": samples,
+        "times": times,
+        "knot_accels": knot_accels,
+        "crossings": crossings,
+        "end": start,
+        "t_end": t0,
+    }
+
+
+def _structure_rows(rows: Rows, s: dict[str, Any], v: dict, unit: dict, q: dict) -> tuple[ca.MX, ca.MX]:
+    """The segments joined, the key angles met, the cycle closed, the key points in order, the die-height
+    crossings at their angles; the crossings' speeds (rising, falling)."""
+    w2, start = v["draw_speed"], s["end"]
+    rows.add("segments join (closed form)", ca.vertcat(*s["shooting"]), 0.0, 0.0, "planner.motion_law")
+    rows.add("key angles", ca.vertcat(*s["boundary"][:2]), 0.0, 0.0, "key_points")
+    closes = ca.vertcat(s["boundary"][2], (start[1] - w2) / unit["draw_speed"], start[2] / unit["feed_accel_1"])
     rows.add("cycle closes", closes, 0.0, 0.0, "key_points")
-    (thu, omu), t_up, span_up = crossings["return"]
-    (thd, omd), t_down, span_down = crossings["feed"]
+    (thu, omu), t_up, span_up = s["crossings"]["return"]
+    (thd, omd), t_down, span_down = s["crossings"]["feed"]
     rows.add("key points in order", ca.vertcat(span_up - t_up, span_down - t_down), 0.0, np.inf, "key_points")
     crossing = ca.vertcat(
         q["die_up_active"] * (thu - q["die_up_angle"]),
         q["die_down_active"] * (thd - (q["die_down_angle"] + 2 * np.pi)),
     )
     rows.add("die crossing angles", crossing, 0.0, 0.0, "limits.die_height_mm")
+    return omu, omd
 
-    # the free profile's samples, then, with a drive, the draw's (the forming force is given at them; every
-    # limit holds in the draw by the draw speed's bounds)
-    th = ca.vertcat(*[sm[0] for sm in samples])
-    om = ca.vertcat(*[sm[1] for sm in samples])
-    al = ca.vertcat(*[sm[2] for sm in samples])
-    draw_time = (q["theta3"] - q["theta2"]) / w2
-    states, t_all, count = (th, om, al), ca.vertcat(*times), 0
+
+def _all_samples(s: dict[str, Any], q: dict, w2: ca.MX, drive: bool) -> tuple[tuple, ca.MX, int, ca.MX]:
+    """The free profile's samples, then, with a drive, the draw's (the forming force is given at them; every
+    limit holds in the draw by the draw speed's bounds): the states, their times, the draw's count, and the
+    free profile's speeds alone."""
+    th = ca.vertcat(*[sm[0] for sm in s["samples"]])
+    om = ca.vertcat(*[sm[1] for sm in s["samples"]])
+    al = ca.vertcat(*[sm[2] for sm in s["samples"]])
+    states, t_all, count = (th, om, al), ca.vertcat(*s["times"]), 0
     if drive:
         count = DRAW_SAMPLES_DRIVE + 1
         th_d, om_d, al_d, since = draw_states(q, w2, ca.DM(np.linspace(0.0, 1.0, count)))
         states = (ca.vertcat(th, th_d), ca.vertcat(om, om_d), ca.vertcat(al, al_d))
-        t_all = ca.vertcat(t_all, t0 + since)
+        t_all = ca.vertcat(t_all, s["t_end"] + since)
+    return states, t_all, count, om
+
+
+def _build(
+    formula: Formula, limit_ids: tuple[str, ...], drive: bool, links: tuple[str, ...] = (), phases: Layout = PHASES
+) -> CycleNLP:
+    # MX with vector operations (every segment of a phase at once): CasADi derives the Jacobian and the
+    # Hessian of this graph in a fraction of the time a scalar SX graph of the same problem takes, and
+    # evaluates them about as fast
+    layout = ParameterLayout(formula, limit_ids, drive, False, links if drive else ())
+    variables, index = variables_of(phases), index_of(phases)
+    x = ca.MX.sym("x", len(variables))
+    p_case = ca.MX.sym("p", layout.size)
+    p_scale = ca.MX.sym("scale", len(variables))
+    physical = x * p_scale
+    v = {name: physical[i] for name, i in index.items()}
+    unit = {name: p_scale[i] for name, i in index.items()}
+    q = layout.symbols(p_case)
+    w2 = v["draw_speed"]
+    rows = Rows()
+    shot = _shooting(phases, physical, v, unit, q, index)
+    omu, omd = _structure_rows(rows, shot, v, unit, q)
+    states, t_all, count, speeds = _all_samples(shot, q, w2, drive)
+    draw_time = (q["theta3"] - q["theta2"]) / w2
     samples, _, lift = sample_states(formula, layout, q, p_case, states, t_all, count)
     nlp = Transcription(
         **samples,
-        period=t0 + draw_time,
+        period=shot["t_end"] + draw_time,
         window_time=phases[1][1] * v["transfer_step"],
-        speeds=Extremes(om, signed=False, sampled=True),
-        accelerations=Extremes(ca.vertcat(*knot_accels), signed=True),
+        speeds=Extremes(speeds, signed=False, sampled=True),
+        accelerations=Extremes(ca.vertcat(*shot["knot_accels"]), signed=True),
         jerks=None,  # the bounds of the segments' jerks
-        lowest_speeds=om,
+        lowest_speeds=speeds,
         crossings=[(omu, q["die_up_slope"]), (omd, q["die_down_slope"])],
         zone=True,
         rate=False,

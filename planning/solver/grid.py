@@ -36,6 +36,7 @@ import numpy as np
 from planning.model.case import Case
 from planning.model.drive import PowerFigures, quadrature
 from planning.model.profile import Profile
+from planning.tolerances import PEAK_BISECTION_TOL, PEAK_FALLBACK_SLACK, PEAK_SLACK
 from press.dynamics import drive_state
 from press.power import chain as bus_chain
 from press.power import (
@@ -48,9 +49,6 @@ from press.power import (
 SHAVING_STEP_S = 5e-3  # [s] the peak-shaving intervals are at most this long ...
 SHAVING_MIN_INTERVALS = 400  # ... and at least this many ...
 SHAVING_MAX_INTERVALS = 4000  # ... and at most this many per cycle
-PEAK_SLACK = 1e-9  # relative: the second programme keeps the grid peak within this share of the first's
-PEAK_FALLBACK_SLACK = 1e-7  # relative: the room the second programme gets when HiGHS finds the first too tight
-PEAK_BISECTION_TOL = 1e-12  # relative: least_peak's bisection stops this close to the least peak
 CAP_BISECTIONS = 30  # steps of bus_cap_for_limit: the cap to 1e-9 of the bus peak's overshoot
 FLAT_SHARE = 0.05  # storage_to_flatten: the grid's peak within this share of the mean bus power
 SCALE_W = 1e3  # the programmes in kW and kJ (HiGHS's tolerances are absolute)

@@ -39,7 +39,7 @@ the die zone at every sample (a plan at a target rate may peak in speed there) a
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from functools import cache, partial
 
 import casadi as ca
@@ -180,6 +180,148 @@ def _angle_at(t: ca.SX, starts: list, states: list, segs: list[Segment]) -> tupl
     return theta, omega
 
 
+@dataclass
+class _Cycle:
+    """The symbols of one halves NLP: variables ``x`` (scaled), the case's parameters ``p_case`` and the
+    variables' scales ``p_scale``; the physical variables ``v`` and their ``unit`` (scale) by name; the
+    case's numbers ``q`` by name; the law's cycle (``params``, its segments from theta3, their knot
+    ``states`` and start times ``starts``; ``before``: the segments from theta3 to theta2, all but the
+    draw, with their starts and states)."""
+
+    x: ca.SX
+    p_case: ca.SX
+    p_scale: ca.SX
+    v: dict[str, ca.SX]
+    unit: dict[str, ca.SX]
+    q: dict[str, ca.SX]
+    params: CycleParameters
+    segs: list[Segment]
+    states: list
+    starts: list
+    n_before: int
+
+    @property
+    def before(self) -> tuple[list, list, list[Segment]]:
+        n = self.n_before
+        return self.starts[:n], self.states[:n], self.segs[:n]
+
+
+def _cycle(law_name: str, layout: ParameterLayout, variables: tuple) -> _Cycle:
+    """The NLP's symbols and the law's cycle laid out from theta3 (:class:`_Cycle`)."""
+    x = ca.SX.sym("x", len(variables))
+    p_case = ca.SX.sym("p", layout.size)
+    p_scale = ca.SX.sym("scale", len(variables))  # physical value = scale * x, chosen per case
+    v = {name: x[i] * p_scale[i] for i, (name, _) in enumerate(VARIABLES)}
+    unit = {name: p_scale[i] for i, (name, _) in enumerate(VARIABLES)}
+    q = layout.symbols(p_case)
+    fields = [f for f in CycleParameters.__dataclass_fields__ if f in v]
+    params = CycleParameters(
+        **{f: v[f] for f in fields}, draw_start=q["theta2"], draw_end=q["theta3"], motion_law=law_name
+    )
+    segs = cycle_segments(params)
+    states = knot_states(q["theta3"], params.draw_speed, 0.0, segs)
+    starts = [0.0]
+    for seg in segs[:-1]:
+        starts.append(starts[-1] + seg.duration)
+    return _Cycle(x, p_case, p_scale, v, unit, q, params, segs, states, starts, len(segs) - 1)
+
+
+def _shape_rows(rows: Rows, c: _Cycle, law) -> None:  # noqa: ANN001 - a Law
+    """The halves monotone (the peaks above the speeds they join), one jerk per S-curve where the law says
+    so (Eq. 14), the cycle closed at 2 pi."""
+    p, unit = c.params, c.unit
+    w1, w2 = p.transfer_speed, p.draw_speed
+    wm1, wm2 = p.feed_peak_speed, p.return_peak_speed
+    peaks = ca.vertcat(wm1 - w1, wm1 - w2, wm2 - w2, wm2 - w1) / unit["draw_speed"]
+    rows.add("peak speeds above their ends", peaks, 0, np.inf, "planner.motion_law")
+    if law.one_jerk_per_curve:  # Eq. 14: one jerk J for both halves of each S-curve
+        d_fa, d_fd = p.feed_accel_duration, p.feed_decel_duration
+        d_ra, d_rd = p.return_accel_duration, p.return_decel_duration
+        t2 = unit["feed_accel_duration"] ** 2 * unit["draw_speed"]
+        one_jerk = ca.vertcat((wm1 - w1) * d_fd**2 - (wm1 - w2) * d_fa**2, (wm2 - w2) * d_rd**2 - (wm2 - w1) * d_ra**2)
+        rows.add("one jerk per S-curve (Eq. 14)", one_jerk / t2, 0.0, 0.0, "planner.motion_law")
+    # the cycle closes: theta at the draw start is theta2 + 2 pi
+    rows.add("cycle closes", c.states[c.n_before][0] - (c.q["theta2"] + 2 * np.pi), 0.0, 0.0, "key_points")
+
+
+def _key_point_rows(rows: Rows, c: _Cycle) -> tuple[int, tuple[ca.SX, ca.SX]]:
+    """The key angles met in order, the published placement's rows (bounds switched per solve), the
+    die-height crossings at their angles; the published rows' place and the crossings' speeds."""
+    v, q, params = c.v, c.q, c.params
+    t4, t1 = v["opening_time"], v["closing_time"]
+    th4, _ = _angle_at(t4, *c.before)
+    th1, _ = _angle_at(t1, *c.before)
+    rows.add("key angles", ca.vertcat(th4 - q["theta4"], th1 - (q["theta1"] + 2 * np.pi)), 0.0, 0.0, "key_points")
+    t_end = c.starts[c.n_before]
+    order = ca.vertcat(t4, t1 - t4, t_end - t1, t_end - v["die_down_time"], t_end - v["die_up_time"])
+    rows.add("key points in order", order, 0.0, np.inf, "key_points")
+    # published structure (Fig. 6): theta4 at x3 + 3 T14 (three quarters into the return deceleration),
+    # theta1 at x1 + T1 (a quarter into the feed acceleration); bounds switched per solve
+    rd_start = params.return_accel_duration
+    fa_start = rd_start + params.return_decel_duration + params.transfer_dwell
+    published = ca.vertcat(
+        t4 - (rd_start + 0.75 * params.return_decel_duration),
+        t1 - (fa_start + 0.25 * params.feed_accel_duration),
+    )
+    published_rows = rows.add("key angles (published placement)", published, -np.inf, np.inf, "planner.placement")
+    # the die-height crossings outside the draw (a crossing inside it: its row switched off, its time fixed)
+    thd, omd = _angle_at(v["die_down_time"], *c.before)
+    thu, omu = _angle_at(v["die_up_time"], *c.before)
+    crossing = ca.vertcat(
+        q["die_down_active"] * (thd - (q["die_down_angle"] + 2 * np.pi)),
+        q["die_up_active"] * (thu - q["die_up_angle"]),
+    )
+    rows.add("die crossing angles", crossing, 0.0, 0.0, "limits.die_height_mm")
+    return published_rows, (omd, omu)
+
+
+def _sampled(c: _Cycle, law, drive: bool) -> tuple[tuple[ca.SX, ca.SX, ca.SX], ca.SX, int]:  # noqa: ANN001
+    """The states at sample points of every segment, one vector per quantity, and their times; the draw's
+    samples last (``drive`` only: otherwise every limit holds in the draw by the draw speed's bounds)."""
+    th_s, om_s, al_s, t_s = [], [], [], []
+    draw_count = 0
+    for seg, st, t0 in zip(c.segs, c.states[:-1], c.starts, strict=True):
+        draw = seg.name == "draw:constant"
+        if draw and not drive:
+            continue  # every limit holds in the draw by the draw speed's bounds
+        count = DRAW_SAMPLES_DRIVE if draw else SAMPLES_CONSTANT if seg.name == "transfer:dwell" else law.samples
+        fractions = np.linspace(0.0, 1.0, count + 1)
+        if not draw:
+            fractions = fractions[:-1]  # the end is the next segment's start
+        else:
+            draw_count = fractions.size
+        if draw:  # sparse rows (see the module docstring)
+            th, om, al, since = draw_states(c.q, c.params.draw_speed, ca.DM(fractions))
+            t_s.append(t0 + since)
+        else:
+            th, om, al, _ = advance_segment(seg, *st, ca.DM(fractions) * seg.duration)
+            t_s.append(t0 + ca.DM(fractions) * seg.duration)
+        th_s.append(th)
+        om_s.append(om)
+        al_s.append(al)
+    return (ca.vertcat(*th_s), ca.vertcat(*om_s), ca.vertcat(*al_s)), ca.vertcat(*t_s), draw_count
+
+
+def _objective(
+    rows: Rows, c: _Cycle, torque: ca.SX, states: tuple, times: ca.SX, kind: tuple[bool, bool, bool]
+) -> ca.SX:
+    """The cycle time; at a rate the objectives' weighted terms; with ``peak`` the grid peak's epigraph.
+    ``kind``: ``(rate, peak, losses)``."""
+    rate, peak, losses = kind
+    q, params = c.q, c.params
+    objective = params.period
+    if rate:
+        heat, energy = objective_terms(q, torque, states[2], times, losses)
+        objective = q["weight_period"] * params.period + q["weight_heat"] * heat + q["weight_energy"] * energy
+        objective -= q["weight_dwell"] * params.transfer_dwell
+    if peak:  # the least grid peak: bus power <= bus_peak at every sample, bus_peak weighed (weight_peak)
+        bus_peak, power_unit = c.x[-1] * c.p_scale[-1], c.p_scale[-1]
+        bus = bus_power_samples(q, torque)
+        rows.add("bus power under its peak", (bus - bus_peak) / power_unit, -np.inf, 0.0, "planner.objective")
+        objective += q["weight_peak"] * bus_peak
+    return objective
+
+
 def _build(
     law_name: str,
     formula: Formula,
@@ -196,115 +338,30 @@ def _build(
     zone = zone or rate
     layout = ParameterLayout(formula, limit_ids, drive, rate, links if drive else ())
     variables = VARIABLES + ((PEAK_VARIABLE,) if peak else ())
-    x = ca.SX.sym("x", len(variables))
-    p_case = ca.SX.sym("p", layout.size)
-    p_scale = ca.SX.sym("scale", len(variables))  # physical value = scale * x, chosen per case
-    v = {name: x[i] * p_scale[i] for i, (name, _) in enumerate(VARIABLES)}
-    unit = {name: p_scale[i] for i, (name, _) in enumerate(VARIABLES)}
-    q = layout.symbols(p_case)
-
-    fields = [f for f in CycleParameters.__dataclass_fields__ if f in v]
-    params = CycleParameters(
-        **{f: v[f] for f in fields}, draw_start=q["theta2"], draw_end=q["theta3"], motion_law=law_name
-    )
-    segs = cycle_segments(params)
-    states = knot_states(q["theta3"], params.draw_speed, 0.0, segs)
-    starts = [0.0]
-    for seg in segs[:-1]:
-        starts.append(starts[-1] + seg.duration)
-    n_before = len(segs) - 1  # the segments from theta3 to theta2 (all but the draw)
-    before = (starts[:n_before], states[:n_before], segs[:n_before])
-
+    c = _cycle(law_name, layout, variables)
     rows = Rows()
-    w1, w2 = params.transfer_speed, params.draw_speed
-    wm1, wm2 = params.feed_peak_speed, params.return_peak_speed
-    peaks = ca.vertcat(wm1 - w1, wm1 - w2, wm2 - w2, wm2 - w1) / unit["draw_speed"]
-    rows.add("peak speeds above their ends", peaks, 0, np.inf, "planner.motion_law")
-    if law.one_jerk_per_curve:  # Eq. 14: one jerk J for both halves of each S-curve
-        d_fa, d_fd = params.feed_accel_duration, params.feed_decel_duration
-        d_ra, d_rd = params.return_accel_duration, params.return_decel_duration
-        t2 = unit["feed_accel_duration"] ** 2 * unit["draw_speed"]
-        one_jerk = ca.vertcat((wm1 - w1) * d_fd**2 - (wm1 - w2) * d_fa**2, (wm2 - w2) * d_rd**2 - (wm2 - w1) * d_ra**2)
-        rows.add("one jerk per S-curve (Eq. 14)", one_jerk / t2, 0.0, 0.0, "planner.motion_law")
-    # the cycle closes: theta at the draw start is theta2 + 2 pi
-    rows.add("cycle closes", states[n_before][0] - (q["theta2"] + 2 * np.pi), 0.0, 0.0, "key_points")
-
-    t4, t1 = v["opening_time"], v["closing_time"]
-    th4, _ = _angle_at(t4, *before)
-    th1, _ = _angle_at(t1, *before)
-    rows.add("key angles", ca.vertcat(th4 - q["theta4"], th1 - (q["theta1"] + 2 * np.pi)), 0.0, 0.0, "key_points")
-    t_end = starts[n_before]
-    order = ca.vertcat(t4, t1 - t4, t_end - t1, t_end - v["die_down_time"], t_end - v["die_up_time"])
-    rows.add("key points in order", order, 0.0, np.inf, "key_points")
-    # published structure (Fig. 6): theta4 at x3 + 3 T14 (three quarters into the return deceleration),
-    # theta1 at x1 + T1 (a quarter into the feed acceleration); bounds switched per solve
-    rd_start = params.return_accel_duration
-    fa_start = rd_start + params.return_decel_duration + params.transfer_dwell
-    published = ca.vertcat(
-        t4 - (rd_start + 0.75 * params.return_decel_duration),
-        t1 - (fa_start + 0.25 * params.feed_accel_duration),
-    )
-    published_rows = rows.add("key angles (published placement)", published, -np.inf, np.inf, "planner.placement")
-    # the die-height crossings outside the draw (a crossing inside it: its row switched off, its time fixed)
-    thd, omd = _angle_at(v["die_down_time"], *before)
-    thu, omu = _angle_at(v["die_up_time"], *before)
-    crossing = ca.vertcat(
-        q["die_down_active"] * (thd - (q["die_down_angle"] + 2 * np.pi)),
-        q["die_up_active"] * (thu - q["die_up_angle"]),
-    )
-    rows.add("die crossing angles", crossing, 0.0, 0.0, "limits.die_height_mm")
-
-    # the states at sample points of every segment, one vector per segment
-    th_s, om_s, al_s, t_s = [], [], [], []
-    draw_count = 0
-    for seg, st, t0 in zip(segs, states[:-1], starts, strict=True):
-        draw = seg.name == "draw:constant"
-        if draw and not drive:
-            continue  # every limit holds in the draw by the draw speed's bounds
-        count = DRAW_SAMPLES_DRIVE if draw else SAMPLES_CONSTANT if seg.name == "transfer:dwell" else law.samples
-        fractions = np.linspace(0.0, 1.0, count + 1)
-        if not draw:
-            fractions = fractions[:-1]  # the end is the next segment's start
-        else:
-            draw_count = fractions.size
-        if draw:  # sparse rows (see the module docstring)
-            th, om, al, since = draw_states(q, w2, ca.DM(fractions))
-            t_s.append(t0 + since)
-        else:
-            th, om, al, _ = advance_segment(seg, *st, ca.DM(fractions) * seg.duration)
-            t_s.append(t0 + ca.DM(fractions) * seg.duration)
-        th_s.append(th)
-        om_s.append(om)
-        al_s.append(al)
-    states = (ca.vertcat(*th_s), ca.vertcat(*om_s), ca.vertcat(*al_s))
-    times = ca.vertcat(*t_s)
-    samples, torque, lift = sample_states(formula, layout, q, p_case, states, times, draw_count)
+    _shape_rows(rows, c, law)
+    published_rows, (omd, omu) = _key_point_rows(rows, c)
+    states, times, draw_count = _sampled(c, law, drive)
+    samples, torque, lift = sample_states(formula, layout, c.q, c.p_case, states, times, draw_count)
+    p = c.params
     nlp = Transcription(
         **samples,
-        period=params.period,
-        window_time=t1 - t4,
-        speeds=Extremes(ca.vertcat(wm1, wm2, w1, w2)),  # the halves are monotone in speed
-        accelerations=Extremes(ca.vertcat(*params.peak_accelerations())),
-        jerks=Extremes(ca.vertcat(*params.peak_jerks())),
+        period=p.period,
+        window_time=c.v["closing_time"] - c.v["opening_time"],
+        # the halves are monotone in speed: its extremes are the speeds they join
+        speeds=Extremes(ca.vertcat(p.feed_peak_speed, p.return_peak_speed, p.transfer_speed, p.draw_speed)),
+        accelerations=Extremes(ca.vertcat(*p.peak_accelerations())),
+        jerks=Extremes(ca.vertcat(*p.peak_jerks())),
         lowest_speeds=None,  # the variable bounds of w1, w2 (the halves are monotone)
-        crossings=[(omd, q["die_down_slope"]), (omu, q["die_up_slope"])],
+        crossings=[(omd, c.q["die_down_slope"]), (omu, c.q["die_up_slope"])],
         zone=zone,
         rate=rate,
-        speed_unit=unit["draw_speed"],
+        speed_unit=c.unit["draw_speed"],
     )
     refinable = add_limit_rows(rows, nlp, layout)
-    objective = params.period
-    if rate:
-        heat, energy = objective_terms(q, torque, states[2], times, losses)
-        objective = q["weight_period"] * params.period + q["weight_heat"] * heat + q["weight_energy"] * energy
-        objective -= q["weight_dwell"] * params.transfer_dwell
-    if peak:  # the least grid peak: bus power <= bus_peak at every sample, bus_peak weighed (weight_peak)
-        bus_peak, power_unit = x[-1] * p_scale[-1], p_scale[-1]
-        bus = bus_power_samples(q, torque)
-        rows.add("bus power under its peak", (bus - bus_peak) / power_unit, -np.inf, 0.0, "planner.objective")
-        objective += q["weight_peak"] * bus_peak
-
-    problem = {"x": x, "p": ca.vertcat(p_case, p_scale), "f": objective, "g": ca.vertcat(*rows.g)}
+    objective = _objective(rows, c, torque, states, times, (rate, peak, losses))
+    problem = {"x": c.x, "p": ca.vertcat(c.p_case, c.p_scale), "f": objective, "g": ca.vertcat(*rows.g)}
     kind = ("_rate" if rate else "_drive" if drive else "") + ("_zone" if zone and not rate else "")
     kind += ("_peak" if peak else "") + ("_losses" if losses else "")
     options = {**CYCLE_OPTIONS, **(DRIVE_OPTIONS if drive else {}), **(RATE_OPTIONS if rate else {})}

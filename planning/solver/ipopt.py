@@ -31,13 +31,14 @@ import casadi as ca
 import numpy as np
 
 from planning.solver.lifting import Lift, lifted_problem
+from planning.tolerances import IPOPT_MU_INIT, IPOPT_TOL, IPOPT_WARM_PUSH
 
 MAX_SOLVE_WALL_S = 30.0  # [s] one IPOPT call at most (a normal one takes well under a second)
 BASE_OPTIONS = {
     "ipopt.print_level": 0,
     "print_time": False,
     "ipopt.sb": "yes",
-    "ipopt.tol": 1e-10,
+    "ipopt.tol": IPOPT_TOL,
     "ipopt.max_wall_time": MAX_SOLVE_WALL_S,
 }
 _SIGNALS = ("SIGINT", "SIGTERM")
@@ -46,10 +47,10 @@ _SIGNALS = ("SIGINT", "SIGTERM")
 _IPOPT_LOCK = threading.Lock()
 WARM_START_OPTIONS = {  # a start from a nearby solution and its multipliers: a few iterations
     "ipopt.warm_start_init_point": "yes",
-    "ipopt.mu_init": 1e-6,
-    "ipopt.warm_start_bound_push": 1e-9,
-    "ipopt.warm_start_mult_bound_push": 1e-9,
-    "ipopt.warm_start_slack_bound_push": 1e-9,
+    "ipopt.mu_init": IPOPT_MU_INIT,
+    "ipopt.warm_start_bound_push": IPOPT_WARM_PUSH,
+    "ipopt.warm_start_mult_bound_push": IPOPT_WARM_PUSH,
+    "ipopt.warm_start_slack_bound_push": IPOPT_WARM_PUSH,
 }
 
 # nlpsol's options that take a derivative function, and the name of that function in a built solver

@@ -12,21 +12,22 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-import numpy as np
-
 from planning.model.case import Case, Placement
 from planning.model.limits import BY_ID
 from planning.model.plan import Plan
 from planning.solver.halves_nlp import halves_nlp_for
+from planning.solver.neighbour import can_answer, can_start, known_evaluation, plan_of
 from planning.solver.search import Ran, Search, prepare
 from planning.solver.solution import Solution
 from planning.solver.starts import free_starts, published_starts
-from planning.solver.verify import assess
+from planning.solver.verify import evaluate
 
 MOTOR_LIMITS = frozenset(limit.id for limit in BY_ID.values() if limit.motor)  # the motor's limits
 
 
-def solve_max_spm(case: Case, placement: Placement | None = None, neighbour: Plan | None = None) -> Solution:
+def solve_max_spm(
+    case: Case, placement: Placement | None = None, neighbour: Plan | Solution | None = None
+) -> Solution:
     """The fastest verified cycle of ``case`` under its law with halves; ``neighbour``: a plan whose values
     start the multi-start (and which answers when it verifies here and beats the starts). Without a
     neighbour: the cold solve (``planning.solver.optimize.solve`` compares the two)."""
@@ -102,22 +103,22 @@ def _try_harder(search: Search, neighbour: Plan | None) -> None:
     _multi_start(search, neighbour)
 
 
-def adopt(search: Search, neighbour: Plan | None) -> Plan | None:
-    """A neighbour plan that fits and verifies here is the first answer; the neighbour when its NLP
-    values can start this case's NLP (same law), else None."""
-    if neighbour is None:
+def adopt(search: Search, neighbour: Plan | Solution | None) -> Plan | None:
+    """A neighbour plan that answers this case (``planning.solver.neighbour``) and verifies here is the
+    first answer (its evaluation against this case reused when it was handed over with one); the
+    neighbour's plan when its NLP values can start this case's NLP, else None."""
+    plan = plan_of(neighbour)
+    if plan is None:
         return None
-    if _fits(neighbour, search.case, search.placement, *search.draw_speed_range):
-        verification, drive = assess(neighbour, search.case)
-        if verification.passed:
-            solution = Solution(neighbour, verification, drive)
+    if can_answer(plan, search.case, search.placement, search.draw_speed_range):
+        evaluation = known_evaluation(neighbour, search.case) or evaluate(plan, search.case)
+        if evaluation.verification.passed:
+            solution = Solution(plan, evaluation)
             search.consider(solution, search.score_of(solution))
-    if neighbour.motion_law != search.case.planner.motion_law or not neighbour.nlp_values:
-        return None  # another law's plan neither answers this case nor starts its NLP
-    return neighbour
+    return plan if can_start(plan, search.case, search.placement) else None
 
 
-def from_neighbour(case: Case, placement: Placement | None, neighbour: Plan) -> Solution | None:
+def from_neighbour(case: Case, placement: Placement | None, neighbour: Plan | Solution) -> Solution | None:
     """The answer from ``neighbour`` alone: its plan when it holds here, and one start from its values
     (same placement rule); None when neither verifies. Fast, but not confirmed: the cold multi-start may
     find a better optimum (``planning.solver.optimize.solve``)."""
@@ -127,17 +128,8 @@ def from_neighbour(case: Case, placement: Placement | None, neighbour: Plan) -> 
 
 
 def _follow(search: Search, neighbour: Plan | None) -> bool:
-    """Solve from the neighbour's values alone (same placement rule); whether that verified."""
-    if neighbour is None or not (neighbour.placement == search.placement or search.placement == "free"):
+    """Solve from the neighbour's values alone (``neighbour``: a plan :func:`adopt` found able to start this
+    case's NLP), in its own placement; whether that verified."""
+    if neighbour is None:
         return False
     return search.attempt(neighbour.nlp_values, neighbour.placement) is not None
-
-
-def _fits(plan: Plan, case: Case, placement: Placement, w2_lo: float, w2_hi: float) -> bool:
-    """Whether ``plan`` is a candidate answer for ``case``: same placement rule (a published-structure
-    plan is also a free one), same key angles, a draw speed within this case's bounds."""
-    same_angles = np.allclose(plan.key_angles, case.key_angles, rtol=0, atol=1e-12)
-    w2 = float(plan.parameters.draw_speed)
-    fits_placement = placement == "free" or plan.placement == "published"
-    same_law = plan.motion_law == case.planner.motion_law
-    return bool(same_angles and same_law and fits_placement and w2_lo - 1e-12 <= w2 <= w2_hi + 1e-12)

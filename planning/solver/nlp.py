@@ -29,17 +29,18 @@ from planning.model.profile import advance
 from planning.solver.ipopt import NLPResult, NLPSolver
 from planning.solver.lifting import SERIES_ORDER, Lift
 from planning.solver.parameters import FORMING_SAMPLES, LINK, ParameterLayout, link_parameter
+from planning.tolerances import IPOPT_CONSTR_VIOL_TOL, IPOPT_RATE_TOL
 from press.dynamics import DriveModel, LinkMass, crank_torque, link_jets, link_terms, motor_speed, motor_torque
 from press.mechanism import Formula
 
 CYCLE_OPTIONS = {  # added to the wrapper's base options
-    "ipopt.constr_viol_tol": 1e-10,
+    "ipopt.constr_viol_tol": IPOPT_CONSTR_VIOL_TOL,
     "ipopt.max_iter": 400,  # a start that has not converged by then is dropped (others remain)
 }
 # the rate NLP's objectives (heat, energy; normalised to 1 at the baseline) are wanted to about a millionth:
 # a tighter optimality tolerance only lengthens IPOPT's crawl where a law's half degenerates (hundreds of
 # iterations for the last digits); the constraints keep CYCLE_OPTIONS' tolerance and the dense verification
-RATE_OPTIONS = {"ipopt.tol": 1e-6}
+RATE_OPTIONS = {"ipopt.tol": IPOPT_RATE_TOL}
 # the drive NLPs' rows (the motor torque at every sample, the RMS integral) depend on every variable: with
 # MUMPS's approximate-minimum-degree ordering an iteration takes 20-30 % less time than with its automatic
 # choice (measured; the optimal law's NLP uses it too); the kinematic NLP keeps the automatic choice (with

@@ -39,13 +39,13 @@ from planning.model.case import Case, Placement
 from planning.model.plan import Plan
 from planning.solver.halves_nlp import PEAK_VARIABLE, VARIABLE_INDEX, VARIABLES, halves_nlp_for
 from planning.solver.max_spm import solve_max_spm
+from planning.solver.neighbour import can_start
 from planning.solver.outcomes import Infeasible, NoPlanFound
 from planning.solver.search import Search, prepare
 from planning.solver.solution import AtRate, Solution, objective_value
-from planning.solver.verify import assess, field_of_check
+from planning.solver.verify import evaluate, field_of_check
+from planning.tolerances import RATE_TOLERANCE, SAME_PERIOD_S
 
-RATE_TOLERANCE = 1e-9  # relative: a target this close above the fastest rate is that rate
-SAME_PERIOD_S = 1e-9  # [s] a plan whose period is this close to the target cycle time runs at the rate
 HEAT_TIE_BREAK = 1e-3  # min-energy, min-grid-peak: the heat's weight against the objective's (both normalised)
 PEAK_START_HEADROOM = 1.05  # min-grid-peak: a start's bus peak this much above the slower starts' grid peak
 BASELINE_SCORE = 1.0  # the objective's score of the baseline (the objectives are normalised by its figures)
@@ -72,8 +72,7 @@ def solve_at_rate(
     if fastest is None:
         fastest = solve_max_spm(case.with_objective("max-spm"), placement)
     if case.electrical and fastest.drive.power is None:  # the max-SPM case leaves the grid out: its figures here
-        verification, drive = assess(fastest.plan, case)
-        fastest = replace(fastest, verification=verification, drive=drive)
+        fastest = replace(fastest, evaluation=evaluate(fastest.plan, case))
     _check_reachable(target, fastest, case)
     period = 60.0 / target
     baseline = _baseline(case, placement, fastest, period, neighbour_baseline, confirm)
@@ -187,8 +186,7 @@ def _run_starts(
     neighbour's start alone when it leads to a verified plan scoring below ``to_beat`` (the objective's
     ``to_beat`` is the baseline's score: a neighbour's start can end in a local optimum worse than
     waiting), else the ``starts`` until one verifies."""
-    fits = neighbour is not None and bool(neighbour.nlp_values)
-    fits = fits and (placement == "free" or neighbour.placement == placement)
+    fits = can_start(neighbour, search.case, placement)
     if confirm:
         search.multi_start(starts, placement, confirm=True)
         if fits and not search.stopped:

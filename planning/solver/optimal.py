@@ -24,15 +24,14 @@ from planning.model.laws.optimal import OptimalLaw
 from planning.model.plan import Plan
 from planning.solver.free_nlp import free_nlp_for
 from planning.solver.max_spm import converged_plan, solve_max_spm
+from planning.solver.neighbour import can_answer, can_start, known_evaluation, plan_of
 from planning.solver.outcomes import Infeasible
 from planning.solver.search import Search, prepare
 from planning.solver.solution import Solution
-from planning.solver.verify import assess
+from planning.solver.verify import evaluate
+from planning.tolerances import MIN_SPEED_BACKOFF
 
 SEED_LAW = "seven-segment"  # a jerk-limited law whose plan starts the NLP
-# relative: the sampled minimum crank speed is held this much above the limit (the speed is cubic between
-# the samples and may dip below them; the slowest point, near TDC, is usually at the limit)
-MIN_SPEED_BACKOFF = 1e-2
 FINE_JERK_SHARE = 0.5  # a plan using less than this share of the jerk limit is solved again on the finer layout
 
 
@@ -64,11 +63,11 @@ def seed_values(seed: Plan, phases: Layout = PHASES) -> dict[str, float]:
     return values
 
 
-def from_neighbour_optimal(case: Case, neighbour: Plan) -> Solution | None:
+def from_neighbour_optimal(case: Case, neighbour: Plan | Solution) -> Solution | None:
     """The answer from ``neighbour`` alone (its plan when it holds here, one start from its values), or
     None: fast, not confirmed (``planning.solver.optimize.solve``)."""
     _require_jerk_limit(case)
-    search = _search(case, _layout_of(neighbour))
+    search = _search(case, _layout_of(plan_of(neighbour)))
     return search.answer() if _from(search, neighbour) else None
 
 
@@ -86,17 +85,17 @@ def _search(case: Case, phases: Layout = PHASES) -> Search:
     return search
 
 
-def _from(search: Search, neighbour: Plan) -> bool:
-    """A neighbouring case's optimal plan: a candidate when it holds here, and a start; whether either
-    verified."""
-    case = search.case
-    if neighbour.motion_law != OptimalLaw.name or not neighbour.nlp_values:
+def _from(search: Search, neighbour: Plan | Solution) -> bool:
+    """A neighbouring case's optimal plan: a candidate when it answers this case and holds here, and a start
+    (``planning.solver.neighbour``); whether either verified."""
+    case, plan = search.case, plan_of(neighbour)
+    if not can_start(plan, case, "free"):
         return False
-    if np.allclose(neighbour.key_angles, case.key_angles, rtol=0, atol=1e-12):
-        verification, drive = assess(neighbour, case)  # a neighbouring case's plan that holds here is an answer
-        if verification.passed:
-            search.consider(Solution(neighbour, verification, drive), neighbour.period)
-    search.attempt(neighbour.nlp_values, "free")
+    if can_answer(plan, case, "free", search.draw_speed_range):
+        evaluation = known_evaluation(neighbour, case) or evaluate(plan, case)
+        if evaluation.verification.passed:  # a neighbouring case's plan that holds here is an answer
+            search.consider(Solution(plan, evaluation), plan.period)
+    search.attempt(plan.nlp_values, "free")
     return search.best is not None
 
 
@@ -107,7 +106,7 @@ def _require_jerk_limit(case: Case) -> None:
         )
 
 
-def solve_optimal(case: Case, neighbour: Plan | None = None) -> Solution:
+def solve_optimal(case: Case, neighbour: Plan | Solution | None = None) -> Solution:
     """The fastest verified cycle of ``case`` under the optimal law (needs ``limits.crank_jerk_rad_s3``).
 
     ``neighbour``: an optimal plan of a neighbouring case (a sweep, an edit on the web page, a looser
@@ -116,7 +115,7 @@ def solve_optimal(case: Case, neighbour: Plan | None = None) -> Solution:
     _require_jerk_limit(case)
     spent = (0, 0)  # a neighbour's search that found nothing: its iterations and starts still count
     if neighbour is not None:
-        search = _search(case, _layout_of(neighbour))
+        search = _search(case, _layout_of(plan_of(neighbour)))
         if _from(search, neighbour):
             return _on_the_finer_layout(case, search)
         spent = (search.iterations, search.starts)

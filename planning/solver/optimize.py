@@ -17,24 +17,26 @@ from planning.model.case import Case, Placement
 from planning.model.laws import get_law
 from planning.model.plan import Plan
 from planning.solver.max_spm import from_neighbour, solve_max_spm
+from planning.solver.neighbour import plan_of
 from planning.solver.objectives import solve_at_rate
 from planning.solver.optimal import from_neighbour_optimal, solve_optimal
 from planning.solver.outcomes import PlanningError
 from planning.solver.solution import Solution
+from planning.tolerances import BETTER_SHARE
 
 __all__ = ["Solution", "solve", "solve_from"]
 
-BETTER_SHARE = 1e-9  # a plan from a neighbour replaces the cold one when its period is this share shorter
 
 
 def solve(
-    case: Case, placement: Placement | None = None, neighbour: Plan | None = None, follow: bool = False
+    case: Case, placement: Placement | None = None, neighbour: Plan | Solution | None = None, follow: bool = False
 ) -> Solution:
     """The fastest verified cycle for ``case``; raises a :class:`PlanningError` when there is none.
 
     One answer per case: the cold solve (its starts and stopping rule as if there were no neighbour),
     or better. ``neighbour``: a plan of a neighbouring case (a sweep's point before, a relaxed limit, the
-    page's plan before an edit). Its plan, when it holds here, and a start from its values compete with
+    page's plan before an edit), or a solution (its evaluation, when made against this case, is not made
+    again; ``planning.solver.neighbour``). Its plan, when it holds here, and a start from its values compete with
     the cold solve; the shorter verified cycle wins, so the answer is never worse than the cold solve's
     nor than the neighbour's where the neighbour holds. ``follow``: the neighbour's answer alone when it
     verifies, unconfirmed (fast, but it may be another local optimum than the cold solve's: the web
@@ -43,7 +45,7 @@ def solve(
     there starts the search and is not compared with a cold solve).
     """
     if case.planner.objective != "max-spm":
-        return solve_at_rate(case, placement, neighbour)
+        return solve_at_rate(case, placement, plan_of(neighbour))
     if neighbour is None:
         return _cold(case, placement)
     warm = _from_neighbour(case, placement, neighbour)
@@ -58,7 +60,7 @@ def solve(
     return _better(cold, warm)
 
 
-def solve_from(case: Case, neighbour: Plan, placement: Placement | None = None) -> Solution | None:
+def solve_from(case: Case, neighbour: Plan | Solution, placement: Placement | None = None) -> Solution | None:
     """The fast, unconfirmed answer of ``case`` from ``neighbour`` alone (its plan when it holds here, one
     start from its values), or None when neither verifies; raises a :class:`PlanningError` when a
     precheck refuses the case. ``solve(case, neighbour=...)`` confirms it against the cold solve. For
@@ -74,7 +76,7 @@ def _cold(case: Case, placement: Placement | None) -> Solution:
     return solve_max_spm(case, placement)
 
 
-def _from_neighbour(case: Case, placement: Placement | None, neighbour: Plan) -> Solution | None:
+def _from_neighbour(case: Case, placement: Placement | None, neighbour: Plan | Solution) -> Solution | None:
     if get_law(case.planner.motion_law).free_profile:
         return from_neighbour_optimal(case, neighbour)
     return from_neighbour(case, placement, neighbour)

@@ -1,8 +1,8 @@
 """What a solve ends with when there is no verified plan: one exception type per outcome.
 
 Each carries data, not only text: the case field that cannot be met, the value, what would be needed;
-or the verification check that failed. The CLI maps the types to exit codes in one place
-(``planning.cli``); a sweep writes ``kind`` into its status column.
+or the verification check that failed; and its :class:`~planning.model.outcome.Outcome`, from which the
+CLI's exit status, the page's answer and a sweep's row derive.
 """
 
 from __future__ import annotations
@@ -10,18 +10,20 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar
 
+from planning.model.outcome import Outcome
+
 if TYPE_CHECKING:
     from planning.solver.verify import Check
 
 
 class PlanningError(Exception):
-    """No verified plan for a case. ``kind`` names the outcome, ``reason`` is the one-line message."""
+    """No verified plan for a case. ``outcome`` says which, ``reason`` is the one-line message."""
 
-    kind: ClassVar[str] = "failed"
+    outcome: ClassVar[Outcome] = Outcome.NO_PLAN
 
     def __init__(self, reason: str):
         self.reason = reason
-        super().__init__(f"{self.kind}: {reason}")
+        super().__init__(f"{self.outcome}: {reason}")
 
 
 class Infeasible(PlanningError):
@@ -32,7 +34,7 @@ class Infeasible(PlanningError):
     where on the cycle, when one angle says it.
     """
 
-    kind = "infeasible"
+    outcome = Outcome.INFEASIBLE
 
     def __init__(
         self,
@@ -53,7 +55,7 @@ class NoPlanFound(PlanningError):
     """Every start of the solver stopped without a plan (``attempts`` say how each ended). Not a proof
     that the limits cannot be met: the message says so and names the closest limit."""
 
-    kind = "no verified plan"
+    outcome = Outcome.NO_PLAN
 
     def __init__(self, reason: str, attempts: tuple[Attempt, ...] = ()):
         super().__init__(reason)
@@ -64,7 +66,7 @@ class Unverified(PlanningError):
     """The solver converged but the dense verification rejected the plan: ``check`` is the first
     failed check (its value, limit and unit)."""
 
-    kind = "unverified"
+    outcome = Outcome.UNVERIFIED
 
     def __init__(self, reason: str, check: Check):
         super().__init__(reason)

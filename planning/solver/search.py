@@ -22,7 +22,6 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from planning.model.case import Case, Placement
-from planning.model.limits.base import BINDING_SHARE
 from planning.model.plan import Plan, SolverInfo
 from planning.solver.halves_nlp import halves_nlp_for
 from planning.solver.ipopt import NLPResult, NLPStatus
@@ -30,12 +29,18 @@ from planning.solver.nlp import CycleNLP
 from planning.solver.outcomes import Attempt, NoPlanFound, Unverified
 from planning.solver.precheck import precheck
 from planning.solver.solution import Solution
-from planning.solver.verify import Verification, assess, field_of_check, schedule_matters
+from planning.solver.verify import Verification, evaluate, field_of_check, schedule_matters, with_least_energy
+from planning.tolerances import (
+    AGREE_S,
+    BINDING_SHARE,
+    REFINE_MARGIN,
+    ROW_ACTIVE,
+    SAME_ANGLE_RAD,
+    SAME_SCORE,
+    SAME_START_REL,
+)
 
 REFINEMENTS = 8  # re-solves with a lowered sampled limit
-REFINE_MARGIN = 1e-5  # relative: a refined sampled limit is tightened this much beyond the measured overshoot
-ROW_ACTIVE = 1e-6  # a row scaled to 1 at its limit (the RMS row: heat over the rating's) is active above 1 - this
-AGREE_S = 1e-6  # [s] two starts whose best periods agree this closely have found the same optimum
 
 
 @dataclass
@@ -107,9 +112,10 @@ class Search:
                 self.attempts.append(Attempt(res.return_status, block.name, amount, case_field=block.field))
                 return found
             plan = self.plan_of(values, placement, res.return_status)
-            verification, drive = assess(plan, self.case, least_energy=False)  # the answer's in full
+            evaluation = evaluate(plan, self.case, least_energy=False)  # the answer's in full
+            verification = evaluation.verification
             if verification.passed:
-                solution = Solution(plan, verification, drive)
+                solution = Solution(plan, evaluation)
                 score = self.score_of(solution)
                 self.consider(solution, score)
                 if found is None or score < found[1]:
@@ -175,7 +181,7 @@ class Search:
 
     def consider(self, solution: Solution, score: float) -> None:
         """Keep ``solution`` (verified) when its ``score`` beats the best so far."""
-        if self.best is None or score < self.best_score - 1e-9:
+        if self.best is None or score < self.best_score - SAME_SCORE:
             self.best, self.best_score = solution, score
 
     def multi_start(
@@ -191,7 +197,7 @@ class Search:
             if self.stopped:
                 break
             key = self.key(x0)
-            if any(np.allclose(key, other, rtol=1e-9, atol=1e-12) for other in tried):
+            if any(np.allclose(key, other, rtol=SAME_START_REL, atol=SAME_ANGLE_RAD) for other in tried):
                 continue  # the same start again would only repeat its answer
             tried.append(key)
             out = self.attempt(x0, placement)
@@ -217,13 +223,11 @@ class Search:
                 tuple(self.attempts),
             )
         if schedule_matters(self.case):  # verified with the storage's lazy schedule: now with its least-energy one
-            verification, drive = assess(self.best.plan, self.case)
-            if not verification.passed:
-                raise Unverified(
-                    "no plan meets the limits: " + Attempt(check=verification.failures()[0]).describe(),
-                    verification.failures()[0],
-                )
-            self.best = replace(self.best, verification=verification, drive=drive)
+            evaluation = with_least_energy(self.best.evaluation)
+            if not evaluation.verification.passed:
+                failed = evaluation.verification.failures()[0]
+                raise Unverified("no plan meets the limits: " + Attempt(check=failed).describe(), failed)
+            self.best = replace(self.best, evaluation=evaluation)
         plan = self.best.plan
         if self.placement == "free" and plan.placement == "published":
             # the published structure is one of the free structures: report it as the free answer

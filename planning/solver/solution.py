@@ -10,21 +10,30 @@ from dataclasses import dataclass
 
 from planning.model.drive import DriveFigures
 from planning.model.plan import Plan
-from planning.solver.verify import Verification
+from planning.solver.verify import Evaluation, Verification
 
 GRID_PEAK = "grid_peak_kW"  # the power figures' key of the grid's peak
 
 
 @dataclass(frozen=True)
 class Solution:
-    """A verified ``plan``, its ``verification``, the drive's figures of it (``drive``, a case with a drive;
-    ``planning.model.drive``) and, for an objective at the line's rate, what that solve found
-    (``at_rate``)."""
+    """A verified ``plan``, its ``evaluation`` (the dense re-simulation, every check and, with a drive, the
+    drive's figures: ``planning.solver.verify.Evaluation``, made once) and, for an objective at the line's
+    rate, what that solve found (``at_rate``)."""
 
     plan: Plan
-    verification: Verification
-    drive: DriveFigures | None = None
+    evaluation: Evaluation
     at_rate: AtRate | None = None
+
+    @property
+    def verification(self) -> Verification:
+        """The checks of the plan (the evaluation's)."""
+        return self.evaluation.verification
+
+    @property
+    def drive(self) -> DriveFigures | None:
+        """The drive's figures of the plan (the evaluation's; a case with a drive)."""
+        return self.evaluation.drive
 
     def saving_pct(self, key: str) -> float:
         """How much lower this plan's drive figure ``key`` (``rms_motor_torque_Nm``, ``supply_energy_kJ`` or,

@@ -60,6 +60,7 @@ from planning.solver.bound import BOUND_OPTIONS, angle_grid, node_speed_bounds
 from planning.solver.ipopt import NLPSolver
 from planning.solver.outcomes import NoPlanFound
 from planning.solver.precheck import precheck
+from planning.tolerances import DEAD_CENTRE_SLOPE, SAME_ANGLE_RAD, SAME_NODE_RAD
 
 UPPER_POINTS = 1440  # intervals of the grid by default
 UPPER_PIECES = 1  # pieces per interval (a time variable each)
@@ -68,7 +69,6 @@ SPLITS = (0.5,)  # shares of a piece after which a start-side envelope gives way
 SOLVED = "Solve_Succeeded"  # the only IPOPT status whose optimum is taken as the bound
 DEAD_CENTRE_SLIVER = 1.0 / 1024  # share of an interval next to a dead centre whose time is bounded by 0 only
 INFLECTION_GRID = 7200  # angles on which the sign changes of h' and h'' are looked for
-SAME_NODE_RAD = 1e-9  # [rad] a zero of h' this close to TDC or BDC is that dead centre
 
 
 @dataclass(frozen=True)
@@ -136,8 +136,8 @@ def _pieces(theta: np.ndarray, d1: np.ndarray, pieces: int) -> tuple[np.ndarray,
     for i in range(theta.size - 1):
         a, b = theta[i], theta[i + 1]
         cuts = list(np.linspace(a, b, pieces + 1))
-        dead_start = abs(d1[i]) <= 1e-9 * scale
-        dead_end = abs(d1[i + 1]) <= 1e-9 * scale
+        dead_start = abs(d1[i]) <= DEAD_CENTRE_SLOPE * scale
+        dead_end = abs(d1[i + 1]) <= DEAD_CENTRE_SLOPE * scale
         if dead_start:
             cuts.insert(1, a + DEAD_CENTRE_SLIVER * (b - a))
         if dead_end:
@@ -177,7 +177,7 @@ class Relaxation:
         motion passes a crank angle, counted from theta1; the angles are taken over one turn from theta1)."""
         start = self.theta[0]
         at_a = np.array([time_at(float(x)) for x in self.a])
-        at_b = np.array([time_at(float(x)) if x < start + 2 * math.pi - 1e-12 else math.nan for x in self.b])
+        at_b = np.array([time_at(float(x)) if x < start + 2 * math.pi - SAME_ANGLE_RAD else math.nan for x in self.b])
         period = time_at(start + 2 * math.pi)
         at_b = np.where(np.isnan(at_b), period, at_b)
         return np.concatenate([np.asarray(speed_at(self.theta[:-1])) ** 2, at_b - at_a])
@@ -215,13 +215,12 @@ def relaxation(case: Case, points: int = UPPER_POINTS, pieces: int = UPPER_PIECE
     w2_lo, w2_hi = precheck(case)
     m = case.machine
     th = angle_grid(case, points, (0.0, m.bdc_angle, *slope_zeros(case), *inflections(case)))
-    n = th.size - 1
     dth = np.diff(th)
     h, d1, d2, _ = m.jets(th)
-    th1, th2, th3, th4 = case.key_angles
+    _, th2, th3, th4 = case.key_angles
     limits = limits_of(case)
-    draw = np.flatnonzero((th[:-1] >= th2 - 1e-12) & (th[:-1] <= th3 + 1e-12))
-    window = th[:-1] >= th4 - 1e-12
+    draw = np.flatnonzero((th[:-1] >= th2 - SAME_ANGLE_RAD) & (th[:-1] <= th3 + SAME_ANGLE_RAD))
+    window = th[:-1] >= th4 - SAME_ANGLE_RAD
     lbx_s, ubx_s = node_speed_bounds(BoundGrid(case, th, h, d1, d2, dth, window), limits, draw, w2_lo, w2_hi)
 
     cell, a, b, dead = _pieces(th, d1, pieces)
@@ -229,63 +228,13 @@ def relaxation(case: Case, points: int = UPPER_POINTS, pieces: int = UPPER_PIECE
     h_b, d1_b = m.jets(b)[:2]
     slope2_min = np.where(dead, 0.0, np.minimum(d1_a**2, d1_b**2))
     grid = RelaxedGrid(case, th, h, d1, d2, dth, window, cell=cell, a=a, b=b, h_a=h_a, h_b=h_b, slope2_min=slope2_min)
+    s_unit, tau_unit, x_s, x_tau, tau_piece = _symbols(grid, lbx_s, ubx_s)
 
-    w_acc2 = case.limits.slider_accel_mm_s2 / m.peak_curvature  # scales, as the grid bound's
-    s_unit = np.clip(np.full(n, w_acc2), lbx_s, ubx_s)
-    tau_unit = (b - a) / np.sqrt(s_unit[cell])
-    x_s = ca.SX.sym("s", n)  # scalar operations only: SX evaluates them fastest
-    x_tau = ca.SX.sym("tau", cell.size)
-    s = ca.DM(s_unit) * x_s
-    tau_piece = ca.DM(tau_unit) * x_tau
-    grid.s = s
-    grid.s_next = ca.vertcat(s[1:], s[0])
-    grid.alpha = (grid.s_next - grid.s) / (2 * dth)  # each interval's mean acceleration over angle
-    # each interval's time: the sum of its pieces' (a sparse 0/1 matrix)
-    to_cell = ca.DM(ca.Sparsity.triplet(n, cell.size, cell.tolist(), list(range(cell.size))), 1.0)
-    grid.tau = ca.mtimes(to_cell, tau_piece)
-    grid.tau_next = ca.vertcat(grid.tau[1:], grid.tau[0])
-
-    g, lbg, ubg = [], [], []
-    left_out = []
-    for limit in limits:
-        rows = limit.relaxed_rows(grid)
-        if rows is None:
-            left_out.append(limit.field)
-            continue
-        for expr, lo, hi in rows:
-            g.append(expr)
-            lbg.append(np.broadcast_to(lo, (expr.shape[0],)))
-            ubg.append(np.broadcast_to(hi, (expr.shape[0],)))
-    if draw.size > 1:  # the draw at one speed
-        g.append(s[draw[1:].tolist()] - s[draw[:-1].tolist()])
-        lbg.append(np.zeros(draw.size - 1))
-        ubg.append(np.zeros(draw.size - 1))
-
-    # each piece's time from the mean of the envelopes over its sub-pieces (module docstring)
-    sub = _sub_grid(grid, SUBPIECES)
+    g, lbg, ubg, left_out = _limit_rows(grid, limits, draw)
     relaxed = [limit for limit in limits if limit.field not in left_out]
-    inside = draw[th[draw + 1] <= th3 + 1e-12]  # the draw's intervals (the node at theta3 starts the return)
-
-    def envelopes_of(g_: RelaxedGrid) -> list[Envelope]:  # the limits', then the draw's at one speed
-        return [e for limit in relaxed for e in limit.relaxed_envelopes(g_)] + [
-            Envelope(g_.s_a, np.isin(g_.cell, inside), "exact")
-        ]
-
-    combined = _affine(envelopes_of, sub) + _caps(relaxed, sub)
+    inside = draw[th[draw + 1] <= th3 + SAME_ANGLE_RAD]  # the draw's intervals (the node at theta3 starts the return)
+    tau_floor = _piece_time_rows(grid, relaxed, inside, dead, tau_piece, (g, lbg, ubg))
     width = b - a
-    tau_floor = np.zeros(cell.size)
-    s_start, s_end = s[cell.tolist()], grid.s_next[cell.tolist()]
-    for k_a, k_b, k_c in _mean_forms(combined, SUBPIECES):
-        ok = np.isfinite(k_c) & ~dead
-        constant = ok & (k_a == 0.0) & (k_b == 0.0)
-        tau_floor[constant] = np.maximum(tau_floor[constant], width[constant] / np.sqrt(k_c[constant]))
-        k = np.flatnonzero(ok & ~constant)
-        if k.size:
-            mean = ca.DM(k_a[k]) * s_start[k.tolist()] + ca.DM(k_b[k]) * s_end[k.tolist()] + ca.DM(k_c[k])
-            g.append(tau_piece[k.tolist()] - ca.DM(width[k]) / ca.sqrt(mean))
-            lbg.append(np.zeros(k.size))
-            ubg.append(np.full(k.size, np.inf))
-
     nlp = {"x": ca.vertcat(x_s, x_tau), "f": ca.sum1(tau_piece), "g": ca.vertcat(*g)}
     return Relaxation(
         nlp=nlp,
@@ -301,6 +250,83 @@ def relaxation(case: Case, points: int = UPPER_POINTS, pieces: int = UPPER_PIECE
         b=b,
         left_out=tuple(dict.fromkeys(left_out)),
     )
+
+
+def _symbols(grid: RelaxedGrid, lbx_s: np.ndarray, ubx_s: np.ndarray) -> tuple:
+    """The relaxation's variables on ``grid`` (set on it): the speed squared at the nodes and each piece's
+    time, scaled (``s_unit``, ``tau_unit``: the grid bound's scales); returns ``(s_unit, tau_unit, x_s,
+    x_tau, tau_piece)``."""
+    case, th, cell = grid.case, grid.theta, grid.cell
+    n = th.size - 1
+    w_acc2 = case.limits.slider_accel_mm_s2 / case.machine.peak_curvature  # scales, as the grid bound's
+    s_unit = np.clip(np.full(n, w_acc2), lbx_s, ubx_s)
+    tau_unit = (grid.b - grid.a) / np.sqrt(s_unit[cell])
+    x_s = ca.SX.sym("s", n)  # scalar operations only: SX evaluates them fastest
+    x_tau = ca.SX.sym("tau", cell.size)
+    s = ca.DM(s_unit) * x_s
+    tau_piece = ca.DM(tau_unit) * x_tau
+    grid.s = s
+    grid.s_next = ca.vertcat(s[1:], s[0])
+    grid.alpha = (grid.s_next - grid.s) / (2 * grid.dtheta)  # each interval's mean acceleration over angle
+    # each interval's time: the sum of its pieces' (a sparse 0/1 matrix)
+    to_cell = ca.DM(ca.Sparsity.triplet(n, cell.size, cell.tolist(), list(range(cell.size))), 1.0)
+    grid.tau = ca.mtimes(to_cell, tau_piece)
+    grid.tau_next = ca.vertcat(grid.tau[1:], grid.tau[0])
+    return s_unit, tau_unit, x_s, x_tau, tau_piece
+
+
+def _limit_rows(grid: RelaxedGrid, limits: tuple, draw: np.ndarray) -> tuple[list, list, list, list[str]]:
+    """Each limit's relaxed rows (the fields of those without any: left out), then the draw at one speed:
+    ``(g, lbg, ubg, left_out)``."""
+    g, lbg, ubg = [], [], []
+    left_out = []
+    for limit in limits:
+        rows = limit.relaxed_rows(grid)
+        if rows is None:
+            left_out.append(limit.field)
+            continue
+        for expr, lo, hi in rows:
+            g.append(expr)
+            lbg.append(np.broadcast_to(lo, (expr.shape[0],)))
+            ubg.append(np.broadcast_to(hi, (expr.shape[0],)))
+    if draw.size > 1:  # the draw at one speed
+        s = grid.s
+        g.append(s[draw[1:].tolist()] - s[draw[:-1].tolist()])
+        lbg.append(np.zeros(draw.size - 1))
+        ubg.append(np.zeros(draw.size - 1))
+    return g, lbg, ubg, left_out
+
+
+def _piece_time_rows(
+    grid: RelaxedGrid, relaxed: list, inside: np.ndarray, dead: np.ndarray, tau_piece: ca.SX, rows: tuple
+) -> np.ndarray:
+    """Each piece's time from the mean of the envelopes over its sub-pieces (module docstring): rows appended
+    to ``rows`` (``g, lbg, ubg``) where the mean depends on the nodes, the time's floor where it is constant
+    (returned)."""
+    g, lbg, ubg = rows
+    cell = grid.cell
+    sub = _sub_grid(grid, SUBPIECES)
+
+    def envelopes_of(g_: RelaxedGrid) -> list[Envelope]:  # the limits', then the draw's at one speed
+        return [e for limit in relaxed for e in limit.relaxed_envelopes(g_)] + [
+            Envelope(g_.s_a, np.isin(g_.cell, inside), "exact")
+        ]
+
+    combined = _affine(envelopes_of, sub) + _caps(relaxed, sub)
+    width = grid.b - grid.a
+    tau_floor = np.zeros(cell.size)
+    s_start, s_end = grid.s[cell.tolist()], grid.s_next[cell.tolist()]
+    for k_a, k_b, k_c in _mean_forms(combined, SUBPIECES):
+        ok = np.isfinite(k_c) & ~dead
+        constant = ok & (k_a == 0.0) & (k_b == 0.0)
+        tau_floor[constant] = np.maximum(tau_floor[constant], width[constant] / np.sqrt(k_c[constant]))
+        k = np.flatnonzero(ok & ~constant)
+        if k.size:
+            mean = ca.DM(k_a[k]) * s_start[k.tolist()] + ca.DM(k_b[k]) * s_end[k.tolist()] + ca.DM(k_c[k])
+            g.append(tau_piece[k.tolist()] - ca.DM(width[k]) / ca.sqrt(mean))
+            lbg.append(np.zeros(k.size))
+            ubg.append(np.full(k.size, np.inf))
+    return tau_floor
 
 
 @dataclass(frozen=True)

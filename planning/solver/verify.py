@@ -12,25 +12,30 @@ from __future__ import annotations
 
 import enum
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from planning.model.case import RPM, Case
 from planning.model.drive import DriveFigures, PowerFigures, cycle_integrals, drive_figures
 from planning.model.limits import field_of, limits_of
-from planning.model.limits.base import BINDING_SHARE, Check, Dense
+from planning.model.limits.base import Check, Dense
 from planning.model.plan import Plan
-from planning.model.profile import dense_times, max_abs_jerk
-from planning.solver.grid import power_figures
+from planning.model.profile import max_abs_jerk, sample_times
+from planning.solver.grid import power_columns, power_figures
+from planning.tolerances import (
+    ACCEL_CLOSE_TOL_RAD_S2,
+    ANGLE_TOL_RAD,
+    BINDING_SHARE,
+    CONTINUITY_TOL,
+    ENERGY_REL_TOL,
+    KNOT_PROBE_S,
+    ROUND_OFF_REL,
+    SPEED_TOL_RAD_S,
+)
 from press.dynamics import drive_state
 
-ANGLE_TOL = 1e-6  # [rad] key angles and cycle closure
-SPEED_TOL = 1e-9  # [rad/s] continuity and constant-speed draw
-ACCEL_CLOSE_TOL = 1e-6  # [rad/s^2] the acceleration at the cycle's two ends
-ENERGY_REL_TOL = 1e-6  # energy balance, relative to the larger of the forming work and integral |T_c omega| dt
-CONTINUITY_TOL = 1e-9  # [rad/s, rad/s^2] jump allowed at a knot (beyond the O(eps^2) remainder)
-__all__ = ["BINDING_SHARE", "Check", "CheckId", "Verification", "assess", "field_of_check", "verify"]
+__all__ = ["BINDING_SHARE", "Check", "CheckId", "Evaluation", "Verification", "evaluate", "field_of_check", "verify"]
 
 
 class CheckId(str, enum.Enum):
@@ -85,44 +90,96 @@ class Verification:
         return next((c for c in self.checks if c.id == check_id), None)
 
 
+@dataclass(frozen=True)
+class Evaluation:
+    """A plan re-simulated densely against a case, once: what every output reads (pvlib's
+    ``ModelChainResult``: one field per step, computed once and carried).
+
+    ``samples``: the dense re-simulation (:class:`~planning.model.limits.base.Dense`: times from TDC, the
+    crank's and the slide's motion, with a drive its state and the cycle's integrals, with the drive's
+    electrical side its power chain and ``power_columns`` at the samples); ``uniform``: the indices of the
+    samples on the uniform grid (the knots are the others); ``verification``: every check, each with where
+    it peaked; ``drive``: the drive's figures (a case with a drive)."""
+
+    samples: Dense
+    uniform: np.ndarray
+    verification: Verification
+    drive: DriveFigures | None = None
+    power_columns: dict[str, np.ndarray] | None = field(default=None, repr=False)
+
+    def rows(self, most: int) -> np.ndarray:
+        """Indices of at most ``most`` + 1 samples on the uniform grid, evenly spaced, both ends included
+        (every uniform sample when there are no more)."""
+        stride = max(1, math.ceil((self.uniform.size - 1) / most))
+        picked = self.uniform[::stride]
+        return picked if picked[-1] == self.uniform[-1] else np.append(picked, self.uniform[-1])
+
+
 def verify(plan: Plan, case: Case) -> Verification:
     """Re-simulate ``plan`` densely and check it against the limits of ``case``."""
-    return assess(plan, case)[0]
+    return evaluate(plan, case).verification
 
 
-def assess(plan: Plan, case: Case, least_energy: bool = True) -> tuple[Verification, DriveFigures | None]:
-    """:func:`verify`, and with a drive the drive's figures of the plan from the same evaluation.
-    ``least_energy`` False: with a storage, its lazy schedule at the least grid peak instead of the one that
-    draws the least energy (``planning.solver.grid.shave``): the same peak and checks, in O(N) (a search's
-    verifications; its answer is assessed in full, ``planning.solver.search.Search.answer``)."""
+def evaluate(plan: Plan, case: Case, least_energy: bool = True) -> Evaluation:
+    """The :class:`Evaluation` of ``plan`` against ``case``: the dense re-simulation, every check, the
+    drive's figures. ``least_energy`` False: with a storage, its lazy schedule at the least grid peak
+    instead of the one that draws the least energy (``planning.solver.peak_shaving.shave``): the same peak
+    and checks, in O(N) (a search's verifications; its answer then takes :func:`with_least_energy`)."""
+    dense, uniform = simulate(plan, case)
+    if case.drive is not None and case.electrical:
+        dense.power = power_figures(plan.profile, case, dense.t, dense.drive_state, least_energy)
+    return _judged(dense, uniform)
+
+
+def simulate(plan: Plan, case: Case) -> tuple[Dense, np.ndarray]:
+    """The dense re-simulation of ``plan`` (the one evaluation of a plan's profile that every check and
+    output reads): the profile in closed form on the uniform grid of at most 1 ms and every knot, the
+    slide's motion, with a drive its state and the cycle's integrals; and the uniform grid's indices."""
     prof = plan.profile
-    P = plan.period
-    t = dense_times(P, prof.knot_times)
+    t, uniform = sample_times(plan.period, prof.knot_times)
     th, om, al, je = prof.at_time(t)
-    h, v, a, _ = case.machine.slider(th, om, al, je)
-    dense = Dense(case, plan, t, th, om, al, je, h, v, a, plan.key_times())
+    h, v, a, slide_jerk = case.machine.slider(th, om, al, je)
+    key_times = plan.key_times()
+    dense = Dense(case, plan, t, th, om, al, je, h, v, a, key_times, slide_jerk=slide_jerk)
+    k_th, k_om, k_al, k_je = prof.at_time(key_times)
+    k_h, k_v, _, _ = case.machine.slider(k_th, k_om, k_al, k_je)
+    dense.key_motion = {"omega": k_om, "h": k_h, "v": k_v}
     if case.drive is not None:
         dense.drive_state = drive_state(th, om, al, case.machine, case.drive_model)
         dense.integrals = cycle_integrals(prof, case)
-        if case.electrical:
-            dense.power = power_figures(prof, case, t, dense.drive_state, least_energy)
+    return dense, uniform
+
+
+def with_least_energy(evaluation: Evaluation) -> Evaluation:
+    """``evaluation`` with the storage's least-energy schedule (its samples as they were; the power chain
+    and the checks again): the answer of a search whose verifications took the lazy one."""
+    dense = replace(evaluation.samples)
+    dense.power = power_figures(dense.plan.profile, dense.case, dense.t, dense.drive_state, True)
+    return _judged(dense, evaluation.uniform)
+
+
+def _judged(dense: Dense, uniform: np.ndarray) -> Evaluation:
+    """The checks of the cycle, of each limit and of the drive's balances on ``dense``; the drive's figures."""
+    case = dense.case
     checks = _cycle_checks(dense)
     for limit in limits_of(case):
         checks += limit.check(dense)
     if case.drive is not None:
         checks.append(_energy_balance(dense.integrals))
+    columns = None
     if dense.power is not None:
         checks += _power_checks(dense.power, dense.integrals, case.drive.storage is not None)
-    verification = Verification(tuple(checks), float(np.max(np.diff(t))), int(t.size))
+        columns = power_columns(dense.power.schedule, dense.drive_state, dense.t, case)
+    verification = Verification(tuple(checks), float(np.max(np.diff(dense.t))), int(dense.t.size))
     figures = None
     if case.drive is not None:
-        figures = drive_figures(prof, case, dense.integrals, (th, dense.drive_state))
+        figures = drive_figures(dense.plan.profile, case, dense.integrals, (dense.theta, dense.drive_state))
         figures = replace(figures, power=dense.power)
-    return verification, figures
+    return Evaluation(dense, uniform, verification, figures, columns)
 
 
 def schedule_matters(case: Case) -> bool:
-    """Whether :func:`assess`'s ``least_energy`` changes anything for ``case`` (a storage on the bus)."""
+    """Whether :func:`evaluate`'s ``least_energy`` changes anything for ``case`` (a storage on the bus)."""
     return case.drive is not None and case.drive.storage is not None
 
 
@@ -169,24 +226,25 @@ def _cycle_checks(d: Dense) -> list[Check]:
     checks.append(Check.of(CheckId.FINITE, "trajectory finite", 1.0 if finite else math.nan, 1.0, "", "equal", 0.0))
     end = prof.at_time(np.array([0.0, P]))
     turn = math.degrees(end[0][1] - end[0][0])
-    checks.append(Check.of(CheckId.CYCLE_ANGLE, "cycle angle", turn, 360.0, "deg", "equal", math.degrees(ANGLE_TOL)))
+    tol = math.degrees(ANGLE_TOL_RAD)
+    checks.append(Check.of(CheckId.CYCLE_ANGLE, "cycle angle", turn, 360.0, "deg", "equal", tol))
     closes = (end[1][1] - end[1][0]) / RPM
-    checks.append(Check.of(CheckId.SPEED_CLOSES, "speed closes", closes, 0.0, "rpm", "equal", SPEED_TOL / RPM))
+    checks.append(Check.of(CheckId.SPEED_CLOSES, "speed closes", closes, 0.0, "rpm", "equal", SPEED_TOL_RAD_S / RPM))
     accel = end[2][1] - end[2][0]
     checks.append(
-        Check.of(CheckId.ACCEL_CLOSES, "acceleration closes", accel, 0.0, "rad/s^2", "equal", ACCEL_CLOSE_TOL)
+        Check.of(CheckId.ACCEL_CLOSES, "acceleration closes", accel, 0.0, "rad/s^2", "equal", ACCEL_CLOSE_TOL_RAD_S2)
     )
     checks += _continuity(prof)
     th_key = prof.at_time(d.key_times)[0]
     err = float(np.max(np.abs(th_key - np.array(d.plan.key_angles))))
-    tol = math.degrees(ANGLE_TOL)
+    tol = math.degrees(ANGLE_TOL_RAD)
     checks.append(Check.of(CheckId.KEY_ANGLES, "key angles reached", math.degrees(err), 0.0, "deg", "equal", tol))
     _, t2, t3, _ = d.key_times
     draw = (d.t >= t2) & (d.t <= t3)
     w2 = float(d.plan.parameters.draw_speed)
     off = float(np.max(np.abs(d.omega[draw] - w2))) / RPM
     name = "draw at constant crank speed"
-    checks.append(Check.of(CheckId.DRAW_CONSTANT, name, off, 0.0, "rpm", "equal", SPEED_TOL / RPM))
+    checks.append(Check.of(CheckId.DRAW_CONSTANT, name, off, 0.0, "rpm", "equal", SPEED_TOL_RAD_S / RPM))
     return checks
 
 
@@ -198,7 +256,7 @@ def _continuity(prof) -> list[Check]:  # noqa: ANN001 - a Profile
     if not knots.size:
         return []
     T = prof.durations
-    eps = np.minimum(1e-7, 0.25 * np.minimum(T[:-1], T[1:]))
+    eps = np.minimum(KNOT_PROBE_S, 0.25 * np.minimum(T[:-1], T[1:]))
     left, right = prof.at_time(knots - eps), prof.at_time(knots + eps)
     j_max = max_abs_jerk(prof)
     j1_max = max(_max_jerk_rate(s) for s in prof.segments)
@@ -212,7 +270,7 @@ def _continuity(prof) -> list[Check]:  # noqa: ANN001 - a Profile
             0.0,
             "rad/s",
             "equal",
-            CONTINUITY_TOL + 1e-14 * j_max,
+            CONTINUITY_TOL + ROUND_OFF_REL * j_max,
         ),
         Check.of(
             CheckId.ACCEL_CONTINUOUS,
@@ -221,7 +279,7 @@ def _continuity(prof) -> list[Check]:  # noqa: ANN001 - a Profile
             0.0,
             "rad/s^2",
             "equal",
-            CONTINUITY_TOL + 1e-14 * j1_max,
+            CONTINUITY_TOL + ROUND_OFF_REL * j1_max,
         ),
     ]
 

@@ -1,8 +1,10 @@
 """``pressplan serve``: a local web page to plan a press motion, on Flask, with plotly.js for the charts.
 
 The page (``static/``) sends the case it shows as JSON; every answer comes from the same functions as
-the CLI: ``case_from_data`` (the validated reader), ``solve``, ``time_optimal_bound``, ``result_dict``,
-``solution_writers``. Nothing here solves or checks on its own.
+the CLI: ``case_from_data`` (the validated reader), ``solve``, ``time_optimal_bound``, ``result_dict``, the
+outputs' registry (``planning.reports.outputs``: the downloads). Nothing here solves, checks or evaluates a
+plan on its own: the charts and the files read the plan's evaluation, made once by its verification. Every
+answer's ``status`` is an :class:`~planning.model.outcome.Outcome`.
 
 Safety: the server binds to 127.0.0.1 unless told otherwise; a request body is at most
 :data:`MAX_REQUEST_BYTES`; an uploaded case goes through the reader's limits (256 kB, depth, values);
@@ -41,7 +43,9 @@ from werkzeug.exceptions import HTTPException
 from planning.model.case import OBJECTIVES, Case
 from planning.model.case_file import MAX_BYTES, CaseFileError, case_from_data, load_yaml, read_case
 from planning.model.laws import LAWS
+from planning.model.outcome import Outcome
 from planning.reports.new_case import MECHANISMS, drive_template
+from planning.reports.outputs import downloads
 
 STATIC = Path(__file__).resolve().parent / "static"
 MAX_REQUEST_BYTES = 2 * MAX_BYTES  # a case as JSON, with the page's own fields
@@ -51,7 +55,6 @@ DRAWING_STEP_DEG = 2.0  # [deg] the mechanism's drawing is sent at every such cr
 BOUND_CACHE = 32
 ANSWER_CACHE = 32  # confirmed answers kept by case (each about 0.2 MB with its curves and solution)
 SOLVES_AT_ONCE = 2  # solves running at once; IPOPT takes one call at a time per process, so two interleave
-DOWNLOADS = ("result.json", "trajectory.csv", "cam_table.csv")
 
 
 @dataclass
@@ -142,6 +145,22 @@ def case_files(folder: Path | None) -> dict[str, Path]:
     return {p.name: p for p in sorted(folder.glob("*.yaml")) if p.is_file()}
 
 
+@dataclass
+class _Shared:
+    """What the requests of every session share: the case files ``offered`` by name, the ``sessions``, the two
+    solve ``queues``, the confirmed ``answers`` and the ``bounds`` kept by case key (each with its lock), and
+    the bounds' worker process."""
+
+    offered: dict[str, Path]
+    sessions: Sessions = field(default_factory=Sessions)
+    queues: dict[str, FairQueue] = field(default_factory=lambda: {"fast": FairQueue(), "cold": FairQueue()})
+    answers: OrderedDict = field(default_factory=OrderedDict)  # case key -> (answer, case, solution)
+    answers_lock: threading.Lock = field(default_factory=threading.Lock)
+    bounds: OrderedDict = field(default_factory=OrderedDict)
+    bounds_lock: threading.Lock = field(default_factory=threading.Lock)
+    bound_pool: Any = None
+
+
 def create_app(
     cases_dir: Path | None = None, initial: Path | None = None, allowed_hosts: tuple[str, ...] = ()
 ) -> Flask:
@@ -152,20 +171,21 @@ def create_app(
     logging.getLogger("werkzeug").setLevel(logging.WARNING)  # no line per request
     app = Flask(__name__, static_folder=None)
     app.config["MAX_CONTENT_LENGTH"] = MAX_REQUEST_BYTES
-    bound_pool = _BoundPool()
-    app.extensions["pressplan_bound_pool"] = bound_pool  # serve() stops its worker on the way out
-    sessions = Sessions()
-    app.extensions["pressplan_sessions"] = sessions  # the tests hold a session's lock to see superseding
-    queues = {"fast": FairQueue(), "cold": FairQueue()}  # the edits' fast answers never wait behind cold solves
-    app.extensions["pressplan_queues"] = queues
-    answers: OrderedDict[str, tuple[dict, Any, Any]] = OrderedDict()  # case key -> (answer, case, solution)
-    answers_lock = threading.Lock()
-    bounds: OrderedDict[str, dict] = OrderedDict()
-    bounds_lock = threading.Lock()
     offered = case_files(cases_dir)
     if initial is not None:
         offered = {initial.name: initial, **{k: v for k, v in offered.items() if k != initial.name}}
+    shared = _Shared(offered, bound_pool=_BoundPool())
+    app.extensions["pressplan_bound_pool"] = shared.bound_pool  # serve() stops its worker on the way out
+    app.extensions["pressplan_sessions"] = shared.sessions  # the tests hold a session's lock to see superseding
+    app.extensions["pressplan_queues"] = shared.queues  # the edits' fast answers never wait behind cold solves
+    _guard(app, allowed_hosts)
+    _page_routes(app, shared)
+    _solve_routes(app, shared)
+    return app
 
+
+def _guard(app: Flask, allowed_hosts: tuple[str, ...]) -> None:
+    """Only this machine's names and the address served; every error answered as JSON the page reads."""
     allowed = {"localhost", "127.0.0.1", "::1", *allowed_hosts}
     everyone = bool(allowed & {"0.0.0.0", "::"})  # bound to every address: the user opened it to the network
 
@@ -176,18 +196,23 @@ def create_app(
         host = _hostname(request.host or "")
         if everyone or host in allowed:
             return None
-        return jsonify({"status": "bad input", "message": f"host {host!r} is not served here"}), 403
+        return jsonify({"status": Outcome.BAD_INPUT, "message": f"host {host!r} is not served here"}), 403
 
     @app.errorhandler(BadRequest)
     def bad_request(exc: BadRequest) -> Response:
-        return jsonify({"status": "bad input", "message": str(exc)}), 400
+        return jsonify({"status": Outcome.BAD_INPUT, "message": str(exc)}), 400
 
     @app.errorhandler(HTTPException)
     def http_error(exc: HTTPException) -> Response:
         """Every HTTP error as JSON the page reads (413 too large, 404 no such route, 405 wrong method)."""
         messages = {413: f"the request is larger than {MAX_REQUEST_BYTES} bytes"}
         message = messages.get(exc.code, f"{exc.code} {exc.name}")
-        return jsonify({"status": "bad input", "message": message}), exc.code
+        return jsonify({"status": Outcome.BAD_INPUT, "message": message}), exc.code
+
+
+def _page_routes(app: Flask, shared: _Shared) -> None:
+    """The page, its static files, what it offers (``/api/meta``), the cases by name and uploads."""
+    offered = shared.offered
 
     @app.get("/")
     def index() -> Response:
@@ -211,6 +236,8 @@ def create_app(
                 "placements": ["free", "published"],
                 "fields": field_specs(),
                 "drive_templates": {kind: drive_template(kind) for kind in MECHANISMS},
+                "outcomes": {outcome.name: outcome.value for outcome in Outcome},
+                "downloads": [{"name": o.name, "title": o.title} for o in downloads()],
             }
         )
 
@@ -218,18 +245,18 @@ def create_app(
     def load_case(name: str) -> Response:
         path = offered.get(name)
         if path is None:
-            return jsonify({"status": "bad input", "message": f"{name}: no such case here"}), 404
+            return jsonify({"status": Outcome.BAD_INPUT, "message": f"{name}: no such case here"}), 404
         try:
             case = read_case(path)
         except CaseFileError as exc:
-            return jsonify({"status": "bad input", "message": str(exc), "field": exc.field}), 400
-        return jsonify({"status": "ok", "label": _label(path), "case": _data(case)})
+            return jsonify({"status": Outcome.BAD_INPUT, "message": str(exc), "field": exc.field}), 400
+        return jsonify({"label": _label(path), "case": _data(case)})
 
     @app.post("/api/upload")
     def upload() -> Response:
         file = request.files.get("file")
         if file is None:
-            return jsonify({"status": "bad input", "message": "no file sent"}), 400
+            return jsonify({"status": Outcome.BAD_INPUT, "message": "no file sent"}), 400
         name = Path(file.filename or "upload.yaml").name[:100]
         blob = file.read(MAX_BYTES + 1)
         try:
@@ -241,46 +268,24 @@ def create_app(
                 raise CaseFileError(f"{name}: not UTF-8 text, expected a YAML case") from None
             case = case_from_data(load_yaml(text, name), name)
         except CaseFileError as exc:
-            return jsonify({"status": "bad input", "message": str(exc), "field": exc.field}), 400
-        return jsonify({"status": "ok", "label": name, "case": _data(case)})
+            return jsonify({"status": Outcome.BAD_INPUT, "message": str(exc), "field": exc.field}), 400
+        return jsonify({"label": name, "case": _data(case)})
+
+
+def _solve_routes(app: Flask, shared: _Shared) -> None:
+    """The solves (fast, then confirmed), the bound, the downloads of the confirmed plan."""
 
     @app.post("/api/solve")
     def solve_endpoint() -> Response:
         body = _body()
         key = str(body.get("session", ""))[:80]
-        session = sessions.get(key)
+        session = shared.sessions.get(key)
         seq = int(body.get("seq", 0)) if isinstance(body.get("seq", 0), int) else 0
-        label = _label_of(body)
         with session.guard:
             session.newest = max(session.newest, seq)
-
-        def work() -> dict[str, Any]:
-            with session.lock:
-                if seq < session.newest:
-                    return {"status": "superseded"}
-                data = body.get("case")
-                known = case_key({"label": label, "case": data})
-                with answers_lock:
-                    hit = answers.get(known)
-                    if hit is not None:
-                        answers.move_to_end(known)
-                if hit is not None:  # this case's confirmed answer, from any tab: no solve
-                    answer, case, solution = hit
-                    session.plan = solution.plan
-                    with session.guard:
-                        session.shown = (case_key(data), case, solution)
-                    return dict(answer)
-                answer = solve_case(data, label, session, body.get("confirm") is True)
-                if answer.get("confirmed") and answer["status"] == "verified":
-                    with answers_lock:
-                        answers[known] = (answer, *session.shown[1:])
-                        while len(answers) > ANSWER_CACHE:
-                            answers.popitem(last=False)
-                return answer
-
         fast = body.get("confirm") is not True and session.plan is not None  # else solve_case solves cold
-        answer = queues["fast" if fast else "cold"].run(key, seq, work)
-        answer = {"status": "superseded"} if answer is SUPERSEDED else answer
+        answer = shared.queues["fast" if fast else "cold"].run(key, seq, lambda: _answer(shared, session, body, seq))
+        answer = {"status": Outcome.INTERRUPTED} if answer is SUPERSEDED else answer
         return jsonify({**answer, "seq": seq})
 
     @app.post("/api/bound")
@@ -288,14 +293,14 @@ def create_app(
         body = _body()
         data = body.get("case")
         key = case_key(data)
-        with bounds_lock:
-            if key in bounds:
-                return jsonify(bounds[key])
-        answer = bound_pool.run(data, _label_of(body))
-        with bounds_lock:
-            bounds[key] = answer
-            while len(bounds) > BOUND_CACHE:
-                bounds.popitem(last=False)
+        with shared.bounds_lock:
+            if key in shared.bounds:
+                return jsonify(shared.bounds[key])
+        answer = shared.bound_pool.run(data, _label_of(body))
+        with shared.bounds_lock:
+            shared.bounds[key] = answer
+            while len(shared.bounds) > BOUND_CACHE:
+                shared.bounds.popitem(last=False)
         return jsonify(answer)
 
     @app.post("/api/download/<name>")
@@ -305,18 +310,44 @@ def create_app(
         try:
             case = case_from_data(body.get("case"), label)
         except CaseFileError as exc:
-            return jsonify({"status": "bad input", "message": str(exc), "field": exc.field}), 400
+            return jsonify({"status": Outcome.BAD_INPUT, "message": str(exc), "field": exc.field}), 400
         if name == "case.yaml":
             text = yaml.safe_dump(_data(case), sort_keys=False, allow_unicode=True)
             return Response(text, mimetype="application/x-yaml", headers=_attachment(f"{case.name}.yaml"))
-        if name not in DOWNLOADS:
-            return jsonify({"status": "bad input", "message": f"{name}: no such file"}), 404
-        session = sessions.get(str(body.get("session", ""))[:80])
+        if name not in {o.name for o in downloads()}:
+            return jsonify({"status": Outcome.BAD_INPUT, "message": f"{name}: no such file"}), 404
+        session = shared.sessions.get(str(body.get("session", ""))[:80])
         with session.guard:
             shown = session.shown
         return files_of(shown, body.get("case"), label, name)
 
-    return app
+
+def _answer(shared: _Shared, session: Session, body: dict[str, Any], seq: int) -> dict[str, Any]:
+    """One solve request of ``session`` when its turn comes: interrupted when a newer one of the session came
+    first; this case's confirmed answer when one is kept (from any tab: no solve); else the solve's."""
+    with session.lock:
+        if seq < session.newest:
+            return {"status": Outcome.INTERRUPTED}
+        data = body.get("case")
+        label = _label_of(body)
+        known = case_key({"label": label, "case": data})
+        with shared.answers_lock:
+            hit = shared.answers.get(known)
+            if hit is not None:
+                shared.answers.move_to_end(known)
+        if hit is not None:  # this case's confirmed answer, from any tab: no solve
+            answer, case, solution = hit
+            session.plan = solution.plan
+            with session.guard:
+                session.shown = (case_key(data), case, solution)
+            return dict(answer)
+        answer = solve_case(data, label, session, body.get("confirm") is True)
+        if answer.get("confirmed") and answer["status"] is Outcome.VERIFIED:
+            with shared.answers_lock:
+                shared.answers[known] = (answer, *session.shown[1:])
+                while len(shared.answers) > ANSWER_CACHE:
+                    shared.answers.popitem(last=False)
+        return answer
 
 
 def _hostname(host: str) -> str:
@@ -327,7 +358,7 @@ def _hostname(host: str) -> str:
 
 
 class BadRequest(Exception):
-    """A request the page never sends: answered 400 with ``{"status": "bad input", "message": ...}``."""
+    """A request the page never sends: answered 400 with ``{"status": Outcome.BAD_INPUT, "message": ...}``."""
 
 
 MAX_JSON_DEPTH = 32  # a request nests 4 deep (case -> section -> table -> row); deeper is refused unparsed
@@ -435,14 +466,14 @@ def solve_case(data: Any, label: str, session: Session, confirm: bool = True) ->
     """Validate and solve ``data`` from the session's last plan; the page's answer. ``confirm`` False: the
     fast answer from the last plan alone when it verifies (``confirmed`` False in the answer: the page
     then asks again with ``confirm``); else the cold solve's answer or better (``confirmed`` True)."""
-    from planning.reports.report import result_dict, sample_profile, summary_text, trajectory_columns
+    from planning.reports.report import columns_at, result_dict, summary_text
     from planning.solver.optimize import solve, solve_from
     from planning.solver.outcomes import Infeasible, PlanningError
 
     try:
         case = case_from_data(data, label)
     except CaseFileError as exc:
-        return {"status": "bad input", "message": str(exc), "field": exc.field}
+        return {"status": Outcome.BAD_INPUT, "message": str(exc), "field": exc.field}
     try:
         solution = None
         if not confirm and session.plan is not None:
@@ -452,19 +483,16 @@ def solve_case(data: Any, label: str, session: Session, confirm: bool = True) ->
             solution = solve(case, neighbour=session.plan)  # the cold solve's answer or better
     except PlanningError as exc:
         limit = exc.limit if isinstance(exc, Infeasible) else None
-        return {"status": exc.kind, "message": f"{label}: {exc}", "field": limit, "confirmed": True}
+        return {"status": exc.outcome, "message": f"{label}: {exc}", "field": limit, "confirmed": True}
     session.plan = solution.plan
     if confirmed:  # the downloads' plan: the last confirmed one (a fast answer on screen is confirmed next)
         with session.guard:
             session.shown = (case_key(data), case, solution)
     result = result_dict(solution, case)
-    plan = solution.plan
-    power = solution.drive.power if solution.drive is not None else None
-    table = sample_profile(plan.profile, case.machine, plan.period / CHART_POINTS, case, power and power.schedule)
-    columns = dict(zip(trajectory_columns(case), table.T, strict=True))
+    columns = columns_at(solution.evaluation, case, solution.evaluation.rows(CHART_POINTS))
     curves = {name: _rounded(col) for name, col in columns.items()}
     return {
-        "status": "verified",
+        "status": Outcome.VERIFIED,
         "confirmed": confirmed,
         "result": _finite(result),
         "curves": curves,
@@ -527,7 +555,7 @@ class _BoundPool:
         try:
             return self._pool.submit(bound_of, data, label).result()
         except Exception as exc:  # noqa: BLE001 - the bound is extra information: say why it is missing
-            return {"status": "none", "message": f"no bound ({type(exc).__name__})"}
+            return {"message": f"no bound ({type(exc).__name__})"}
 
     def close(self) -> None:
         """Stop the worker process now (a bound under way is dropped)."""
@@ -556,8 +584,8 @@ def bound_of(data: Any, label: str) -> dict[str, Any]:
         upper = upper_bound(case, LAWS_UPPER_POINTS, LAWS_UPPER_PIECES)
         grid = time_optimal_bound(case)
     except (CaseFileError, PlanningError) as exc:
-        return {"status": "none", "message": str(exc)}
-    return {"status": "ok", "spm": grid.spm, "upper_spm": upper.spm, "left_out": list(upper.left_out)}
+        return {"message": str(exc)}
+    return {"spm": grid.spm, "upper_spm": upper.spm, "left_out": list(upper.left_out)}
 
 
 def case_key(data: Any) -> str:
@@ -566,18 +594,20 @@ def case_key(data: Any) -> str:
 
 
 def files_of(shown: tuple[str, Any, Any] | None, data: Any, label: str, name: str) -> tuple[Response, int] | Response:
-    """One file of the confirmed plan on screen, as ``pressplan solve`` writes it (the same writers; no
-    solve here); 409 when the case sent is not the one whose confirmed plan is shown."""
-    from planning.reports.outputs import solution_writers
+    """One file of the confirmed plan on screen, as ``pressplan solve`` writes it (that output's writer
+    alone; no solve here); 409 when the case sent is not the one whose confirmed plan is shown."""
+    from planning.reports.outputs import writer_of
 
     if shown is None or shown[0] != case_key(data):
         message = f"{label}: no confirmed plan of this case on the page yet; wait for the plan, then download"
-        return jsonify({"status": "bad input", "message": message}), 409
+        return jsonify({"status": Outcome.BAD_INPUT, "message": message}), 409
     _, case, solution = shown
-    writers = solution_writers(solution, case, plot_format=None)
+    write = writer_of(solution, case, name)
+    if write is None:
+        return jsonify({"status": Outcome.BAD_INPUT, "message": f"{name}: this plan has no such file"}), 404
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / name
-        writers[name](path)
+        write(path)
         blob = path.read_bytes()
     mime = "application/json" if name.endswith(".json") else "text/csv"
     return Response(blob, mimetype=mime, headers=_attachment(name))

@@ -26,24 +26,23 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 
 from planning.model.units import RPM
+from planning.tolerances import BINDING_SHARE, SAME_RELATIVE, TINY_SCALE
 from press.backend import math_module
 
-REL_TOL = 1e-6  # relative tolerance of every dense check of a limit (the README's numerical contract)
-TIME_TOL = 1e-6  # [s] a time limit
-BINDING_SHARE = 1e-4  # relative: a check within this share of its limit binds (the reports' binding list)
 DRAW_GRID = 4001  # angles from theta2 to theta3 on which the draw-speed bounds are taken
 
 
 @dataclass(frozen=True)
 class Check:
     """One verified constraint ``id`` (display ``name``): measured ``value`` against ``limit`` (``kind``
-    max|min|equal) in ``unit``."""
+    max|min|equal) in ``unit``; where on the cycle it peaked (:class:`Peak`, None for a figure of the whole
+    cycle)."""
 
     name: str
     value: float
@@ -55,6 +54,7 @@ class Check:
     refine_by: tuple[str, float, float] | None = field(default=None, compare=False)  # (NLP parameter,
     # factor, ceiling): this check's failure sets the parameter to min(itself, ceiling) x factor (the grid's
     # cap or storage allowance; None: the limit's refined parameter lowered by limit / value, the overshoot)
+    peak: Peak | None = field(default=None, compare=False)
 
     @classmethod
     def of(cls, check_id: str, name: str, value: float, limit: float, unit: str, kind: str, tol: float) -> Check:
@@ -82,14 +82,48 @@ class Check:
     @property
     def binds(self) -> bool:
         """An inequality that sits at its limit, within :data:`BINDING_SHARE` of it."""
-        return self.kind in ("max", "min") and abs(self.margin) <= BINDING_SHARE * max(abs(self.limit), 1e-12)
+        return self.kind in ("max", "min") and abs(self.margin) <= BINDING_SHARE * max(abs(self.limit), TINY_SCALE)
+
+    def located(self, t: np.ndarray, theta: np.ndarray, values: np.ndarray, scale: float) -> Check:
+        """This check with where it peaked: ``values`` (the checked quantity at times ``t`` [s from TDC] and
+        crank angles ``theta`` [rad]) at their extreme, and the spans of samples within :data:`BINDING_SHARE`
+        of ``scale`` (the limit's size) of it."""
+        if not len(values):
+            return self
+        low = self.kind == "min"
+        k = int(np.argmin(values) if low else np.argmax(values))
+        room = BINDING_SHARE * max(abs(scale), TINY_SCALE)
+        near = values <= values[k] + room if low else values >= values[k] - room
+        return replace(self, peak=Peak(float(t[k]), float(math.degrees(theta[k])) % 360.0, spans(t, near)))
 
     def as_dict(self) -> dict:
         """The check as ``result.json`` writes it (stable id, display name, value, limit, unit, kind, passed,
-        margin): a script finds a check by its ``id``, the name is for people."""
+        margin; where it peaked: ``peak_time_s`` from TDC and ``peak_angle_deg``, None for a figure of the
+        whole cycle): a script finds a check by its ``id``, the name is for people."""
         out = asdict(self)
         out.pop("refine_by")
-        return {"id": out.pop("id"), **out, "margin": self.margin}
+        out.pop("peak")
+        place = {"peak_time_s": None, "peak_angle_deg": None}
+        if self.peak is not None:
+            place = {"peak_time_s": self.peak.time_s, "peak_angle_deg": self.peak.angle_deg}
+        return {"id": out.pop("id"), **out, "margin": self.margin, **place}
+
+
+class Peak(NamedTuple):
+    """Where a check's quantity peaked: ``time_s`` [s from TDC] and ``angle_deg`` [deg from TDC] of its
+    extreme on the dense samples, and ``spans`` ((start, end) [s] runs of samples within
+    :data:`BINDING_SHARE` of the limit of the extreme: where it binds when it binds)."""
+
+    time_s: float
+    angle_deg: float
+    spans: tuple[tuple[float, float], ...]
+
+
+def spans(t: np.ndarray, mask: np.ndarray) -> tuple[tuple[float, float], ...]:
+    """The runs of ``mask`` over the times ``t`` as ``(first, last)`` time pairs [s]."""
+    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
+    starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
+    return tuple((float(t[a]), float(t[b])) for a, b in zip(starts, ends, strict=True))
 
 
 class Row(NamedTuple):
@@ -164,7 +198,8 @@ class Dense:
     ``theta``, ``omega``, ``alpha``, ``jerk``, the slide's ``h``, ``v``, ``a`` there; the key points'
     times ``key_times`` [s]; the ``plan`` and the ``case``; with a drive, the drive's state on the grid
     (``drive_state``, ``press.dynamics.drive_state``) and the cycle's integrals (``integrals``,
-    ``planning.model.drive.cycle_integrals``); with the drive's electrical side, its power chain (``power``)."""
+    ``planning.model.drive.cycle_integrals``); with the drive's electrical side, its power chain (``power``);
+    the crank speed and the slide at the key points' exact times (``key_motion``: ``omega``, ``h``, ``v``)."""
 
     case: Any
     plan: Any
@@ -180,6 +215,8 @@ class Dense:
     drive_state: dict | None = None
     integrals: dict | None = None
     power: Any = None  # the power chain to the grid (planning.model.drive.PowerFigures), drive.electrical
+    slide_jerk: np.ndarray | None = None  # [mm/s^3] the slide's jerk at the samples
+    key_motion: dict | None = None  # at the key points' times: crank speed [rad/s], slide height [mm], speed [mm/s]
 
 
 @dataclass
@@ -310,12 +347,12 @@ class Limit:
         above the top crank speed the limit sets (:meth:`top_crank_speed`), or, with
         ``refuses_draw_speed_above_bound``, above its draw-speed bound."""
         top = self.top_crank_speed(draw.case)
-        if top is not None and speed > top * (1 + 1e-12):
+        if top is not None and speed > top * (1 + SAME_RELATIVE):
             return f"is above the {top / RPM:.6g} rpm on the crank that {self.field} allows"
         if not self.refuses_draw_speed_above_bound:
             return None
         bound = self.draw_speed_bound(draw)
-        if bound is None or speed <= bound * (1 + 1e-12):
+        if bound is None or speed <= bound * (1 + SAME_RELATIVE):
             return None
         return f"is above the {bound / RPM:.3f} rpm that {self.field} allows"
 

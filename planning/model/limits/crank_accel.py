@@ -8,7 +8,6 @@ import numpy as np
 from pydantic import Field
 
 from planning.model.limits.base import (
-    REL_TOL,
     BoundGrid,
     Check,
     Dense,
@@ -19,6 +18,7 @@ from planning.model.limits.base import (
     Transcription,
 )
 from planning.model.units import CrankAccel
+from planning.tolerances import LIMIT_REL_TOL
 
 
 class CrankAccelLimit(Limit):
@@ -55,8 +55,9 @@ class CrankAccelLimit(Limit):
 
     def check(self, dense: Dense) -> list[Check]:
         limit = dense.case.limits.crank_accel_rad_s2
-        peak = float(np.max(np.abs(dense.alpha)))
-        return [Check.of(self.id, self.name, peak, limit, self.unit, "max", REL_TOL * limit)]
+        accel = np.abs(dense.alpha)
+        check = Check.of(self.id, self.name, float(np.max(accel)), limit, self.unit, "max", LIMIT_REL_TOL * limit)
+        return [check.located(dense.t, dense.theta, accel, limit)]
 
     def bound_rows(self, grid: BoundGrid) -> list[tuple[Any, Any, Any]]:
         limit = grid.case.limits.crank_accel_rad_s2

@@ -8,7 +8,6 @@ import numpy as np
 from pydantic import Field
 
 from planning.model.limits.base import (
-    REL_TOL,
     BoundGrid,
     Check,
     Dense,
@@ -20,6 +19,7 @@ from planning.model.limits.base import (
 )
 from planning.model.profile import max_abs_jerk
 from planning.model.units import CrankJerk
+from planning.tolerances import LIMIT_REL_TOL
 
 
 class CrankJerkLimit(Limit):
@@ -60,7 +60,8 @@ class CrankJerkLimit(Limit):
     def check(self, dense: Dense) -> list[Check]:
         limit = dense.case.limits.crank_jerk_rad_s3
         peak = max_abs_jerk(dense.plan.profile)
-        return [Check.of(self.id, self.name, peak, limit, self.unit, "max", REL_TOL * limit)]
+        check = Check.of(self.id, self.name, peak, limit, self.unit, "max", LIMIT_REL_TOL * limit)
+        return [check.located(dense.t, dense.theta, np.abs(dense.jerk), limit)]
 
     def bound_rows(self, grid: BoundGrid) -> list[tuple[Any, Any, Any]]:
         """Neighbouring intervals' accelerations differ by at most J times half their joint time."""

@@ -8,8 +8,9 @@ import numpy as np
 from pydantic import Field
 
 from planning.model.errors import CaseError
-from planning.model.limits.base import REL_TOL, BoundGrid, Check, Dense, Draw, Limit, RelaxedGrid, Row, Transcription
+from planning.model.limits.base import BoundGrid, Check, Dense, Draw, Limit, RelaxedGrid, Row, Transcription
 from planning.model.units import RPM, CrankSpeed
+from planning.tolerances import LIMIT_REL_TOL, SAME_RELATIVE
 
 
 class CrankSpeedLimit(Limit):
@@ -46,7 +47,9 @@ class CrankSpeedLimit(Limit):
 
     def refuse_draw_speed(self, draw: Draw, speed: float) -> str | None:
         top = self.top_crank_speed(draw.case)
-        return f"is above {self.field} = {draw.case.limits.crank_speed_rpm:g}" if speed > top * (1 + 1e-12) else None
+        if speed <= top * (1 + SAME_RELATIVE):
+            return None
+        return f"is above {self.field} = {draw.case.limits.crank_speed_rpm:g}"
 
     def parameter_values(self, case: Any) -> dict[str, float]:
         return {"crank_speed_max": case.limits.crank_speed_rpm * RPM}
@@ -57,7 +60,9 @@ class CrankSpeedLimit(Limit):
 
     def check(self, dense: Dense) -> list[Check]:
         top = dense.case.limits.crank_speed_rpm
-        return [Check.of(self.id, self.name, float(np.max(dense.omega)) / RPM, top, self.unit, "max", REL_TOL * top)]
+        fastest = float(np.max(dense.omega)) / RPM
+        check = Check.of(self.id, self.name, fastest, top, self.unit, "max", LIMIT_REL_TOL * top)
+        return [check.located(dense.t, dense.theta, dense.omega / RPM, top)]
 
     def bound_speeds(self, grid: BoundGrid) -> tuple[np.ndarray | None, np.ndarray | None]:
         top = grid.case.limits.crank_speed_rpm * RPM

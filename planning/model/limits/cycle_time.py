@@ -6,7 +6,8 @@ from typing import Any
 
 import numpy as np
 
-from planning.model.limits.base import TIME_TOL, Check, Dense, Limit, Row, Transcription
+from planning.model.limits.base import Check, Dense, Limit, Row, Transcription
+from planning.tolerances import TIME_TOL_S
 
 
 class CycleTimeLimit(Limit):
@@ -38,5 +39,5 @@ class CycleTimeLimit(Limit):
         if planner.objective == "max-spm" or planner.target_spm is None:
             return []
         return [
-            Check.of(self.id, self.name, dense.plan.period, 60.0 / planner.target_spm, self.unit, "equal", TIME_TOL)
+            Check.of(self.id, self.name, dense.plan.period, 60.0 / planner.target_spm, self.unit, "equal", TIME_TOL_S)
         ]

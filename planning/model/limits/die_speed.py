@@ -10,7 +10,6 @@ from pydantic import Field
 
 from planning.model.errors import CaseError
 from planning.model.limits.base import (
-    REL_TOL,
     BoundGrid,
     Check,
     Dense,
@@ -22,6 +21,7 @@ from planning.model.limits.base import (
     sample_vector,
 )
 from planning.model.units import Height, SliderSpeed
+from planning.tolerances import LIMIT_REL_TOL, SAME_HEIGHT_MM, SAME_RELATIVE
 from press.backend import math_module
 
 
@@ -109,20 +109,21 @@ class DieSpeedLimit(Limit):
         m, lim = case.machine, case.limits
         low = dense.h <= lim.die_height_mm
         crossings = [float(x) for x in m.angles_at_height(min(lim.die_height_mm, m.stroke))]
-        at_crossings = []
-        for angle in crossings:
-            t = plan.profile.time_at_angle(angle)
-            th, om, al, je = plan.profile.at_time(np.array([t]))
-            at_crossings.append(abs(float(m.slider(th, om, al, je)[1][0])))
-        fastest = max(([float(np.max(np.abs(dense.v[low])))] if low.any() else [0.0]) + at_crossings)
-        return [
-            Check.of(self.id, self.name, fastest, lim.die_speed_mm_s, self.unit, "max", REL_TOL * lim.die_speed_mm_s)
-        ]
+        times = np.array([plan.profile.time_at_angle(angle) for angle in crossings])
+        th, om, al, je = plan.profile.at_time(times)
+        at_crossings = np.abs(m.slider(th, om, al, je)[1])
+        fastest = max(([float(np.max(np.abs(dense.v[low])))] if low.any() else [0.0]) + at_crossings.tolist())
+        limit = lim.die_speed_mm_s
+        check = Check.of(self.id, self.name, fastest, limit, self.unit, "max", LIMIT_REL_TOL * limit)
+        speed = np.concatenate([np.abs(dense.v[low]), at_crossings])  # the zone's samples and the crossings, in time
+        t, theta = np.concatenate([dense.t[low], times]), np.concatenate([dense.theta[low], th])
+        order = np.argsort(t, kind="stable")
+        return [check.located(t[order], theta[order], speed[order], limit)]
 
     def bound_speeds(self, grid: BoundGrid) -> tuple[np.ndarray | None, np.ndarray | None]:
         lim = grid.case.limits
         d1, h = grid.d1[:-1], grid.h[:-1]
-        low = (h <= lim.die_height_mm * (1 + 1e-12) + 1e-9) & (np.abs(d1) > 0)  # the crossings count
+        low = (h <= lim.die_height_mm * (1 + SAME_RELATIVE) + SAME_HEIGHT_MM) & (np.abs(d1) > 0)  # the crossings count
         upper = np.full(h.shape, np.inf)
         upper[low] = (lim.die_speed_mm_s / np.abs(d1[low])) ** 2
         return None, upper

@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from pydantic import Field
 
-from planning.model.limits.base import REL_TOL, Check, Dense, Draw, Limit
+from planning.model.limits.base import Check, Dense, Draw, Limit
 from planning.model.units import SliderSpeed
+from planning.tolerances import LIMIT_REL_TOL
 
 
 class DrawStartSpeedLimit(Limit):
@@ -49,4 +51,6 @@ class DrawStartSpeedLimit(Limit):
         w2 = float(plan.parameters.draw_speed)
         v2 = abs(float(case.machine.slider(plan.key_angles[1], w2)[1]))
         limit = case.limits.draw_start_speed_mm_s
-        return [Check.of(self.id, self.name, v2, limit, self.unit, "max", REL_TOL * limit)]
+        check = Check.of(self.id, self.name, v2, limit, self.unit, "max", LIMIT_REL_TOL * limit)
+        t2 = dense.key_times[1:2]
+        return [check.located(t2, np.array(plan.key_angles[1:2]), np.array([v2]), limit)]

@@ -24,9 +24,10 @@ from typing import Any
 
 import numpy as np
 
-from planning.model.limits.base import REL_TOL, Check, Dense, Impossible, Limit, Row, Transcription, trapezoid
+from planning.model.limits.base import Check, Dense, Impossible, Limit, Row, Transcription, trapezoid
 from planning.model.limits.motor import draw_drive_state
 from planning.model.units import RPM
+from planning.tolerances import GRID_BACKOFF, LIMIT_REL_TOL
 from press.power import chain
 
 CAP_HEADROOM = 1.01  # the starting cap with storage: this much above the most the motors can draw from the bus
@@ -46,7 +47,7 @@ class GridPeakLimit(Limit):
     order = 110
     parameters = ("grid_cap", "grid_copper", "grid_converter", "grid_limit", "grid_allowance")
     refined = "grid_cap"
-    backoff = 5e-5
+    backoff = GRID_BACKOFF
     motor = True
     uses_drive = True
 
@@ -102,7 +103,7 @@ class GridPeakLimit(Limit):
         theta, state = draw_drive_state(case, w2)
         bus = _chain(state["motor_torque_Nm"], state["motor_power_W"], d)["bus_power_W"]
         k = int(np.argmax(bus))
-        if bus[k] <= limit * (1 + REL_TOL):
+        if bus[k] <= limit * (1 + LIMIT_REL_TOL):
             return None
         excess = np.maximum(bus - limit, 0.0)
         energy = float(np.sum(np.diff(theta) * (excess[1:] + excess[:-1]) / 2)) / w2  # [J]
@@ -134,7 +135,7 @@ class GridPeakLimit(Limit):
         overshoot."""
         limit = dense.case.drive.grid.peak_power_kW
         p = dense.power
-        check = Check.of(self.id, self.name, p.grid_peak_kW, limit, self.unit, "max", REL_TOL * limit)
+        check = Check.of(self.id, self.name, p.grid_peak_kW, limit, self.unit, "max", LIMIT_REL_TOL * limit)
         if not _storage_counts(dense.case):  # planned as without storage: the cap lowered by the overshoot
             return [check]
         needed, usable = p.storage_for_limit_kJ, p.storage_usable_kJ

@@ -7,8 +7,9 @@ from typing import Any
 import numpy as np
 from pydantic import Field
 
-from planning.model.limits.base import REL_TOL, BoundGrid, Check, Dense, Draw, Limit, Row, Transcription
+from planning.model.limits.base import BoundGrid, Check, Dense, Draw, Limit, Row, Transcription
 from planning.model.units import RPM, CrankSpeed
+from planning.tolerances import LIMIT_REL_TOL, SAME_RELATIVE
 
 
 class MinCrankSpeedLimit(Limit):
@@ -36,7 +37,7 @@ class MinCrankSpeedLimit(Limit):
 
     def refuse_draw_speed(self, draw: Draw, speed: float) -> str | None:
         lowest = draw.case.limits.min_crank_speed_rpm
-        return f"is below {self.field} = {lowest:g}" if speed < lowest * RPM * (1 - 1e-12) else None
+        return f"is below {self.field} = {lowest:g}" if speed < lowest * RPM * (1 - SAME_RELATIVE) else None
 
     def parameter_values(self, case: Any) -> dict[str, float]:
         return {"min_crank_speed": case.limits.min_crank_speed_rpm * RPM}
@@ -50,7 +51,8 @@ class MinCrankSpeedLimit(Limit):
     def check(self, dense: Dense) -> list[Check]:
         lowest = dense.case.limits.min_crank_speed_rpm
         slowest = float(np.min(dense.omega)) / RPM
-        return [Check.of(self.id, self.name, slowest, lowest, self.unit, "min", REL_TOL * lowest)]
+        check = Check.of(self.id, self.name, slowest, lowest, self.unit, "min", LIMIT_REL_TOL * lowest)
+        return [check.located(dense.t, dense.theta, dense.omega / RPM, lowest)]
 
     def bound_speeds(self, grid: BoundGrid) -> tuple[np.ndarray | None, np.ndarray | None]:
         w_min = grid.case.limits.min_crank_speed_rpm * RPM

@@ -10,7 +10,6 @@ import numpy as np
 
 from planning.model.errors import CaseError
 from planning.model.limits.base import (
-    REL_TOL,
     BoundGrid,
     Check,
     Dense,
@@ -22,11 +21,9 @@ from planning.model.limits.base import (
     trapezoid,
 )
 from planning.model.units import RPM
+from planning.tolerances import DRIVE_BACKOFF, LIMIT_REL_TOL, RMS_PROOF_MARGIN, SAME_ANGLE_RAD
 from press.backend import math_module
 from press.dynamics import GRAVITY, drive_state, envelope_torque, forming_force, link_terms
-
-DRIVE_BACKOFF = 5e-5  # the NLPs hold the motor's peak and RMS torque this much inside (refined if exceeded)
-RMS_PROOF_MARGIN = 1e-3  # relative: the trapezoidal draw integral of the RMS precheck is far more accurate
 
 
 class MotorSpeedLimit(Limit):
@@ -72,7 +69,7 @@ class MotorSpeedLimit(Limit):
         d = dense.case.drive
         top = float(np.max(d.gear_ratio * dense.omega)) / RPM
         limit = d.motor.max_speed_rpm
-        return [Check.of(self.id, self.name, top, limit, self.unit, "max", REL_TOL * limit)]
+        return [Check.of(self.id, self.name, top, limit, self.unit, "max", LIMIT_REL_TOL * limit)]
 
     def bound_speeds(self, grid: BoundGrid) -> tuple[np.ndarray | None, np.ndarray | None]:
         return None, np.full(grid.dtheta.size, _top_crank_speed(grid.case) ** 2)
@@ -140,8 +137,9 @@ class MotorPeakTorqueLimit(Limit):
         motor = dense.case.drive.motor
         s = dense.drive_state
         envelope = envelope_torque(s["motor_speed_rad_s"], motor.peak_torque_Nm, motor.base_speed_rpm * RPM)
-        use = float(np.max(np.abs(s["motor_torque_Nm"]) / envelope))
-        return [Check.of(self.id, self.name, use, 1.0, self.unit, "max", REL_TOL)]
+        use = np.abs(s["motor_torque_Nm"]) / envelope
+        check = Check.of(self.id, self.name, float(np.max(use)), 1.0, self.unit, "max", LIMIT_REL_TOL)
+        return [check.located(dense.t, dense.theta, use, 1.0)]
 
     def bound_rows(self, grid: BoundGrid) -> list[tuple[Any, Any, Any]]:
         """Motor torque at both ends of every interval, as the two linear forms whose larger is the motor
@@ -154,7 +152,8 @@ class MotorPeakTorqueLimit(Limit):
         peak = case.drive.motor.peak_torque_Nm
         n = grid.dtheta.size
         rows = []
-        for theta, speed2 in ((grid.theta[:-1] + 1e-12, grid.s), (grid.theta[1:] - 1e-12, grid.s_next)):
+        ends = ((grid.theta[:-1] + SAME_ANGLE_RAD, grid.s), (grid.theta[1:] - SAME_ANGLE_RAD, grid.s_next))
+        for theta, speed2 in ends:
             h, d1, d2, _ = m.jets(theta)
             d1, d2 = d1 * 1e-3, d2 * 1e-3
             f_env = forming_force(theta, h, d) + d.F_cb - d.M * GRAVITY
@@ -218,7 +217,7 @@ class MotorRMSTorqueLimit(Limit):
     def check(self, dense: Dense) -> list[Check]:
         rated = dense.case.drive.motor.rated_torque_Nm
         rms = dense.integrals["rms_motor_torque_Nm"]
-        return [Check.of(self.id, self.name, rms, rated, self.unit, "max", REL_TOL * rated)]
+        return [Check.of(self.id, self.name, rms, rated, self.unit, "max", LIMIT_REL_TOL * rated)]
 
     def relaxed_rows(self, grid: RelaxedGrid) -> None:
         """Not in the upper bound (the RMS of a cycle is no condition at an angle): left out."""

@@ -10,8 +10,6 @@ import numpy as np
 
 from planning.model.errors import CaseError
 from planning.model.limits.base import (
-    REL_TOL,
-    TIME_TOL,
     BoundGrid,
     Check,
     Dense,
@@ -24,6 +22,7 @@ from planning.model.limits.base import (
     total,
 )
 from planning.model.units import RPM
+from planning.tolerances import LIMIT_REL_TOL, TIME_TOL_S
 
 
 class TransferTimeLimit(Limit):
@@ -61,7 +60,7 @@ class TransferTimeLimit(Limit):
     def check(self, dense: Dense) -> list[Check]:
         t1, _, _, t4 = dense.key_times
         window = t1 + dense.plan.period - t4
-        return [Check.of(self.id, self.name, window, dense.case.process.transfer_time_s, self.unit, "min", TIME_TOL)]
+        return [Check.of(self.id, self.name, window, dense.case.process.transfer_time_s, self.unit, "min", TIME_TOL_S)]
 
     def bound_rows(self, grid: BoundGrid) -> list[tuple[Any, Any, Any]]:
         window = np.flatnonzero(grid.window).tolist()
@@ -129,7 +128,7 @@ class SafetyHeightLimit(Limit):
         th1, _, _, th4 = dense.plan.key_angles
         ends = dense.case.machine.height(np.array([th1, th4]))  # the window's ends, exactly (not a grid point)
         lowest = float(min(np.min(dense.h[window], initial=np.inf), np.min(ends)))
-        return [Check.of(self.id, self.name, lowest, safety, self.unit, "min", REL_TOL * safety)]
+        return [Check.of(self.id, self.name, lowest, safety, self.unit, "min", LIMIT_REL_TOL * safety)]
 
 
 def lowest_in_window(case: Any) -> tuple[float, float]:

@@ -9,7 +9,6 @@ import numpy as np
 from pydantic import Field
 
 from planning.model.limits.base import (
-    REL_TOL,
     BoundGrid,
     Check,
     Dense,
@@ -22,11 +21,7 @@ from planning.model.limits.base import (
     Transcription,
 )
 from planning.model.units import SliderAccel
-
-DEAD_CENTRE_SLOPE = 1e-9  # relative to the largest |h'|: a node where the slide stands (a dead centre)
-
-ACCEL_BACKOFF = 5e-4  # the NLPs hold |slider acceleration| <= (1 - backoff) * limit at their samples
-HARDER_BACKOFF = 5e-3  # the back-off of a second round when no start verified
+from planning.tolerances import ACCEL_BACKOFF, DEAD_CENTRE_SLOPE, HARDER_BACKOFF, LIMIT_REL_TOL, SAME_RELATIVE
 
 
 class SliderAccelLimit(Limit):
@@ -68,7 +63,7 @@ class SliderAccelLimit(Limit):
         if given is None:
             return None
         bound = self.draw_speed_bound(Draw.of(case))
-        if given <= bound * (1 + 1e-12):
+        if given <= bound * (1 + SAME_RELATIVE):
             return None
         limit = case.limits.slider_accel_mm_s2
         a_draw = limit * (given / bound) ** 2
@@ -89,7 +84,9 @@ class SliderAccelLimit(Limit):
 
     def check(self, dense: Dense) -> list[Check]:
         limit = dense.case.limits.slider_accel_mm_s2
-        return [Check.of(self.id, self.name, float(np.max(np.abs(dense.a))), limit, self.unit, "max", REL_TOL * limit)]
+        accel = np.abs(dense.a)
+        check = Check.of(self.id, self.name, float(np.max(accel)), limit, self.unit, "max", LIMIT_REL_TOL * limit)
+        return [check.located(dense.t, dense.theta, accel, limit)]
 
     def bound_rows(self, grid: BoundGrid) -> list[tuple[Any, Any, Any]]:
         A = grid.case.limits.slider_accel_mm_s2

@@ -9,7 +9,6 @@ import numpy as np
 from pydantic import Field
 
 from planning.model.limits.base import (
-    REL_TOL,
     BoundGrid,
     Check,
     Dense,
@@ -21,8 +20,7 @@ from planning.model.limits.base import (
     Transcription,
 )
 from planning.model.units import SliderSpeed
-
-SPEED_BACKOFF = 5e-4  # the NLPs hold |slider speed| <= (1 - backoff) * limit at their samples (refined if exceeded)
+from planning.tolerances import LIMIT_REL_TOL, SAME_RELATIVE, SPEED_BACKOFF
 
 
 class SliderSpeedLimit(Limit):
@@ -75,7 +73,7 @@ class SliderSpeedLimit(Limit):
         if given is None:
             return None
         bound = self.draw_speed_bound(Draw.of(case))
-        if given <= bound * (1 + 1e-12):
+        if given <= bound * (1 + SAME_RELATIVE):
             return None
         limit = case.limits.slider_speed_mm_s
         return Impossible(
@@ -95,8 +93,9 @@ class SliderSpeedLimit(Limit):
 
     def check(self, dense: Dense) -> list[Check]:
         limit = dense.case.limits.slider_speed_mm_s
-        fastest = float(np.max(np.abs(dense.v)))
-        return [Check.of(self.id, self.name, fastest, limit, self.unit, "max", REL_TOL * limit)]
+        speed = np.abs(dense.v)
+        check = Check.of(self.id, self.name, float(np.max(speed)), limit, self.unit, "max", LIMIT_REL_TOL * limit)
+        return [check.located(dense.t, dense.theta, speed, limit)]
 
     def bound_speeds(self, grid: BoundGrid) -> tuple[np.ndarray | None, np.ndarray | None]:
         d1 = np.abs(grid.d1[:-1])

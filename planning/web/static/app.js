@@ -12,6 +12,9 @@ const TYPING_REST_MS = 120; // a pause this long in typing solves (a fast typist
 const BOUND_REST_MS = 800;
 
 const state = { meta: null, label: "case", data: null, seq: 0, shownSeq: -1, last: null, pinned: null };
+// how a solve ended: the server's one outcome type (planning.model.outcome), sent with /api/meta; the
+// page compares an answer's status against these, never against text of its own
+let OUTCOME = { ERROR: "error" };
 
 function $(sel) { return document.querySelector(sel); }
 
@@ -233,12 +236,12 @@ async function readJson(responsePromise) {
   try {
     response = await responsePromise;
   } catch (e) {
-    return { status: "error", message: "the server did not answer: " + e, confirmed: true };
+    return { status: OUTCOME.ERROR, message: "the server did not answer: " + e, confirmed: true };
   }
   try {
     return await response.json();
   } catch (e) {
-    return { status: "error", message: `the server answered ${response.status} without JSON`, confirmed: true };
+    return { status: OUTCOME.ERROR, message: `the server answered ${response.status} without JSON`, confirmed: true };
   }
 }
 
@@ -262,15 +265,15 @@ async function solveNow() {
   // one: the cold solve's plan or better, whatever the order of the edits
   let answer = await askSolve(data, seq, false);
   window.solveAnsweredAt = performance.now();
-  if (answer.status === "superseded" || seq < state.seq) return; // a newer edit is on its way
-  if (answer.status === "verified" && !answer.confirmed) {
+  if (answer.status === OUTCOME.INTERRUPTED || seq < state.seq) return; // a newer edit is on its way
+  if (answer.status === OUTCOME.VERIFIED && !answer.confirmed) {
     state.data = data;
     render(answer, seq, false);
     answer = await askSolve(data, seq, true);
-    if (answer.status === "superseded" || seq < state.seq) return;
+    if (answer.status === OUTCOME.INTERRUPTED || seq < state.seq) return;
   }
   clearMessages();
-  if (answer.status === "verified") {
+  if (answer.status === OUTCOME.VERIFIED) {
     state.data = data;
     render(answer, seq, true);
     // the bound (half a second, in the server's other process) once the edits rest
@@ -280,7 +283,7 @@ async function solveNow() {
     // keep the last good plan of this case on screen; say what is wrong, next to the field when one is named
     const field = answer.field || "";
     showMessage(field, answer.message);
-    setStatus(answer.message + (field && answer.status !== "bad input" ? ` (the limit: ${field})` : ""), "failed");
+    setStatus(answer.message + (field && answer.status !== OUTCOME.BAD_INPUT ? ` (the limit: ${field})` : ""), "failed");
     document.body.dataset.state = answer.status;
     document.body.dataset.rendered = String(seq);
   }
@@ -302,8 +305,9 @@ async function requestBound(data, seq) {
   if (seq !== state.shownSeq) return;
   const spm = state.last.result.spm;
   // the share of the certified upper bound (no motion within the limits makes more: never above 100 %)
-  $("#bound-share").textContent = answer.status === "ok" ? (100 * spm / answer.upper_spm).toFixed(1) + " %" : "no bound";
-  $("#bound-share").title = answer.status === "ok"
+  const bounded = answer.upper_spm != null; // else the answer says why there is no bound
+  $("#bound-share").textContent = bounded ? (100 * spm / answer.upper_spm).toFixed(1) + " %" : "no bound";
+  $("#bound-share").title = bounded
     ? `bracket: ${spm.toFixed(3)} strokes/min verified … ${answer.upper_spm.toFixed(3)} certified upper bound (no motion within the limits makes more` +
       (answer.left_out.length ? `; left out: ${answer.left_out.join(", ")}` : "") + `); the grid bound ${answer.spm.toFixed(3)}`
     : answer.message;
@@ -626,8 +630,9 @@ async function loadCase(name) {
 }
 
 function showLoaded(answer) {
-  $("#load-message").textContent = answer.status === "ok" ? "" : answer.message;
-  if (answer.status !== "ok") return;
+  const read = answer.case != null; // a case read, else the answer says what is wrong with it
+  $("#load-message").textContent = read ? "" : answer.message;
+  if (!read) return;
   state.label = answer.label;
   state.data = answer.case;
   state.pinned = null; // a pinned plan belongs to the case it was pinned on
@@ -664,6 +669,15 @@ async function download(name) {
 
 async function start() {
   state.meta = await (await fetch("/api/meta")).json();
+  OUTCOME = Object.freeze(state.meta.outcomes);
+  const buttons = $("#downloads");
+  for (const d of state.meta.downloads) { // the outputs' registry: every file the page offers
+    const b = document.createElement("button");
+    b.type = "button";
+    b.dataset.download = d.name;
+    b.textContent = d.title;
+    buttons.appendChild(b);
+  }
   const select = $("#case-select");
   for (const name of state.meta.cases) select.add(new Option(name, name));
   select.addEventListener("change", () => loadCase(select.value));

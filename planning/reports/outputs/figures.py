@@ -1,0 +1,56 @@
+"""The figures: ``motion_vs_time`` and ``motion_vs_angle`` (the slide and the crank, every limit where it
+applies), ``drive`` (with a drive: the torque-speed plane, torque and power) and ``energy`` (with the drive's
+electrical side); drawn from ``result.json``'s data and the trajectory (``pressplan plot`` redraws them
+from those files)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from planning.reports.folder import OutputError
+from planning.reports.outputs import Option, Output, Writer, Written
+
+PLOT_FORMATS = ("png", "svg", "pdf")
+FORMAT = Option(
+    "--format",
+    {"dest": "plot_format", "choices": PLOT_FORMATS, "default": "png", "help": "figure format (default png)"},
+)
+NO_PLOTS = Option("--no-plots", {"dest": "no_plots", "action": "store_true", "help": "do not draw the figures"})
+
+
+def _writers(w: Written) -> dict[str, Writer]:
+    from planning.reports.plots import plot_files, save
+    from planning.reports.report import TRAJECTORY_COLUMNS
+
+    published = w.published
+    pub_cols = dict(zip(TRAJECTORY_COLUMNS, published.T, strict=True)) if published is not None else None
+    figures = plot_files(w.result, w.columns, pub_cols, w.option("plot_format"))
+    return {name: (lambda p, fig=fig: save(fig, p)) for name, fig in figures.items()}
+
+
+def redraw(folder: Path, plot_format: str = "png") -> dict[str, Writer]:
+    """The figures redrawn from a finished output folder's result.json and trajectory.csv (``pressplan plot``)."""
+    from planning.reports.plots import plot_files, read_table, save
+
+    try:
+        result = json.loads((folder / "result.json").read_text(encoding="utf-8"))
+        traj = read_table(folder / "trajectory.csv")
+        pub_path = folder / "published_profile.csv"
+        published = read_table(pub_path) if pub_path.exists() else None
+        figures = plot_files(result, traj, published, plot_format)
+    except (OSError, ValueError, KeyError, IndexError, TypeError, AttributeError) as exc:
+        reason = " ".join(str(exc).split())[:120] or type(exc).__name__
+        raise OutputError(f"{folder}: not a finished pressplan output folder ({reason})") from None
+    return {name: (lambda p, fig=fig: save(fig, p)) for name, fig in figures.items()}
+
+
+OUTPUT = Output(
+    "motion_vs_time.*",
+    "the figures",
+    ("motion_vs_time.*", "motion_vs_angle.*", "drive.*", "energy.*"),
+    _writers,
+    order=90,
+    figure=True,
+    options=(FORMAT, NO_PLOTS),
+)
