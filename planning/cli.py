@@ -18,14 +18,16 @@ from typing import NoReturn
 
 from planning.model.case import OBJECTIVES
 from planning.model.laws import LAWS
+from planning.model.outcome import Outcome
 from planning.reports.arguments import whole
 from planning.reports.new_case import MECHANISMS
 from planning.reports.outputs import options as output_options
 from planning.reports.outputs.figures import PLOT_FORMATS
 from planning.tolerances import TINY_RATE
 
-EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = 0, 2, 3
-EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143  # Ctrl-C, SIGTERM (128 + the signal number)
+# the exit statuses, from the one outcome type (planning.model.outcome)
+EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = (o.exit_code for o in (Outcome.VERIFIED, Outcome.BAD_INPUT, Outcome.NO_PLAN))
+EXIT_INTERRUPTED, EXIT_TERMINATED = Outcome.INTERRUPTED.exit_code, Outcome.TERMINATED.exit_code  # 128 + signal
 SERVE_FIRST = "wang2023-side-panel.yaml"  # the case the page opens with when none is given
 
 
@@ -245,7 +247,7 @@ def _exit_code(exc: Exception, case_path: str | None) -> tuple[str, int] | None:
     if isinstance(exc, CaseError):  # a case changed by an option (--law) that no longer holds together
         return exc.line(case_path), EXIT_INPUT
     if isinstance(exc, PlanningError):  # no feasible or no verified plan
-        return f"{case_path}: {exc}", EXIT_INFEASIBLE
+        return f"{case_path}: {exc}", exc.outcome.exit_code
     if isinstance(exc, OSError):  # a file or folder the command needs cannot be used
         where = exc.filename if exc.filename is not None else case_path
         return f"{where}: {exc.strerror or exc}", EXIT_INPUT

@@ -204,7 +204,8 @@ def test_tolerances_live_in_their_module():
         if name == "planning.tolerances":
             continue
         for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-            if isinstance(node, ast.Constant) and isinstance(node.value, float) and 0 < abs(node.value) < SMALLEST_LITERAL:
+            small = isinstance(node, ast.Constant) and isinstance(node.value, float)
+            if small and 0 < abs(node.value) < SMALLEST_LITERAL:
                 found.append(f"{path.relative_to(ROOT)}:{node.lineno}: {node.value!r}")
     assert found == []
     assert _graph()["planning.tolerances"] == set()
