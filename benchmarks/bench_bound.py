@@ -17,7 +17,7 @@ from results_section import write_section  # benchmarks/ is the script's folder
 ROOT = Path(__file__).resolve().parents[1]
 BEGIN, END = "<!-- bound:begin -->", "<!-- bound:end -->"
 PUBLISHED = "cases/wang2023-side-panel.yaml"
-UPPER_GRIDS = (360, 720, 1440, 2880)
+UPPER_MESHES = (360, 720, 1440, 2880)
 BRACKETS = [  # (case file, overrides, label)
     (PUBLISHED, [], "published case, no jerk limit"),
     (PUBLISHED, ["--set", "limits.crank_jerk_rad_s3=3263"], "published case, crank jerk <= 3263 rad/s^3"),
@@ -48,7 +48,7 @@ def _in_process() -> list[tuple[int, float, float]]:
     case = read_case(ROOT / PUBLISHED)
     upper_bound(case, 96, 1)  # imports and first use
     rows = []
-    for n in UPPER_GRIDS:
+    for n in UPPER_MESHES:
         t = time.perf_counter()
         upper = upper_bound(case, n, 1)
         rows.append((n, upper.spm, time.perf_counter() - t))

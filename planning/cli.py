@@ -345,7 +345,7 @@ def _with_law(case, args):  # noqa: ANN001, ANN202 - a Case and the parsed argum
     if args.law is None:
         return case
     objective = getattr(args, "objective", None)
-    if LAWS[args.law].free_profile and objective not in (None, "max-spm"):
+    if not LAWS[args.law].plans_at_rate and objective not in (None, "max-spm"):
         raise CommandError(
             f"--law {args.law}: the {args.law} law plans for the most strokes only; it takes no --objective "
             f"{objective} (choose a law with halves, e.g. --law improved-s-curve)"

@@ -174,7 +174,7 @@ CASADI_MODULES = {  # the wrapper and the modules that build expressions for it
     "planning.solver.free_nlp",
     "planning.solver.bound",
     "planning.solver.upper_bound",
-    "planning.solver.grid",  # the peak-shaving linear programme (HiGHS through casadi.conic)
+    "planning.solver.peak_shaving",  # the peak-shaving linear programme (HiGHS through casadi.conic)
 }
 
 

@@ -1,4 +1,4 @@
-"""From the motor to the grid (``press.power``, ``planning.solver.grid``): the energy balance with every loss,
+"""From the motor to the grid (``press.power``, ``planning.solver.peak_shaving``): the energy balance with every loss,
 the peak-shaving programme against an independent LP (SciPy's HiGHS through ``linprog``), its limits (no storage:
 the bus's peak; unbounded storage: the mean), the sizing curve, and the outputs against an independent
 integration of ``trajectory.csv``."""
@@ -15,7 +15,7 @@ from scipy.optimize import linprog
 from planning.cli import main
 from planning.model.case_file import case_from_data, load_yaml, read_case
 from planning.model.profile import Profile, Segment
-from planning.solver.grid import (
+from planning.solver.peak_shaving import (
     Storage,
     chain,
     end_peaks,

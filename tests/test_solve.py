@@ -11,6 +11,7 @@ import pytest
 from planning.model.case import RPM
 from planning.model.plan import Plan, profile_from_tdc
 from planning.reports.report import trajectory
+from planning.reports.source_solution import paper_solution
 from planning.solver.verify import verify
 
 # The paper's worked case reaches "11.7 strokes/min" (one decimal): the published placement must land
@@ -24,7 +25,7 @@ def test_published_placement_reproduces_the_paper(published_solution):
     assert PUBLISHED_SPM_RANGE[0] <= plan.spm <= PUBLISHED_SPM_RANGE[1]
     assert published_solution.verification.passed
     assert plan.placement == "published"
-    x = plan.paper_solution()
+    x = paper_solution(plan)
     # the relations printed under Fig. 6: t1 = x1 + T1, t4 = x3 + 3 T14, x2 = x1 + 4 T1, t2 = x2 + 4 T5
     t1, t2, t3, t4 = plan.key_times()
     assert t1 == pytest.approx(x["x1_s"] + x["T1_s"], abs=1e-9)

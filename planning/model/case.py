@@ -669,7 +669,7 @@ def _drive_mass_checks(case: Case) -> None:
 
 def _law_checks(case: Case) -> None:
     """The optimal law plans under a jerk limit: the case must give one."""
-    if LAWS[case.planner.motion_law].free_profile and case.limits.crank_jerk_rad_s3 is None:
+    if LAWS[case.planner.motion_law].needs_jerk_limit and case.limits.crank_jerk_rad_s3 is None:
         raise CaseError(
             "limits.crank_jerk_rad_s3",
             f"the {case.planner.motion_law} law needs a crank-jerk limit (the jerk it may use)",
@@ -687,7 +687,7 @@ def _objective_checks(case: Case) -> None:
         raise CaseError("planner.target_spm", f"the {planner.objective} objective needs the line's rate", None, False)
     if case.drive is None:
         raise CaseError("planner.objective", "needs a drive: section (the motor it weighs)", planner.objective)
-    if LAWS[planner.motion_law].free_profile:
+    if not LAWS[planner.motion_law].plans_at_rate:
         raise CaseError(
             "planner.objective",
             f"the {planner.motion_law} law plans for the most strokes only (max-spm); choose a law with halves",

@@ -61,7 +61,7 @@ class DriveFigures:
 @dataclass(frozen=True)
 class PowerFigures:
     """One cycle of the power chain from the motors to the grid (``press.power``; computed by
-    ``planning.solver.grid``): energies per stroke [kJ], powers [kW], the storage's state [kJ]. Over the
+    ``planning.solver.peak_shaving``): energies per stroke [kJ], powers [kW], the storage's state [kJ]. Over the
     cycle ``grid_energy = forming work + gear + copper + converter + storage + resistor losses +
     storage_change`` (the storage's schedule is periodic: its change is zero to the programme's tolerance)."""
 
@@ -89,12 +89,13 @@ class PowerFigures:
     storage_peak_power_kW: float
     grid_limit_kW: float | None
     bus_cap_for_limit_kW: float | None  # above the grid limit with storage: the bus cap the storage could
-    # shave to the limit on this plan's shape (planning.solver.grid.bus_cap_for_limit; None otherwise)
+    # shave to the limit on this plan's shape (planning.solver.peak_shaving.bus_cap_for_limit; None otherwise)
     storage_for_limit_kJ: float | None  # with storage and a grid limit: the least usable energy with which it
-    # holds the limit on this plan (None: no size does, or no storage or limit; planning.solver.grid.storage_needed)
+    # holds the limit on this plan (None: no size does, or no storage or limit;
+    # planning.solver.peak_shaving.storage_needed)
     storage_to_flatten_kJ: float | None  # with storage: the least usable energy of one like it that brings the
-    # grid's peak within 5 % of the mean bus power (planning.solver.grid.storage_to_flatten; None: none does)
-    schedule: Any = field(default=None, compare=False, repr=False)  # planning.solver.grid.Schedule
+    # grid's peak within 5 % of the mean bus power (planning.solver.peak_shaving.storage_to_flatten; None: none does)
+    schedule: Any = field(default=None, compare=False, repr=False)  # planning.solver.peak_shaving.Schedule
 
     def as_dict(self) -> dict[str, Any]:
         """The figures as ``result.json``'s ``power`` block writes them (the schedule apart)."""

@@ -11,7 +11,6 @@ from planning.model.case import Placement
 from planning.model.cycle import CycleParameters, cycle_segments
 from planning.model.free_profile import FreeProfileParameters
 from planning.model.laws import DEFAULT_LAW
-from planning.model.laws import improved_scurve as sc
 from planning.model.profile import Profile, advance_segment, knot_states, split_segment
 from planning.tolerances import KNOT_TIME_S, TINY
 
@@ -77,45 +76,6 @@ class Plan:
         """Achieved time [s] from theta4 to theta1 through TDC."""
         t = self.key_times()
         return float(t[0] + self.period - t[3])
-
-    def paper_solution(self) -> dict[str, float]:
-        """The plan in the paper's notation X = [x1..x5, wm1, wm2, T1, T5, T9, T10, T14, J].
-
-        Mapping (time from TDC, as in the paper's Fig. 6): x1 start of the feed acceleration,
-        x2 feed peak speed, x3 return peak speed, x4 end of the return deceleration, x5 the period;
-        wm1, wm2 [rpm]; T1, T5, T10, T14 the sub-segment lengths of the four halves, T9 the draw [s];
-        J [rpm/s^2] the feed jerk (the return jerk is reported separately as ``J_return``).
-        """
-        p = self.parameters
-        if self.motion_law != sc.ImprovedSCurve.name:
-            raise ValueError("the paper's notation describes improved-s-curve plans only")
-        n = sc.SUBSEGMENTS
-        tk = self.profile.knot_times
-        names = [s.name for s in self.profile.segments]
-        rpm = 60.0 / (2 * math.pi)
-
-        def start(name: str) -> float:
-            return float(tk[names.index(name)])
-
-        def end(name: str) -> float:
-            return float(tk[names.index(name) + 1])
-
-        return {
-            "x1_s": start("feed:accel1"),
-            "x2_s": start("feed:decel1"),
-            "x3_s": start("return:decel1"),
-            "x4_s": end("return:decel4"),
-            "x5_s": self.period,
-            "wm1_rpm": float(p.feed_peak_speed) * rpm,
-            "wm2_rpm": float(p.return_peak_speed) * rpm,
-            "T1_s": float(p.feed_accel_duration) / n,
-            "T5_s": float(p.feed_decel_duration) / n,
-            "T9_s": float(p.draw_time),
-            "T10_s": float(p.return_accel_duration) / n,
-            "T14_s": float(p.return_decel_duration) / n,
-            "J_rpm_s2": float(p.feed_jerk) * rpm,
-            "J_return_rpm_s2": float(p.return_jerk) * rpm,
-        }
 
 
 def profile_from_tdc(params: CycleParameters) -> Profile:

@@ -10,7 +10,7 @@ import numpy as np
 
 from planning.model.case import KEY_POINT_NAMES, Case, PublishedSolution
 from planning.reports.report import key_points
-from planning.reports.source_solution import consistency, rebuild_profile, transfer_speed_rpm
+from planning.reports.source_solution import consistency, paper_solution, rebuild_profile, transfer_speed_rpm
 from planning.solver.solution import Solution
 
 SYMBOLS = {
@@ -52,8 +52,8 @@ def comparison(case: Case, ours_published: Solution, ours_free: Solution) -> dic
                 }
             )
     x_pub = pub.solution.model_dump() if pub and pub.solution else {}
-    x_a = ours_published.plan.paper_solution()
-    x_b = ours_free.plan.paper_solution()
+    x_a = paper_solution(ours_published.plan)
+    x_b = paper_solution(ours_free.plan)
     rows_x = [
         {
             "symbol": sym,

@@ -112,7 +112,7 @@ def compare_laws(case: Case, laws: tuple[str, ...] = tuple(LAWS)) -> tuple[dict[
     rows, tables = [], {}
     for law in laws:
         note = {}
-        if LAWS[law].free_profile:  # the optimal law plans under a jerk limit: the case's, or the S-curve's own
+        if LAWS[law].needs_jerk_limit:  # the optimal law plans under a jerk limit: the case's, or the S-curve's own
             try:
                 variant, note = _jerk_limited(case, law, rows)
             except (CaseError, CaseFileError) as exc:  # e.g. an objective at a rate, which it does not plan

@@ -17,6 +17,7 @@ from planning.model.laws.improved_scurve import ImprovedSCurve
 from planning.model.limits.slider_accel import SliderAccelLimit
 from planning.model.outcome import Outcome
 from planning.model.profile import MAX_STEP_S, Profile
+from planning.reports.source_solution import paper_solution
 from planning.reports.stages import stage_table
 from planning.solver.solution import GRID_PEAK, Solution
 from planning.solver.verify import Evaluation
@@ -161,7 +162,7 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
         "limits": case.limits.model_dump(),
         "key_points": key_points(solution),
         "segments": segments(solution),
-        "paper_solution": plan.paper_solution() if plan.motion_law == ImprovedSCurve.name else None,
+        "paper_solution": paper_solution(plan) if plan.motion_law == ImprovedSCurve.name else None,
         **({"drive": drive_block(solution, case)} if case.drive is not None else {}),
         **({"power": solution.drive.power.as_dict()} if solution.drive and solution.drive.power else {}),
         **objective_block(solution, case),

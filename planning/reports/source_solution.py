@@ -24,6 +24,7 @@ import numpy as np
 
 from planning.model.case import RPM, Case, PublishedSolution
 from planning.model.laws import improved_scurve as sc
+from planning.model.plan import Plan
 from planning.model.profile import Profile, Segment
 from planning.tolerances import HALF_ULP_REL, SAME_RELATIVE
 
@@ -272,3 +273,43 @@ def _angle_allowance(case: Case) -> float:
 
     names = ["x1_s", "x5_s", "T1_s", "T5_s", "T9_s", "T10_s", "T14_s", "wm1_rpm", "wm2_rpm", "J_rpm_s2"]
     return _propagate(swept, v, names)
+
+
+def paper_solution(plan: Plan) -> dict[str, float]:
+    """An improved-S-curve plan in the paper's notation X = [x1..x5, wm1, wm2, T1, T5, T9, T10, T14, J].
+
+    Mapping (time from TDC, as in the paper's Fig. 6): x1 start of the feed acceleration,
+    x2 feed peak speed, x3 return peak speed, x4 end of the return deceleration, x5 the period;
+    wm1, wm2 [rpm]; T1, T5, T10, T14 the sub-segment lengths of the four halves, T9 the draw [s];
+    J [rpm/s^2] the feed jerk (the return jerk is reported separately as ``J_return``).
+    """
+    p = plan.parameters
+    if plan.motion_law != sc.ImprovedSCurve.name:
+        raise ValueError("the paper's notation describes improved-s-curve plans only")
+    n = sc.SUBSEGMENTS
+    tk = plan.profile.knot_times
+    names = [s.name for s in plan.profile.segments]
+    rpm = 60.0 / (2 * math.pi)
+
+    def start(name: str) -> float:
+        return float(tk[names.index(name)])
+
+    def end(name: str) -> float:
+        return float(tk[names.index(name) + 1])
+
+    return {
+        "x1_s": start("feed:accel1"),
+        "x2_s": start("feed:decel1"),
+        "x3_s": start("return:decel1"),
+        "x4_s": end("return:decel4"),
+        "x5_s": plan.period,
+        "wm1_rpm": float(p.feed_peak_speed) * rpm,
+        "wm2_rpm": float(p.return_peak_speed) * rpm,
+        "T1_s": float(p.feed_accel_duration) / n,
+        "T5_s": float(p.feed_decel_duration) / n,
+        "T9_s": float(p.draw_time),
+        "T10_s": float(p.return_accel_duration) / n,
+        "T14_s": float(p.return_decel_duration) / n,
+        "J_rpm_s2": float(p.feed_jerk) * rpm,
+        "J_return_rpm_s2": float(p.return_jerk) * rpm,
+    }

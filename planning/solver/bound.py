@@ -1,4 +1,4 @@
-"""The time-optimal bound on a grid: the shortest cycle of a crank motion with constant acceleration on
+"""The time-optimal bound on a mesh: the shortest cycle of a crank motion with constant acceleration on
 each interval of a grid over crank angle, under the case's limits. It approaches the true optimum from
 below as the grid refines (a restriction of the motions, not an upper bound: ``planning.solver.upper_bound``
 gives the certified one).
@@ -42,7 +42,7 @@ import numpy as np
 
 from planning.model.case import RPM, Case
 from planning.model.limits import limits_of
-from planning.model.limits.base import BoundGrid
+from planning.model.limits.base import BoundMesh
 from planning.solver.ipopt import NLPSolver
 from planning.solver.outcomes import Infeasible, NoPlanFound
 from planning.solver.precheck import precheck
@@ -54,7 +54,7 @@ BOUND_OPTIONS = {"ipopt.max_iter": 3000}  # added to the wrapper's base options
 
 @dataclass(frozen=True)
 class Bound:
-    """The bound: ``spm``, ``cycle_time_s`` [s], ``points`` of the grid, ``window_slack_s`` [s] (time the
+    """The bound: ``spm``, ``cycle_time_s`` [s], ``points`` of the mesh, ``window_slack_s`` [s] (time the
     relaxation adds in the robot window beyond the motion's own), ``draw_speed_rpm``, the speed
     profile ``angle_deg`` / ``crank_speed_rpm`` at the nodes, ``wall_time_s`` [s]."""
 
@@ -84,7 +84,7 @@ class Bound:
         }
 
 
-def angle_grid(case: Case, points: int, extra: tuple[float, ...] = ()) -> np.ndarray:
+def angle_mesh(case: Case, points: int, extra: tuple[float, ...] = ()) -> np.ndarray:
     """Nodes [rad] from theta1 over one revolution, ``points`` intervals in all (more only when ``points`` is
     below :data:`MIN_INTERVALS_PER_ARC` per arc). Among them: the key angles,
     TDC, and the angles where the slide passes the die height, so that the die-height speed limit holds
@@ -133,7 +133,7 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
     :class:`~planning.solver.outcomes.PlanningError` if there is none."""
     t_start = time.perf_counter()
     w2_lo, w2_hi = precheck(case)
-    th = angle_grid(case, points)
+    th = angle_mesh(case, points)
     n = len(th) - 1  # intervals; node n is node 0 one revolution on
     dth = np.diff(th)
     m = case.machine
@@ -144,8 +144,8 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
 
     draw = np.flatnonzero((th[:-1] >= th2 - SAME_ANGLE_RAD) & (th[:-1] <= th3 + SAME_ANGLE_RAD))
     window = th[:-1] >= th4 - SAME_ANGLE_RAD  # the grid starts at theta1: the robot window is [theta4, theta1 + 2 pi)
-    grid = BoundGrid(case, th, h, d1, d2, dth, window)
-    lbx_s, ubx_s = node_speed_bounds(grid, limits, draw, w2_lo, w2_hi)
+    mesh = BoundMesh(case, th, h, d1, d2, dth, window)
+    lbx_s, ubx_s = node_speed_bounds(mesh, limits, draw, w2_lo, w2_hi)
     # scales: each node's speed^2 near the speed the slider-acceleration limit allows at constant speed,
     # within the node's bounds; each interval's time accordingly. A draw at 0.001 rpm and a stroke at
     # 30 rpm then both solve with variables of order one.
@@ -154,23 +154,23 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
     tau_unit = dth / np.sqrt(s_unit)
     x_s = ca.MX.sym("s", n)  # scaled speed^2 at nodes 0..n-1; node n is node 0
     x_tau = ca.MX.sym("tau", n)
-    grid.s = ca.DM(s_unit) * x_s
-    grid.tau = ca.DM(tau_unit) * x_tau
-    grid.s_next = ca.vertcat(grid.s[1:], grid.s[0])
-    grid.tau_next = ca.vertcat(grid.tau[1:], grid.tau[0])
-    grid.alpha = (grid.s_next - grid.s) / (2 * dth)
-    g = [grid.tau - 2 * dth / (ca.sqrt(grid.s) + ca.sqrt(grid.s_next))]  # each interval's time (convex)
+    mesh.s = ca.DM(s_unit) * x_s
+    mesh.tau = ca.DM(tau_unit) * x_tau
+    mesh.s_next = ca.vertcat(mesh.s[1:], mesh.s[0])
+    mesh.tau_next = ca.vertcat(mesh.tau[1:], mesh.tau[0])
+    mesh.alpha = (mesh.s_next - mesh.s) / (2 * dth)
+    g = [mesh.tau - 2 * dth / (ca.sqrt(mesh.s) + ca.sqrt(mesh.s_next))]  # each interval's time (convex)
     lbg, ubg = [np.zeros(n)], [np.full(n, np.inf)]
     for limit in limits:
-        for expr, lo, hi in limit.bound_rows(grid):
+        for expr, lo, hi in limit.bound_rows(mesh):
             g.append(expr)
             lbg.append(np.broadcast_to(lo, (expr.shape[0],)))
             ubg.append(np.broadcast_to(hi, (expr.shape[0],)))
     if draw.size > 1:  # one speed through the draw
-        g.append(grid.s[draw[1:].tolist()] - grid.s[draw[:-1].tolist()])
+        g.append(mesh.s[draw[1:].tolist()] - mesh.s[draw[:-1].tolist()])
         lbg.append(np.zeros(draw.size - 1))
         ubg.append(np.zeros(draw.size - 1))
-    nlp = {"x": ca.vertcat(x_s, x_tau), "f": ca.sum1(grid.tau), "g": ca.vertcat(*g)}
+    nlp = {"x": ca.vertcat(x_s, x_tau), "f": ca.sum1(mesh.tau), "g": ca.vertcat(*g)}
     solver = NLPSolver("bound", nlp, BOUND_OPTIONS, fixed_scale=np.concatenate([s_unit, tau_unit]))
     s0 = s_unit  # the scales: speeds the slider-acceleration limit allows, within every bound
     x0 = np.concatenate([s0, 2 * dth / (2 * np.sqrt(s0))])
@@ -199,15 +199,15 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
 
 
 def node_speed_bounds(
-    grid: BoundGrid, limits: tuple, draw: np.ndarray, w2_lo: float, w2_hi: float
+    mesh: BoundMesh, limits: tuple, draw: np.ndarray, w2_lo: float, w2_hi: float
 ) -> tuple[np.ndarray, np.ndarray]:
     """The bounds on the speed squared at the nodes: every limit's, the draw's range on the draw's nodes.
     :class:`Infeasible` naming the limit that leaves no speed at some node."""
-    n = grid.dtheta.size
+    n = mesh.dtheta.size
     lower, upper = np.zeros(n), np.full(n, np.inf)
     uppers = []
     for limit in limits:
-        lo, up = limit.bound_speeds(grid)
+        lo, up = limit.bound_speeds(mesh)
         if lo is not None:
             lower = np.maximum(lower, lo)
         if up is not None:
@@ -221,7 +221,7 @@ def node_speed_bounds(
         limit = next((lim for lim, up in uppers if up[k] < lower[k]), None)
         field = limit.field if limit is not None else "limits.min_crank_speed_rpm"
         raise Infeasible(
-            f"{field} leaves no crank speed above the minimum at {math.degrees(grid.theta[k]) % 360:.1f} deg",
+            f"{field} leaves no crank speed above the minimum at {math.degrees(mesh.theta[k]) % 360:.1f} deg",
             limit=field,
         )
     return lower, upper

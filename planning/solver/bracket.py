@@ -5,7 +5,7 @@ Below: a motion that passes the dense verification against every limit of the ca
 (``planning.solver.upper_bound``), which no motion within the limits can exceed. The fastest possible
 cycle lies between them; the gap ``upper / verified - 1`` says how well it is known. Each round refines
 the two sides in turn: the verified motion on a layout of more segments (:data:`LAYOUT_FACTORS` times the
-first layout's), the upper bound on a grid of more intervals (:data:`UPPER_GRIDS`), until the gap is under
+first layout's), the upper bound on a grid of more intervals (:data:`UPPER_MESHES`), until the gap is under
 the tolerance or the refinements run out, or stall (a side that closed less than :data:`STALL_SHARE` of the
 gap is refined no further: the gap is then the relaxation's, e.g. limits it leaves out, or the motion's).
 The gap reached is reported, not hidden.
@@ -36,7 +36,7 @@ from planning.solver.verify import evaluate
 from planning.tolerances import CROSSED_PCT
 
 BRACKET_TOL_PCT = 0.05  # [%] the gap the bracket refines down to by default
-UPPER_GRIDS = (1440, 2880, 5760)  # intervals of the upper bound's grid, coarse to fine (one piece each)
+UPPER_MESHES = (1440, 2880, 5760)  # intervals of the upper bound's mesh, coarse to fine (one piece each)
 LAYOUT_FACTORS = (6.0, 15.0)  # the verified motion's refinements: this many times the first layout's segments
 STALL_SHARE = 0.1  # a refinement that closes less than this share of the gap ends that side's refinements
 JERK_ALLOWANCE = 2000.0  # x the press's characteristic jerk: the verified motion's jerk without a case limit
@@ -110,15 +110,15 @@ def bracket(case: Case, tolerance_pct: float = BRACKET_TOL_PCT) -> Bracket:
     planned = planned.with_law(OptimalLaw.name)
     fastest = case.with_objective("max-spm")  # the bracket is about the most strokes, whatever the objective
     verified = _checked(fastest, solve_optimal(planned))
-    upper = upper_bound(fastest, UPPER_GRIDS[0], 1)
+    upper = upper_bound(fastest, UPPER_MESHES[0], 1)
     rounds = [BracketRound(verified.plan.spm, upper.spm, gap_pct(verified.plan.spm, upper.spm))]
     layouts = [finer(PHASES, f) for f in LAYOUT_FACTORS]
-    grids = list(UPPER_GRIDS[1:])
+    meshes = list(UPPER_MESHES[1:])
     turn = 0
-    while rounds[-1].gap_pct > tolerance_pct and (layouts or grids):
+    while rounds[-1].gap_pct > tolerance_pct and (layouts or meshes):
         before = rounds[-1]
         room = STALL_SHARE * (before.upper_spm - before.verified_spm)
-        if layouts and (turn % 2 == 0 or not grids):  # the two sides in turn, the verified motion first
+        if layouts and (turn % 2 == 0 or not meshes):  # the two sides in turn, the verified motion first
             try:
                 verified = _checked(fastest, on_layout(planned, verified, layouts.pop(0)), verified)
             except PlanningError:  # no plan on the finer layout: the side stalls, the motion found stays
@@ -126,12 +126,12 @@ def bracket(case: Case, tolerance_pct: float = BRACKET_TOL_PCT) -> Bracket:
             if verified.plan.spm - before.verified_spm < room:
                 layouts.clear()  # the layout does not hold the motion back (or failed): finer ones will not help
         else:
-            try:  # the grids are not nested: the lowest upper bound is kept
-                upper = min(upper, upper_bound(fastest, grids.pop(0), 1), key=lambda u: u.spm)
+            try:  # the meshes are not nested: the lowest upper bound is kept
+                upper = min(upper, upper_bound(fastest, meshes.pop(0), 1), key=lambda u: u.spm)
             except PlanningError:
                 pass
             if before.upper_spm - upper.spm < room:
-                grids.clear()  # the relaxation, not its grid, leaves the gap
+                meshes.clear()  # the relaxation, not its mesh, leaves the gap
         turn += 1
         rounds.append(BracketRound(verified.plan.spm, upper.spm, gap_pct(verified.plan.spm, upper.spm)))
     gap = rounds[-1].gap_pct

@@ -10,8 +10,8 @@ held fixed) the planner minimises
   ``drive.regen_efficiency``) of the bus power (the motors' copper loss and the converter counted, where the
   drive states them; no storage). ``max(P, 0)`` has a kink where the power changes sign: the NLP uses the
   smooth ``(P + sqrt(P^2 + eps^2)) / 2`` on its samples; the verification and every output use the
-  exact integral (``planning.model.drive``, ``planning.solver.grid``);
-- ``min-grid-peak``: the grid's peak power with the case's storage (``planning.solver.grid``). The NLP
+  exact integral (``planning.model.drive``, ``planning.solver.peak_shaving``);
+- ``min-grid-peak``: the grid's peak power with the case's storage (``planning.solver.peak_shaving``). The NLP
   (the rate NLP's peak variant) minimises the bus power's peak at its samples, an epigraph variable
   ``bus_peak >= (T_m omega_m + k T_m^2) / eta_c`` at every sample, with the heat as a tie-break; the
   answer is chosen by the exact grid peak on the dense grid (with a storage: the least peak its schedule

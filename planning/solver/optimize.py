@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from planning.model.case import Case, Placement
-from planning.model.laws import get_law
+from planning.model.laws import FREE, HALVES, get_law
 from planning.model.plan import Plan
 from planning.solver.max_spm import from_neighbour, solve_max_spm
 from planning.solver.neighbour import plan_of
@@ -71,15 +71,21 @@ def solve_from(case: Case, neighbour: Plan | Solution, placement: Placement | No
 
 
 def _cold(case: Case, placement: Placement | None) -> Solution:
-    if get_law(case.planner.motion_law).free_profile:
-        return solve_optimal(case)
-    return solve_max_spm(case, placement)
+    """The cold solve of the case's law's transcription."""
+    return TRANSCRIPTIONS[get_law(case.planner.motion_law).transcription][0](case, placement)
 
 
 def _from_neighbour(case: Case, placement: Placement | None, neighbour: Plan | Solution) -> Solution | None:
-    if get_law(case.planner.motion_law).free_profile:
-        return from_neighbour_optimal(case, neighbour)
-    return from_neighbour(case, placement, neighbour)
+    """The answer from a neighbour alone, by the case's law's transcription."""
+    return TRANSCRIPTIONS[get_law(case.planner.motion_law).transcription][1](case, placement, neighbour)
+
+
+# each transcription's cold solve and its answer from a neighbour (the optimal law's free profile is planned
+# whole, in free placement: it takes no placement)
+TRANSCRIPTIONS = {
+    HALVES: (solve_max_spm, from_neighbour),
+    FREE: (lambda case, _: solve_optimal(case), lambda case, _, neighbour: from_neighbour_optimal(case, neighbour)),
+}
 
 
 def _better(cold: Solution, warm: Solution | None) -> Solution:

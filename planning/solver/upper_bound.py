@@ -34,7 +34,7 @@ the limits (the limits state their own, ``Limit.relaxed_rows`` / ``relaxed_caps`
   dips -- and every inflection point of h is a node), so the least h'^2 of a sub-piece is at one of its
   ends. On an arc where a limit is active the envelope follows the motion to O(sub-piece) and Jensen's
   inequality costs O(piece^2): without a jerk limit the bound converges from above as the grid refines
-  (the jerk rows keep a slack of m / (m - 1) on a jerk ramp at any grid).
+  (the jerk rows keep a slack of m / (m - 1) on a jerk ramp at any mesh).
 
 ``1 / sqrt`` of an affine function is convex, so the relaxed problem is convex and IPOPT's optimum is its
 global one; the upper bound is ``60 / (sum tau)`` at that optimum, up to IPOPT's tolerance (1e-10; only
@@ -55,8 +55,8 @@ import numpy as np
 
 from planning.model.case import RPM, Case
 from planning.model.limits import limits_of
-from planning.model.limits.base import BoundGrid, Envelope, RelaxedGrid
-from planning.solver.bound import BOUND_OPTIONS, angle_grid, node_speed_bounds
+from planning.model.limits.base import BoundMesh, Envelope, RelaxedMesh
+from planning.solver.bound import BOUND_OPTIONS, angle_mesh, node_speed_bounds
 from planning.solver.ipopt import NLPSolver
 from planning.solver.outcomes import NoPlanFound
 from planning.solver.precheck import precheck
@@ -74,7 +74,7 @@ INFLECTION_GRID = 7200  # angles on which the sign changes of h' and h'' are loo
 @dataclass(frozen=True)
 class UpperBound:
     """The certified upper bound: ``spm`` (no motion meeting the limits makes more), ``cycle_time_s`` [s]
-    (no motion's cycle is shorter), ``points`` (intervals) and ``pieces`` (per interval) of the grid,
+    (no motion's cycle is shorter), ``points`` (intervals) and ``pieces`` (per interval) of the mesh,
     ``left_out`` (limits of the case without a relaxed form: not in the bound, which stays an upper bound),
     ``wall_time_s`` [s]."""
 
@@ -116,10 +116,10 @@ def inflections(case: Case) -> list[float]:
 
 def _sign_changes(case: Case, order: int) -> list[float]:
     """Crank angles [rad] where the ``order``-th derivative of h changes sign."""
-    grid = np.linspace(0.0, 2 * math.pi, INFLECTION_GRID + 1)
-    d2 = case.machine.jets(grid)[order]
+    mesh = np.linspace(0.0, 2 * math.pi, INFLECTION_GRID + 1)
+    d2 = case.machine.jets(mesh)[order]
     k = np.flatnonzero(np.sign(d2[:-1]) * np.sign(d2[1:]) < 0)
-    lo, hi = grid[k], grid[k + 1]
+    lo, hi = mesh[k], mesh[k + 1]
     sign_lo = np.sign(d2[k])
     for _ in range(60):
         mid = 0.5 * (lo + hi)
@@ -152,9 +152,9 @@ def _pieces(theta: np.ndarray, d1: np.ndarray, pieces: int) -> tuple[np.ndarray,
 
 @dataclass(frozen=True)
 class Relaxation:
-    """The relaxed problem of a case on one grid: ``nlp`` (CasADi: ``x`` scaled variables, ``f``, ``g``),
+    """The relaxed problem of a case on one mesh: ``nlp`` (CasADi: ``x`` scaled variables, ``f``, ``g``),
     ``scale`` (physical = scale * x: the crank speed squared at the nodes [rad^2/s^2], then each piece's time
-    [s]), bounds ``lbx``, ``ubx`` (physical), ``lbg``, ``ubg``, start ``x0`` (physical); the grid: ``theta``
+    [s]), bounds ``lbx``, ``ubx`` (physical), ``lbg``, ``ubg``, start ``x0`` (physical); the mesh: ``theta``
     (nodes [rad], from theta1 over one turn), ``cell`` (each piece's interval), ``a``, ``b`` (its ends
     [rad]); ``left_out`` (limits without a relaxed form)."""
 
@@ -214,26 +214,26 @@ def relaxation(case: Case, points: int = UPPER_POINTS, pieces: int = UPPER_PIECE
     motion at all (the prechecks)."""
     w2_lo, w2_hi = precheck(case)
     m = case.machine
-    th = angle_grid(case, points, (0.0, m.bdc_angle, *slope_zeros(case), *inflections(case)))
+    th = angle_mesh(case, points, (0.0, m.bdc_angle, *slope_zeros(case), *inflections(case)))
     dth = np.diff(th)
     h, d1, d2, _ = m.jets(th)
     _, th2, th3, th4 = case.key_angles
     limits = limits_of(case)
     draw = np.flatnonzero((th[:-1] >= th2 - SAME_ANGLE_RAD) & (th[:-1] <= th3 + SAME_ANGLE_RAD))
     window = th[:-1] >= th4 - SAME_ANGLE_RAD
-    lbx_s, ubx_s = node_speed_bounds(BoundGrid(case, th, h, d1, d2, dth, window), limits, draw, w2_lo, w2_hi)
+    lbx_s, ubx_s = node_speed_bounds(BoundMesh(case, th, h, d1, d2, dth, window), limits, draw, w2_lo, w2_hi)
 
     cell, a, b, dead = _pieces(th, d1, pieces)
     h_a, d1_a = m.jets(a)[:2]
     h_b, d1_b = m.jets(b)[:2]
     slope2_min = np.where(dead, 0.0, np.minimum(d1_a**2, d1_b**2))
-    grid = RelaxedGrid(case, th, h, d1, d2, dth, window, cell=cell, a=a, b=b, h_a=h_a, h_b=h_b, slope2_min=slope2_min)
-    s_unit, tau_unit, x_s, x_tau, tau_piece = _symbols(grid, lbx_s, ubx_s)
+    mesh = RelaxedMesh(case, th, h, d1, d2, dth, window, cell=cell, a=a, b=b, h_a=h_a, h_b=h_b, slope2_min=slope2_min)
+    s_unit, tau_unit, x_s, x_tau, tau_piece = _symbols(mesh, lbx_s, ubx_s)
 
-    g, lbg, ubg, left_out = _limit_rows(grid, limits, draw)
+    g, lbg, ubg, left_out = _limit_rows(mesh, limits, draw)
     relaxed = [limit for limit in limits if limit.field not in left_out]
     inside = draw[th[draw + 1] <= th3 + SAME_ANGLE_RAD]  # the draw's intervals (the node at theta3 starts the return)
-    tau_floor = _piece_time_rows(grid, relaxed, inside, dead, tau_piece, (g, lbg, ubg))
+    tau_floor = _piece_time_rows(mesh, relaxed, inside, dead, tau_piece, (g, lbg, ubg))
     width = b - a
     nlp = {"x": ca.vertcat(x_s, x_tau), "f": ca.sum1(tau_piece), "g": ca.vertcat(*g)}
     return Relaxation(
@@ -252,36 +252,36 @@ def relaxation(case: Case, points: int = UPPER_POINTS, pieces: int = UPPER_PIECE
     )
 
 
-def _symbols(grid: RelaxedGrid, lbx_s: np.ndarray, ubx_s: np.ndarray) -> tuple:
+def _symbols(mesh: RelaxedMesh, lbx_s: np.ndarray, ubx_s: np.ndarray) -> tuple:
     """The relaxation's variables on ``grid`` (set on it): the speed squared at the nodes and each piece's
     time, scaled (``s_unit``, ``tau_unit``: the grid bound's scales); returns ``(s_unit, tau_unit, x_s,
     x_tau, tau_piece)``."""
-    case, th, cell = grid.case, grid.theta, grid.cell
+    case, th, cell = mesh.case, mesh.theta, mesh.cell
     n = th.size - 1
     w_acc2 = case.limits.slider_accel_mm_s2 / case.machine.peak_curvature  # scales, as the grid bound's
     s_unit = np.clip(np.full(n, w_acc2), lbx_s, ubx_s)
-    tau_unit = (grid.b - grid.a) / np.sqrt(s_unit[cell])
+    tau_unit = (mesh.b - mesh.a) / np.sqrt(s_unit[cell])
     x_s = ca.SX.sym("s", n)  # scalar operations only: SX evaluates them fastest
     x_tau = ca.SX.sym("tau", cell.size)
     s = ca.DM(s_unit) * x_s
     tau_piece = ca.DM(tau_unit) * x_tau
-    grid.s = s
-    grid.s_next = ca.vertcat(s[1:], s[0])
-    grid.alpha = (grid.s_next - grid.s) / (2 * grid.dtheta)  # each interval's mean acceleration over angle
+    mesh.s = s
+    mesh.s_next = ca.vertcat(s[1:], s[0])
+    mesh.alpha = (mesh.s_next - mesh.s) / (2 * mesh.dtheta)  # each interval's mean acceleration over angle
     # each interval's time: the sum of its pieces' (a sparse 0/1 matrix)
     to_cell = ca.DM(ca.Sparsity.triplet(n, cell.size, cell.tolist(), list(range(cell.size))), 1.0)
-    grid.tau = ca.mtimes(to_cell, tau_piece)
-    grid.tau_next = ca.vertcat(grid.tau[1:], grid.tau[0])
+    mesh.tau = ca.mtimes(to_cell, tau_piece)
+    mesh.tau_next = ca.vertcat(mesh.tau[1:], mesh.tau[0])
     return s_unit, tau_unit, x_s, x_tau, tau_piece
 
 
-def _limit_rows(grid: RelaxedGrid, limits: tuple, draw: np.ndarray) -> tuple[list, list, list, list[str]]:
+def _limit_rows(mesh: RelaxedMesh, limits: tuple, draw: np.ndarray) -> tuple[list, list, list, list[str]]:
     """Each limit's relaxed rows (the fields of those without any: left out), then the draw at one speed:
     ``(g, lbg, ubg, left_out)``."""
     g, lbg, ubg = [], [], []
     left_out = []
     for limit in limits:
-        rows = limit.relaxed_rows(grid)
+        rows = limit.relaxed_rows(mesh)
         if rows is None:
             left_out.append(limit.field)
             continue
@@ -290,7 +290,7 @@ def _limit_rows(grid: RelaxedGrid, limits: tuple, draw: np.ndarray) -> tuple[lis
             lbg.append(np.broadcast_to(lo, (expr.shape[0],)))
             ubg.append(np.broadcast_to(hi, (expr.shape[0],)))
     if draw.size > 1:  # the draw at one speed
-        s = grid.s
+        s = mesh.s
         g.append(s[draw[1:].tolist()] - s[draw[:-1].tolist()])
         lbg.append(np.zeros(draw.size - 1))
         ubg.append(np.zeros(draw.size - 1))
@@ -298,24 +298,24 @@ def _limit_rows(grid: RelaxedGrid, limits: tuple, draw: np.ndarray) -> tuple[lis
 
 
 def _piece_time_rows(
-    grid: RelaxedGrid, relaxed: list, inside: np.ndarray, dead: np.ndarray, tau_piece: ca.SX, rows: tuple
+    mesh: RelaxedMesh, relaxed: list, inside: np.ndarray, dead: np.ndarray, tau_piece: ca.SX, rows: tuple
 ) -> np.ndarray:
     """Each piece's time from the mean of the envelopes over its sub-pieces (module docstring): rows appended
     to ``rows`` (``g, lbg, ubg``) where the mean depends on the nodes, the time's floor where it is constant
     (returned)."""
     g, lbg, ubg = rows
-    cell = grid.cell
-    sub = _sub_grid(grid, SUBPIECES)
+    cell = mesh.cell
+    sub = _sub_mesh(mesh, SUBPIECES)
 
-    def envelopes_of(g_: RelaxedGrid) -> list[Envelope]:  # the limits', then the draw's at one speed
+    def envelopes_of(g_: RelaxedMesh) -> list[Envelope]:  # the limits', then the draw's at one speed
         return [e for limit in relaxed for e in limit.relaxed_envelopes(g_)] + [
             Envelope(g_.s_a, np.isin(g_.cell, inside), "exact")
         ]
 
     combined = _affine(envelopes_of, sub) + _caps(relaxed, sub)
-    width = grid.b - grid.a
+    width = mesh.b - mesh.a
     tau_floor = np.zeros(cell.size)
-    s_start, s_end = grid.s[cell.tolist()], grid.s_next[cell.tolist()]
+    s_start, s_end = mesh.s[cell.tolist()], mesh.s_next[cell.tolist()]
     for k_a, k_b, k_c in _mean_forms(combined, SUBPIECES):
         ok = np.isfinite(k_c) & ~dead
         constant = ok & (k_a == 0.0) & (k_b == 0.0)
@@ -340,7 +340,7 @@ class _Affine:
     side: str
 
 
-def _affine(envelopes_of, sub: RelaxedGrid) -> list[_Affine]:  # noqa: ANN001 - grid -> list of Envelope
+def _affine(envelopes_of, sub: RelaxedMesh) -> list[_Affine]:  # noqa: ANN001 - grid -> list of Envelope
     """The envelopes ``envelopes_of(sub)`` as numbers: evaluated at the unit node values (each is affine in
     them), infinite where it does not hold."""
     at = []
@@ -355,7 +355,7 @@ def _affine(envelopes_of, sub: RelaxedGrid) -> list[_Affine]:  # noqa: ANN001 - 
     return out
 
 
-def _caps(limits: list, sub: RelaxedGrid) -> list[_Affine]:
+def _caps(limits: list, sub: RelaxedMesh) -> list[_Affine]:
     """The limits' caps as one envelope of either side: on each sub-piece the least of them (none: [])."""
     caps = [np.asarray(c, dtype=float) for c in (limit.relaxed_caps(sub) for limit in limits) if c is not None]
     if not caps:
@@ -364,25 +364,25 @@ def _caps(limits: list, sub: RelaxedGrid) -> list[_Affine]:
     return [_Affine(zero, zero, np.min(caps, axis=0), "both")]
 
 
-def _sub_grid(grid: RelaxedGrid, count: int) -> RelaxedGrid:
+def _sub_mesh(mesh: RelaxedMesh, count: int) -> RelaxedMesh:
     """Each piece of ``grid`` cut into ``count`` equal sub-pieces, in order (a piece's at ``count * p`` on)."""
     frac = np.linspace(0.0, 1.0, count + 1)
-    width = (grid.b - grid.a)[:, None]
-    a = (grid.a[:, None] + width * frac[None, :-1]).ravel()
-    b = (grid.a[:, None] + width * frac[None, 1:]).ravel()
-    dead = np.repeat(grid.slope2_min == 0.0, count)
-    h_a, d1_a = grid.case.machine.jets(a)[:2]
-    h_b, d1_b = grid.case.machine.jets(b)[:2]
+    width = (mesh.b - mesh.a)[:, None]
+    a = (mesh.a[:, None] + width * frac[None, :-1]).ravel()
+    b = (mesh.a[:, None] + width * frac[None, 1:]).ravel()
+    dead = np.repeat(mesh.slope2_min == 0.0, count)
+    h_a, d1_a = mesh.case.machine.jets(a)[:2]
+    h_b, d1_b = mesh.case.machine.jets(b)[:2]
     slope2_min = np.where(dead, 0.0, np.minimum(d1_a**2, d1_b**2))
-    return RelaxedGrid(
-        grid.case,
-        grid.theta,
-        grid.h,
-        grid.d1,
-        grid.d2,
-        grid.dtheta,
-        grid.window,
-        cell=np.repeat(grid.cell, count),
+    return RelaxedMesh(
+        mesh.case,
+        mesh.theta,
+        mesh.h,
+        mesh.d1,
+        mesh.d2,
+        mesh.dtheta,
+        mesh.window,
+        cell=np.repeat(mesh.cell, count),
         a=a,
         b=b,
         h_a=h_a,

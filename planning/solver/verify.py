@@ -22,7 +22,7 @@ from planning.model.limits import field_of, limits_of
 from planning.model.limits.base import Check, Dense
 from planning.model.plan import Plan
 from planning.model.profile import max_abs_jerk, sample_times
-from planning.solver.grid import power_columns, power_figures
+from planning.solver.peak_shaving import power_columns, power_figures
 from planning.tolerances import (
     ACCEL_CLOSE_TOL_RAD_S2,
     ANGLE_TOL_RAD,

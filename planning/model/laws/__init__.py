@@ -22,7 +22,8 @@ optimal            no halves: a piecewise-constant jerk profile from       accel
                    theta3 round to theta2, planned whole under |jerk| <= J
 =================  ====================================================  ===========================
 
-Each law is a class (``base.MotionLaw``) in a file of its own; this module is the registry. The
+Each law is a class in a file of its own (``base.MotionLaw`` for a law with halves; the optimal law is a
+``base.Law`` with a transcription of its own); this module is the registry. The
 peak speed between the halves is a point (no constant-speed segment at the peak); the seven-
 segment law's degenerate cases -- the plateau vanishes at ``r = 1``, the constant-speed segments at
 the ends vanish when the optimizer sets them to zero -- are all inside its parameter range.
@@ -32,24 +33,35 @@ from __future__ import annotations
 
 from typing import Literal, get_args
 
-from planning.model.laws.base import MotionLaw, ShapeParameter
+from planning.model.laws.base import FREE, HALVES, Law, MotionLaw, ShapeParameter
 from planning.model.laws.improved_scurve import ImprovedSCurve
 from planning.model.laws.one_segment import CycloidalLaw, LogisticLaw, QuinticLaw
 from planning.model.laws.optimal import OptimalLaw
 from planning.model.laws.seven_segment import SevenSegment
 
-LAWS: dict[str, MotionLaw] = {
+LAWS: dict[str, Law] = {
     law.name: law
     for law in (ImprovedSCurve(), SevenSegment(), QuinticLaw(), LogisticLaw(), CycloidalLaw(), OptimalLaw())
 }
 DEFAULT_LAW = ImprovedSCurve.name
-SHAPED_LAWS = tuple(name for name, law in LAWS.items() if not law.free_profile)  # the laws with halves
+SHAPED_LAWS = tuple(name for name, law in LAWS.items() if law.transcription == HALVES)  # the laws with halves
 LawName = Literal["improved-s-curve", "seven-segment", "quintic", "logistic", "cycloidal", "optimal"]
 assert set(get_args(LawName)) == set(LAWS)
 
-__all__ = ["DEFAULT_LAW", "LAWS", "SHAPED_LAWS", "LawName", "MotionLaw", "ShapeParameter", "get_law"]
+__all__ = [
+    "DEFAULT_LAW",
+    "FREE",
+    "HALVES",
+    "LAWS",
+    "SHAPED_LAWS",
+    "Law",
+    "LawName",
+    "MotionLaw",
+    "ShapeParameter",
+    "get_law",
+]
 
 
-def get_law(name: str) -> MotionLaw:
+def get_law(name: str) -> Law:
     """The law called ``name`` (:data:`LAWS`)."""
     return LAWS[name]

@@ -27,24 +27,49 @@ class ShapeParameter:
         return self.valid_low, self.valid_high
 
 
-class MotionLaw(ABC):
-    """A motion law: how the crank speed changes over one half of an S-curve.
+HALVES = "halves"  # a cycle of four halves and constant stages (planning.solver.halves_nlp)
+FREE = "free"  # a free piecewise-constant-jerk profile, planned whole (planning.solver.free_nlp)
+
+
+class Law:
+    """A motion law of the registry: how the crank moves between the draw and the robot's window.
 
     Class attributes: ``name``, ``continuity`` (``"acceleration"`` or ``"jerk"``: the highest derivative
-    of the speed that is continuous), ``source``, ``parameter`` (a :class:`ShapeParameter` or None),
-    ``samples`` (slider-acceleration samples the NLP takes per segment of a half; the dense
-    verification decides between them), ``one_jerk_per_curve`` (Eq. 14: both halves of an S-curve
-    share one jerk), ``free_profile`` (no halves: the optimal law). Every method works on floats, numpy
-    arrays and CasADi symbols.
-    """
+    of the speed that is continuous), ``source``, ``transcription`` (:data:`HALVES`: the law shapes the
+    halves of a cycle, :class:`MotionLaw`; :data:`FREE`: the profile is planned whole, the optimal law;
+    the solver picks the NLP by it), ``needs_jerk_limit`` (it plans under ``limits.crank_jerk_rad_s3`` and
+    needs one), ``plans_at_rate`` (it takes an objective at the line's rate), ``parameter`` (a
+    :class:`ShapeParameter` or None)."""
 
     name: ClassVar[str]
     continuity: ClassVar[str]
     source: ClassVar[str]
+    transcription: ClassVar[str]
+    needs_jerk_limit: ClassVar[bool] = False
+    plans_at_rate: ClassVar[bool] = True
     parameter: ClassVar[ShapeParameter | None] = None
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}()"
+
+    def __eq__(self, other: object) -> bool:
+        return type(self) is type(other)
+
+    def __hash__(self) -> int:
+        return hash(type(self))
+
+
+class MotionLaw(Law, ABC):
+    """A law with halves: how the crank speed changes over one half of an S-curve.
+
+    Besides :class:`Law`'s: ``samples`` (slider-acceleration samples the NLP takes per segment of a half;
+    the dense verification decides between them), ``one_jerk_per_curve`` (Eq. 14: both halves of an
+    S-curve share one jerk). Every method works on floats, numpy arrays and CasADi symbols.
+    """
+
+    transcription = HALVES
     samples: ClassVar[int] = 5
     one_jerk_per_curve: ClassVar[bool] = False
-    free_profile: ClassVar[bool] = False  # True: no halves, the profile is planned whole (the optimal law)
 
     @abstractmethod
     def half(self, prefix: str, duration: Any, dv: Any, param: Any = None) -> list[Segment]:
@@ -57,12 +82,3 @@ class MotionLaw(ABC):
     @abstractmethod
     def peak_jerk(self, param: Any = None) -> Any:
         """Peak |jerk| of a half in units of ``|dv| / D^2``."""
-
-    def __repr__(self) -> str:
-        return f"{type(self).__name__}()"
-
-    def __eq__(self, other: object) -> bool:
-        return type(self) is type(other)
-
-    def __hash__(self) -> int:
-        return hash(type(self))

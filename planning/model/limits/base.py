@@ -15,7 +15,7 @@ algorithms:
 
 - :class:`Transcription`: an NLP's states at its samples and the extremes it can express (symbols);
 - :class:`Dense`: the dense re-simulation of a plan (numpy arrays);
-- :class:`BoundGrid`: the time-optimal bound's grid over crank angle and its variables (symbols);
+- :class:`BoundMesh`: the time-optimal bound's grid over crank angle and its variables (symbols);
 - :class:`Draw`: the draw at constant crank speed, sampled (numpy arrays), for the draw-speed bounds.
 
 Every expression works on numpy arrays and CasADi symbols alike (``press.backend``); nothing here
@@ -220,7 +220,7 @@ class Dense:
 
 
 @dataclass
-class BoundGrid:
+class BoundMesh:
     """The time-optimal bound's grid (``planning.solver.bound``): ``theta`` [rad], ``h`` [mm], ``d1``
     [mm/rad], ``d2`` [mm/rad^2] at the n + 1 nodes (node n is node 0 a turn on), ``dtheta`` [rad] of the n
     intervals; the symbols ``s`` (crank speed squared at nodes 0 .. n-1 [rad^2/s^2]), ``s_next`` (at
@@ -243,9 +243,9 @@ class BoundGrid:
 
 
 @dataclass
-class RelaxedGrid(BoundGrid):
+class RelaxedMesh(BoundMesh):
     """The certified upper bound's grid (``planning.solver.upper_bound``): the nodes and symbols of
-    :class:`BoundGrid` (``alpha``: each interval's mean crank acceleration over angle, whatever the motion
+    :class:`BoundMesh` (``alpha``: each interval's mean crank acceleration over angle, whatever the motion
     does within it), on nodes where ``h`` is monotone and ``d1^2`` monotone over every interval; each
     interval cut into pieces: ``cell`` (the interval of each piece), ``a``, ``b`` [rad] (its ends), ``h_a``,
     ``h_b`` [mm] (heights there), ``slope2_min`` [mm^2/rad^2] (the least ``d1^2`` over the piece); per piece
@@ -282,7 +282,7 @@ class Draw:
 
 class Envelope(NamedTuple):
     """An upper bound on the crank speed squared [rad^2/s^2] over each piece of the certified upper bound's
-    grid, for every motion that meets the limit: ``value`` (one per piece, affine in the node values; the
+    mesh, for every motion that meets the limit: ``value`` (one per piece, affine in the node values; the
     largest the limit allows anywhere in the piece), ``where`` (the pieces on which it holds), ``side``:
     ``"start"`` when it grows from the interval's start node (tight near it), ``"end"`` from its end node."""
 
@@ -385,16 +385,16 @@ class Limit:
         """The limit's checks on the dense re-simulation."""
         return []
 
-    def bound_speeds(self, grid: BoundGrid) -> tuple[np.ndarray | None, np.ndarray | None]:
+    def bound_speeds(self, mesh: BoundMesh) -> tuple[np.ndarray | None, np.ndarray | None]:
         """The limit's bounds ``(lower, upper)`` on the crank speed squared [rad^2/s^2] at the bound's nodes
         0 .. n-1 (None: none); numbers, known before the bound's variables (``grid`` without symbols)."""
         return None, None
 
-    def bound_rows(self, grid: BoundGrid) -> list[tuple[Any, Any, Any]]:
+    def bound_rows(self, mesh: BoundMesh) -> list[tuple[Any, Any, Any]]:
         """The limit's rows ``(expr, lo, hi)`` over the bound's intervals."""
         return []
 
-    def relaxed_rows(self, grid: RelaxedGrid) -> list[tuple[Any, Any, Any]] | None:
+    def relaxed_rows(self, mesh: RelaxedMesh) -> list[tuple[Any, Any, Any]] | None:
         """The limit's rows ``(expr, lo, hi)`` in the certified upper bound: conditions every motion that
         meets the limit meets at the grid's nodes and over its intervals (never a restriction). None: the
         limit has no such form and is left out of the upper bound (which stays an upper bound, looser).
@@ -402,12 +402,12 @@ class Limit:
         nodes, :meth:`bound_speeds`, hold at any angle), else None."""
         return [] if type(self).bound_rows is Limit.bound_rows else None
 
-    def relaxed_caps(self, grid: RelaxedGrid) -> np.ndarray | None:
+    def relaxed_caps(self, mesh: RelaxedMesh) -> np.ndarray | None:
         """An upper bound on the crank speed squared [rad^2/s^2] valid over each whole piece (numbers;
         None: none), the largest the limit allows anywhere in the piece."""
         return None
 
-    def relaxed_envelopes(self, grid: RelaxedGrid) -> list[Envelope]:
+    def relaxed_envelopes(self, mesh: RelaxedMesh) -> list[Envelope]:
         """The limit's :class:`Envelope` s of the crank speed squared over the grid's pieces (none by
         default)."""
         return []

@@ -8,12 +8,12 @@ import numpy as np
 from pydantic import Field
 
 from planning.model.limits.base import (
-    BoundGrid,
+    BoundMesh,
     Check,
     Dense,
     Envelope,
     Limit,
-    RelaxedGrid,
+    RelaxedMesh,
     Row,
     Transcription,
 )
@@ -59,23 +59,23 @@ class CrankAccelLimit(Limit):
         check = Check.of(self.id, self.name, float(np.max(accel)), limit, self.unit, "max", LIMIT_REL_TOL * limit)
         return [check.located(dense.t, dense.theta, accel, limit)]
 
-    def bound_rows(self, grid: BoundGrid) -> list[tuple[Any, Any, Any]]:
-        limit = grid.case.limits.crank_accel_rad_s2
-        n = grid.dtheta.size
-        return [(grid.alpha, -limit * np.ones(n), limit * np.ones(n))]
+    def bound_rows(self, mesh: BoundMesh) -> list[tuple[Any, Any, Any]]:
+        limit = mesh.case.limits.crank_accel_rad_s2
+        n = mesh.dtheta.size
+        return [(mesh.alpha, -limit * np.ones(n), limit * np.ones(n))]
 
-    def relaxed_rows(self, grid: RelaxedGrid) -> list[tuple[Any, Any, Any]]:
+    def relaxed_rows(self, mesh: RelaxedMesh) -> list[tuple[Any, Any, Any]]:
         """Each interval's mean acceleration over angle lies within the limit as every value does: the grid
         bound's rows on the means."""
-        return self.bound_rows(grid)
+        return self.bound_rows(mesh)
 
-    def relaxed_envelopes(self, grid: RelaxedGrid) -> list[Envelope]:
+    def relaxed_envelopes(self, mesh: RelaxedMesh) -> list[Envelope]:
         """``ds/dtheta = 2 alpha``: over a piece [a, b] of interval i, ``s <= s_i + 2 A_c (b - theta_i)`` and
         ``s <= s_(i+1) + 2 A_c (theta_(i+1) - a)``."""
-        limit = grid.case.limits.crank_accel_rad_s2
-        every = np.ones(grid.cell.size, dtype=bool)
-        start, end = grid.theta[grid.cell], grid.theta[grid.cell + 1]
+        limit = mesh.case.limits.crank_accel_rad_s2
+        every = np.ones(mesh.cell.size, dtype=bool)
+        start, end = mesh.theta[mesh.cell], mesh.theta[mesh.cell + 1]
         return [
-            Envelope(grid.s_a + 2 * limit * (grid.b - start), every, "start"),
-            Envelope(grid.s_b + 2 * limit * (end - grid.a), every, "end"),
+            Envelope(mesh.s_a + 2 * limit * (mesh.b - start), every, "start"),
+            Envelope(mesh.s_b + 2 * limit * (end - mesh.a), every, "end"),
         ]

@@ -8,11 +8,11 @@ import numpy as np
 from pydantic import Field
 
 from planning.model.limits.base import (
-    BoundGrid,
+    BoundMesh,
     Check,
     Dense,
     Limit,
-    RelaxedGrid,
+    RelaxedMesh,
     Row,
     Transcription,
     sample_vector,
@@ -63,26 +63,26 @@ class CrankJerkLimit(Limit):
         check = Check.of(self.id, self.name, peak, limit, self.unit, "max", LIMIT_REL_TOL * limit)
         return [check.located(dense.t, dense.theta, np.abs(dense.jerk), limit)]
 
-    def bound_rows(self, grid: BoundGrid) -> list[tuple[Any, Any, Any]]:
+    def bound_rows(self, mesh: BoundMesh) -> list[tuple[Any, Any, Any]]:
         """Neighbouring intervals' accelerations differ by at most J times half their joint time."""
-        return _jerk_rows(grid, 0.5)
+        return _jerk_rows(mesh, 0.5)
 
-    def relaxed_rows(self, grid: RelaxedGrid) -> list[tuple[Any, Any, Any]]:
+    def relaxed_rows(self, mesh: RelaxedMesh) -> list[tuple[Any, Any, Any]]:
         """An interval's mean acceleration over angle is a value the acceleration takes within it, so the
         means of intervals i and i + m - 1 differ by at most ``J`` times the time of the m intervals from
         i to i + m - 1 (the grid bound's half is an estimate, not a bound); for m in :data:`RELAXED_SPANS`:
         on a long jerk ramp the rows over m intervals allow ``m / (m - 1)`` times the jerk (twice it over
         a pair of neighbours, 4/3 over four intervals)."""
-        J = grid.case.limits.crank_jerk_rad_s3
-        n = grid.dtheta.size
+        J = mesh.case.limits.crank_jerk_rad_s3
+        n = mesh.dtheta.size
         rows = []
-        window, m = grid.tau, 1  # window[i]: the time of the m intervals from i on (cyclic)
+        window, m = mesh.tau, 1  # window[i]: the time of the m intervals from i on (cyclic)
         for span in RELAXED_SPANS:
             while m < span:
                 window, m = window + _shifted(window, m), 2 * m
             if span > n:
                 break
-            change = _shifted(grid.alpha, span - 1) - grid.alpha
+            change = _shifted(mesh.alpha, span - 1) - mesh.alpha
             rows += [
                 (change - J * window, np.full(n, -np.inf), np.zeros(n)),
                 (change + J * window, np.zeros(n), np.full(n, np.inf)),
@@ -99,13 +99,13 @@ def _shifted(values: Any, k: int) -> Any:
     return sample_vector([values[k:], values[:k]])
 
 
-def _jerk_rows(grid: BoundGrid, share: float) -> list[tuple[Any, Any, Any]]:
+def _jerk_rows(mesh: BoundMesh, share: float) -> list[tuple[Any, Any, Any]]:
     """``|alpha_(i+1) - alpha_i| <= J share (tau_i + tau_(i+1))`` over every pair of neighbouring intervals."""
-    J = grid.case.limits.crank_jerk_rad_s3
-    alpha_next = sample_vector([grid.alpha[1:], grid.alpha[0]])
-    room = J * share * (grid.tau + grid.tau_next)
-    n = grid.dtheta.size
+    J = mesh.case.limits.crank_jerk_rad_s3
+    alpha_next = sample_vector([mesh.alpha[1:], mesh.alpha[0]])
+    room = J * share * (mesh.tau + mesh.tau_next)
+    n = mesh.dtheta.size
     return [
-        (alpha_next - grid.alpha - room, np.full(n, -np.inf), np.zeros(n)),
-        (alpha_next - grid.alpha + room, np.zeros(n), np.full(n, np.inf)),
+        (alpha_next - mesh.alpha - room, np.full(n, -np.inf), np.zeros(n)),
+        (alpha_next - mesh.alpha + room, np.zeros(n), np.full(n, np.inf)),
     ]

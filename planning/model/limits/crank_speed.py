@@ -8,7 +8,7 @@ import numpy as np
 from pydantic import Field
 
 from planning.model.errors import CaseError
-from planning.model.limits.base import BoundGrid, Check, Dense, Draw, Limit, RelaxedGrid, Row, Transcription
+from planning.model.limits.base import BoundMesh, Check, Dense, Draw, Limit, RelaxedMesh, Row, Transcription
 from planning.model.units import RPM, CrankSpeed
 from planning.tolerances import LIMIT_REL_TOL, SAME_RELATIVE
 
@@ -64,9 +64,9 @@ class CrankSpeedLimit(Limit):
         check = Check.of(self.id, self.name, fastest, top, self.unit, "max", LIMIT_REL_TOL * top)
         return [check.located(dense.t, dense.theta, dense.omega / RPM, top)]
 
-    def bound_speeds(self, grid: BoundGrid) -> tuple[np.ndarray | None, np.ndarray | None]:
-        top = grid.case.limits.crank_speed_rpm * RPM
-        return None, np.full(grid.dtheta.size, top**2)
+    def bound_speeds(self, mesh: BoundMesh) -> tuple[np.ndarray | None, np.ndarray | None]:
+        top = mesh.case.limits.crank_speed_rpm * RPM
+        return None, np.full(mesh.dtheta.size, top**2)
 
-    def relaxed_caps(self, grid: RelaxedGrid) -> np.ndarray:
-        return np.full(grid.cell.size, (grid.case.limits.crank_speed_rpm * RPM) ** 2)
+    def relaxed_caps(self, mesh: RelaxedMesh) -> np.ndarray:
+        return np.full(mesh.cell.size, (mesh.case.limits.crank_speed_rpm * RPM) ** 2)

@@ -10,12 +10,12 @@ from pydantic import Field
 
 from planning.model.errors import CaseError
 from planning.model.limits.base import (
-    BoundGrid,
+    BoundMesh,
     Check,
     Dense,
     Draw,
     Limit,
-    RelaxedGrid,
+    RelaxedMesh,
     Row,
     Transcription,
     sample_vector,
@@ -120,18 +120,18 @@ class DieSpeedLimit(Limit):
         order = np.argsort(t, kind="stable")
         return [check.located(t[order], theta[order], speed[order], limit)]
 
-    def bound_speeds(self, grid: BoundGrid) -> tuple[np.ndarray | None, np.ndarray | None]:
-        lim = grid.case.limits
-        d1, h = grid.d1[:-1], grid.h[:-1]
+    def bound_speeds(self, mesh: BoundMesh) -> tuple[np.ndarray | None, np.ndarray | None]:
+        lim = mesh.case.limits
+        d1, h = mesh.d1[:-1], mesh.h[:-1]
         low = (h <= lim.die_height_mm * (1 + SAME_RELATIVE) + SAME_HEIGHT_MM) & (np.abs(d1) > 0)  # the crossings count
         upper = np.full(h.shape, np.inf)
         upper[low] = (lim.die_speed_mm_s / np.abs(d1[low])) ** 2
         return None, upper
 
-    def relaxed_caps(self, grid: RelaxedGrid) -> np.ndarray:
+    def relaxed_caps(self, mesh: RelaxedMesh) -> np.ndarray:
         """On a piece wholly at or below the die height: ``(v_die / min |h'|)^2``."""
-        lim = grid.case.limits
-        inside = (np.maximum(grid.h_a, grid.h_b) <= lim.die_height_mm) & (grid.slope2_min > 0)
-        caps = np.full(grid.cell.size, np.inf)
-        caps[inside] = lim.die_speed_mm_s**2 / grid.slope2_min[inside]
+        lim = mesh.case.limits
+        inside = (np.maximum(mesh.h_a, mesh.h_b) <= lim.die_height_mm) & (mesh.slope2_min > 0)
+        caps = np.full(mesh.cell.size, np.inf)
+        caps[inside] = lim.die_speed_mm_s**2 / mesh.slope2_min[inside]
         return caps

@@ -1,5 +1,5 @@
 """The plant's limit on the press's draw from the grid (``drive.grid.peak_power_kW``), with the DC-bus storage's
-schedule (``planning.solver.grid``; the chain and its signs: ``press.power``).
+schedule (``planning.solver.peak_shaving``; the chain and its signs: ``press.power``).
 
 In a drive NLP the limit caps the bus power at every sample, ``P_bus <= cap`` (the parameter ``grid_cap``; the
 row ``(T_m omega_m + P_cu) / (eta_c cap) <= 1``, which a braking sample meets anyway). Without storage the cap is
@@ -12,7 +12,7 @@ storage's best schedule on the dense grid; where the plan needs more storage tha
 energy above the limit, or the storage cannot recharge in time), the allowance is scaled by the usable energy
 over the storage the plan needs and the plan solved again; where no storage size would do (its power), the cap
 goes to the highest level at which the storage could hold the limit were that plan's bus power clipped there
-(``planning.solver.grid.bus_cap_for_limit``). The storage's energy budget is in the NLP, its periodic schedule
+(``planning.solver.peak_shaving.bus_cap_for_limit``). The storage's energy budget is in the NLP, its periodic schedule
 is not: the plans are verified, not proven the fastest (the README says so).
 """
 
@@ -148,7 +148,7 @@ class GridPeakLimit(Limit):
             return [replace(check, refine_by=("grid_cap", factor, p.bus_peak_kW * 1e3))]
         return [check]
 
-    def relaxed_rows(self, grid: Any) -> None:
+    def relaxed_rows(self, mesh: Any) -> None:
         """Not in the upper bound (the storage's state couples the whole cycle): left out."""
         return None
 

@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 from pydantic import Field
 
-from planning.model.limits.base import BoundGrid, Check, Dense, Draw, Limit, Row, Transcription
+from planning.model.limits.base import BoundMesh, Check, Dense, Draw, Limit, Row, Transcription
 from planning.model.units import RPM, CrankSpeed
 from planning.tolerances import LIMIT_REL_TOL, SAME_RELATIVE
 
@@ -54,6 +54,6 @@ class MinCrankSpeedLimit(Limit):
         check = Check.of(self.id, self.name, slowest, lowest, self.unit, "min", LIMIT_REL_TOL * lowest)
         return [check.located(dense.t, dense.theta, dense.omega / RPM, lowest)]
 
-    def bound_speeds(self, grid: BoundGrid) -> tuple[np.ndarray | None, np.ndarray | None]:
-        w_min = grid.case.limits.min_crank_speed_rpm * RPM
-        return np.full(grid.dtheta.size, w_min**2), None
+    def bound_speeds(self, mesh: BoundMesh) -> tuple[np.ndarray | None, np.ndarray | None]:
+        w_min = mesh.case.limits.min_crank_speed_rpm * RPM
+        return np.full(mesh.dtheta.size, w_min**2), None

@@ -10,12 +10,12 @@ import numpy as np
 
 from planning.model.errors import CaseError
 from planning.model.limits.base import (
-    BoundGrid,
+    BoundMesh,
     Check,
     Dense,
     Impossible,
     Limit,
-    RelaxedGrid,
+    RelaxedMesh,
     Row,
     Transcription,
     trapezoid,
@@ -71,11 +71,11 @@ class MotorSpeedLimit(Limit):
         limit = d.motor.max_speed_rpm
         return [Check.of(self.id, self.name, top, limit, self.unit, "max", LIMIT_REL_TOL * limit)]
 
-    def bound_speeds(self, grid: BoundGrid) -> tuple[np.ndarray | None, np.ndarray | None]:
-        return None, np.full(grid.dtheta.size, _top_crank_speed(grid.case) ** 2)
+    def bound_speeds(self, mesh: BoundMesh) -> tuple[np.ndarray | None, np.ndarray | None]:
+        return None, np.full(mesh.dtheta.size, _top_crank_speed(mesh.case) ** 2)
 
-    def relaxed_caps(self, grid: RelaxedGrid) -> np.ndarray:
-        return np.full(grid.cell.size, _top_crank_speed(grid.case) ** 2)
+    def relaxed_caps(self, mesh: RelaxedMesh) -> np.ndarray:
+        return np.full(mesh.cell.size, _top_crank_speed(mesh.case) ** 2)
 
 
 def _top_crank_speed(case: Any) -> float:
@@ -141,25 +141,25 @@ class MotorPeakTorqueLimit(Limit):
         check = Check.of(self.id, self.name, float(np.max(use)), 1.0, self.unit, "max", LIMIT_REL_TOL)
         return [check.located(dense.t, dense.theta, use, 1.0)]
 
-    def bound_rows(self, grid: BoundGrid) -> list[tuple[Any, Any, Any]]:
+    def bound_rows(self, mesh: BoundMesh) -> list[tuple[Any, Any, Any]]:
         """Motor torque at both ends of every interval, as the two linear forms whose larger is the motor
         torque: ``T_c / (i eta) + J_m i alpha`` and ``T_c eta / i + J_m i alpha``, with ``T_c`` linear in s and
         alpha (``press.dynamics``, a linkage's links included). Both <= peak is exactly ``T_m <= peak``. The
         forming force is taken on each interval's side of theta2 and BDC."""
-        case = grid.case
+        case = mesh.case
         d = case.drive_model
         m = case.machine
         peak = case.drive.motor.peak_torque_Nm
-        n = grid.dtheta.size
+        n = mesh.dtheta.size
         rows = []
-        ends = ((grid.theta[:-1] + SAME_ANGLE_RAD, grid.s), (grid.theta[1:] - SAME_ANGLE_RAD, grid.s_next))
+        ends = ((mesh.theta[:-1] + SAME_ANGLE_RAD, mesh.s), (mesh.theta[1:] - SAME_ANGLE_RAD, mesh.s_next))
         for theta, speed2 in ends:
             h, d1, d2, _ = m.jets(theta)
             d1, d2 = d1 * 1e-3, d2 * 1e-3
             f_env = forming_force(theta, h, d) + d.F_cb - d.M * GRAVITY
             J, dJ, weight = link_terms(m.frames(theta), d.links) if d.links else (0.0, 0.0, 0.0)
-            tc = (d.J0 + d.M * d1**2 + J) * grid.alpha + (d.M * d1 * d2 + 0.5 * dJ) * speed2 - f_env * d1 + weight
-            for form in (tc / (d.i * d.eta) + d.J_m * d.i * grid.alpha, tc * d.eta / d.i + d.J_m * d.i * grid.alpha):
+            tc = (d.J0 + d.M * d1**2 + J) * mesh.alpha + (d.M * d1 * d2 + 0.5 * dJ) * speed2 - f_env * d1 + weight
+            for form in (tc / (d.i * d.eta) + d.J_m * d.i * mesh.alpha, tc * d.eta / d.i + d.J_m * d.i * mesh.alpha):
                 rows.append((form, np.full(n, -np.inf), np.full(n, peak)))
         return rows
 
@@ -219,7 +219,7 @@ class MotorRMSTorqueLimit(Limit):
         rms = dense.integrals["rms_motor_torque_Nm"]
         return [Check.of(self.id, self.name, rms, rated, self.unit, "max", LIMIT_REL_TOL * rated)]
 
-    def relaxed_rows(self, grid: RelaxedGrid) -> None:
+    def relaxed_rows(self, mesh: RelaxedMesh) -> None:
         """Not in the upper bound (the RMS of a cycle is no condition at an angle): left out."""
         return None
 

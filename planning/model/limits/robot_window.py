@@ -10,13 +10,13 @@ import numpy as np
 
 from planning.model.errors import CaseError
 from planning.model.limits.base import (
-    BoundGrid,
+    BoundMesh,
     Check,
     Dense,
     Draw,
     Impossible,
     Limit,
-    RelaxedGrid,
+    RelaxedMesh,
     Row,
     Transcription,
     total,
@@ -62,13 +62,13 @@ class TransferTimeLimit(Limit):
         window = t1 + dense.plan.period - t4
         return [Check.of(self.id, self.name, window, dense.case.process.transfer_time_s, self.unit, "min", TIME_TOL_S)]
 
-    def bound_rows(self, grid: BoundGrid) -> list[tuple[Any, Any, Any]]:
-        window = np.flatnonzero(grid.window).tolist()
-        return [(total(grid.tau[window]), grid.case.process.transfer_time_s, np.inf)]
+    def bound_rows(self, mesh: BoundMesh) -> list[tuple[Any, Any, Any]]:
+        window = np.flatnonzero(mesh.window).tolist()
+        return [(total(mesh.tau[window]), mesh.case.process.transfer_time_s, np.inf)]
 
-    def relaxed_rows(self, grid: RelaxedGrid) -> list[tuple[Any, Any, Any]]:
+    def relaxed_rows(self, mesh: RelaxedMesh) -> list[tuple[Any, Any, Any]]:
         """The window's intervals' times add up as in the grid bound (each at least the motion's)."""
-        return self.bound_rows(grid)
+        return self.bound_rows(mesh)
 
 
 class SafetyHeightLimit(Limit):

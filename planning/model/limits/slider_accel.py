@@ -9,14 +9,14 @@ import numpy as np
 from pydantic import Field
 
 from planning.model.limits.base import (
-    BoundGrid,
+    BoundMesh,
     Check,
     Dense,
     Draw,
     Envelope,
     Impossible,
     Limit,
-    RelaxedGrid,
+    RelaxedMesh,
     Row,
     Transcription,
 )
@@ -88,33 +88,33 @@ class SliderAccelLimit(Limit):
         check = Check.of(self.id, self.name, float(np.max(accel)), limit, self.unit, "max", LIMIT_REL_TOL * limit)
         return [check.located(dense.t, dense.theta, accel, limit)]
 
-    def bound_rows(self, grid: BoundGrid) -> list[tuple[Any, Any, Any]]:
-        A = grid.case.limits.slider_accel_mm_s2
-        start = grid.d2[:-1] * grid.s + grid.d1[:-1] * grid.alpha
-        end = grid.d2[1:] * grid.s_next + grid.d1[1:] * grid.alpha
-        n = grid.dtheta.size
+    def bound_rows(self, mesh: BoundMesh) -> list[tuple[Any, Any, Any]]:
+        A = mesh.case.limits.slider_accel_mm_s2
+        start = mesh.d2[:-1] * mesh.s + mesh.d1[:-1] * mesh.alpha
+        end = mesh.d2[1:] * mesh.s_next + mesh.d1[1:] * mesh.alpha
+        n = mesh.dtheta.size
         return [(start, -A * np.ones(n), A * np.ones(n)), (end, -A * np.ones(n), A * np.ones(n))]
 
-    def relaxed_rows(self, grid: RelaxedGrid) -> list[tuple[Any, Any, Any]]:
+    def relaxed_rows(self, mesh: RelaxedMesh) -> list[tuple[Any, Any, Any]]:
         """The slide's own kinematics, exact for any motion: ``d(v^2)/dtheta = 2 h' a`` with ``v = h' omega``,
         so over an interval where h is monotone ``|h'_(i+1)^2 s_(i+1) - h'_i^2 s_i| <= 2 A |h_(i+1) - h_i|``; at
         a dead centre (h' = 0) ``|h'' s| <= A``."""
-        A = grid.case.limits.slider_accel_mm_s2
-        w, w_next = grid.d1[:-1] ** 2 * grid.s, grid.d1[1:] ** 2 * grid.s_next
-        room = 2 * A * np.abs(np.diff(grid.h))
+        A = mesh.case.limits.slider_accel_mm_s2
+        w, w_next = mesh.d1[:-1] ** 2 * mesh.s, mesh.d1[1:] ** 2 * mesh.s_next
+        room = 2 * A * np.abs(np.diff(mesh.h))
         rows = [(w_next - w, -room, room)]
-        dead = np.flatnonzero(np.abs(grid.d1[:-1]) <= DEAD_CENTRE_SLOPE * np.max(np.abs(grid.d1)))
+        dead = np.flatnonzero(np.abs(mesh.d1[:-1]) <= DEAD_CENTRE_SLOPE * np.max(np.abs(mesh.d1)))
         if dead.size:
-            rows.append((grid.d2[dead] * grid.s[dead.tolist()], -A * np.ones(dead.size), A * np.ones(dead.size)))
+            rows.append((mesh.d2[dead] * mesh.s[dead.tolist()], -A * np.ones(dead.size), A * np.ones(dead.size)))
         return rows
 
-    def relaxed_envelopes(self, grid: RelaxedGrid) -> list[Envelope]:
+    def relaxed_envelopes(self, mesh: RelaxedMesh) -> list[Envelope]:
         """Over a piece [a, b] of interval i: ``v^2 <= v_i^2 + 2 A |h(b) - h_i|`` and ``<= v_(i+1)^2 + 2 A |h_(i+1) -
         h(a)|``, so ``s <= that / min h'^2`` over the piece (pieces where h' vanishes: none)."""
-        A = grid.case.limits.slider_accel_mm_s2
-        moving = grid.slope2_min > 0
-        m = np.where(moving, grid.slope2_min, 1.0)
-        start, end = grid.cell, grid.cell + 1
-        from_start = (grid.d1[start] ** 2 * grid.s_a + 2 * A * np.abs(grid.h_b - grid.h[start])) / m
-        from_end = (grid.d1[end] ** 2 * grid.s_b + 2 * A * np.abs(grid.h[end] - grid.h_a)) / m
+        A = mesh.case.limits.slider_accel_mm_s2
+        moving = mesh.slope2_min > 0
+        m = np.where(moving, mesh.slope2_min, 1.0)
+        start, end = mesh.cell, mesh.cell + 1
+        from_start = (mesh.d1[start] ** 2 * mesh.s_a + 2 * A * np.abs(mesh.h_b - mesh.h[start])) / m
+        from_end = (mesh.d1[end] ** 2 * mesh.s_b + 2 * A * np.abs(mesh.h[end] - mesh.h_a)) / m
         return [Envelope(from_start, moving, "start"), Envelope(from_end, moving, "end")]

@@ -9,13 +9,13 @@ import numpy as np
 from pydantic import Field
 
 from planning.model.limits.base import (
-    BoundGrid,
+    BoundMesh,
     Check,
     Dense,
     Draw,
     Impossible,
     Limit,
-    RelaxedGrid,
+    RelaxedMesh,
     Row,
     Transcription,
 )
@@ -97,15 +97,15 @@ class SliderSpeedLimit(Limit):
         check = Check.of(self.id, self.name, float(np.max(speed)), limit, self.unit, "max", LIMIT_REL_TOL * limit)
         return [check.located(dense.t, dense.theta, speed, limit)]
 
-    def bound_speeds(self, grid: BoundGrid) -> tuple[np.ndarray | None, np.ndarray | None]:
-        d1 = np.abs(grid.d1[:-1])
+    def bound_speeds(self, mesh: BoundMesh) -> tuple[np.ndarray | None, np.ndarray | None]:
+        d1 = np.abs(mesh.d1[:-1])
         upper = np.full(d1.shape, np.inf)
         moving = d1 > 0
-        upper[moving] = (grid.case.limits.slider_speed_mm_s / d1[moving]) ** 2
+        upper[moving] = (mesh.case.limits.slider_speed_mm_s / d1[moving]) ** 2
         return None, upper
 
-    def relaxed_caps(self, grid: RelaxedGrid) -> np.ndarray:
-        caps = np.full(grid.cell.size, np.inf)
-        moving = grid.slope2_min > 0
-        caps[moving] = grid.case.limits.slider_speed_mm_s**2 / grid.slope2_min[moving]
+    def relaxed_caps(self, mesh: RelaxedMesh) -> np.ndarray:
+        caps = np.full(mesh.cell.size, np.inf)
+        moving = mesh.slope2_min > 0
+        caps[moving] = mesh.case.limits.slider_speed_mm_s**2 / mesh.slope2_min[moving]
         return caps
