@@ -34,6 +34,7 @@ from planning.tolerances import (
     SPEED_TOL_RAD_S,
 )
 from press.dynamics import drive_state
+from press.mechanism import slider_motion
 
 __all__ = ["BINDING_SHARE", "Check", "CheckId", "Evaluation", "Verification", "evaluate", "field_of_check", "verify"]
 
@@ -138,9 +139,10 @@ def simulate(plan: Plan, case: Case) -> tuple[Dense, np.ndarray]:
     prof = plan.profile
     t, uniform = sample_times(plan.period, prof.knot_times)
     th, om, al, je = prof.at_time(t)
-    h, v, a, slide_jerk = case.machine.slider(th, om, al, je)
+    h, d1, d2, d3 = case.machine.jets(th)
+    _, v, a, slide_jerk = slider_motion(h, d1, d2, d3, om, al, je)
     key_times = plan.key_times()
-    dense = Dense(case, plan, t, th, om, al, je, h, v, a, key_times, slide_jerk=slide_jerk)
+    dense = Dense(case, plan, t, th, om, al, je, h, v, a, key_times, slide_jerk=slide_jerk, slope=d1, curvature=d2)
     k_th, k_om, k_al, k_je = prof.at_time(key_times)
     k_h, k_v, _, _ = case.machine.slider(k_th, k_om, k_al, k_je)
     dense.key_motion = {"omega": k_om, "h": k_h, "v": k_v}

@@ -22,7 +22,8 @@ def _discover() -> tuple[Limit, ...]:
             continue
         module = importlib.import_module(f"{__name__}.{info.name}")
         for value in vars(module).values():
-            if isinstance(value, type) and issubclass(value, Limit) and value.__module__ == module.__name__:
+            is_limit = isinstance(value, type) and issubclass(value, Limit) and value.__module__ == module.__name__
+            if is_limit and "id" in vars(value):  # a limit, not a form of them (``canonical``)
                 found.append(value())
     return tuple(sorted(found, key=lambda limit: limit.order))
 

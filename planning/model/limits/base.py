@@ -216,6 +216,8 @@ class Dense:
     integrals: dict | None = None
     power: Any = None  # the power chain to the grid (planning.model.drive.PowerFigures), drive.electrical
     slide_jerk: np.ndarray | None = None  # [mm/s^3] the slide's jerk at the samples
+    slope: np.ndarray | None = None  # [mm/rad] dh/dtheta at the samples
+    curvature: np.ndarray | None = None  # [mm/rad^2] d2h/dtheta2 at the samples
     key_motion: dict | None = None  # at the key points' times: crank speed [rad/s], slide height [mm], speed [mm/s]
 
 

@@ -7,23 +7,15 @@ from typing import Any
 import numpy as np
 from pydantic import Field
 
-from planning.model.limits.base import (
-    BoundMesh,
-    Check,
-    Dense,
-    Envelope,
-    Limit,
-    RelaxedMesh,
-    Row,
-    Transcription,
-)
+from planning.model.limits.base import RelaxedMesh
+from planning.model.limits.canonical import AccelLimit
 from planning.model.units import CrankAccel
-from planning.tolerances import LIMIT_REL_TOL
 
 
-class CrankAccelLimit(Limit):
-    """|crank acceleration| <= the limit: at the closed-form peaks of a law's halves (3/2 J T for the improved
-    S-curve), at a free profile's knots (it is piecewise linear there), on the bound's intervals."""
+class CrankAccelLimit(AccelLimit):
+    """``|alpha| <= C`` (canonical: ``a = 1``, ``b = 0``): at the closed-form peaks of a law's halves (3/2 J T for
+    the improved S-curve), at a free profile's knots (it is piecewise linear there), on the bound's
+    intervals; in the certified upper bound ``mu = 1``, ``I = 2 theta`` (``ds/dtheta = 2 alpha``)."""
 
     id = "crank_accel"
     name = "|crank acceleration| <= limits.crank_accel_rad_s2"
@@ -41,41 +33,24 @@ class CrankAccelLimit(Limit):
         ),
     }
     parameters = ("crank_accel_max",)
+    parameter = "crank_accel_max"
+    row_name = "crank acceleration limit"
+    crank_only = True
 
     def applies(self, case: Any) -> bool:
         return case.limits.crank_accel_rad_s2 is not None
 
-    def parameter_values(self, case: Any) -> dict[str, float]:
-        return {"crank_accel_max": case.limits.crank_accel_rad_s2}
+    def coefficients(self, theta: Any, d1: Any, d2: Any) -> tuple[Any, Any]:
+        return 1.0, 0.0
 
-    def rows(self, nlp: Transcription) -> list[Row]:
-        peaks = nlp.accelerations
-        lo = -1.0 if peaks.signed else -np.inf
-        return [Row("crank acceleration limit", peaks.values / nlp.param("crank_accel_max"), lo, 1.0)]
+    def cap(self, case: Any) -> float:
+        return case.limits.crank_accel_rad_s2
 
-    def check(self, dense: Dense) -> list[Check]:
-        limit = dense.case.limits.crank_accel_rad_s2
-        accel = np.abs(dense.alpha)
-        check = Check.of(self.id, self.name, float(np.max(accel)), limit, self.unit, "max", LIMIT_REL_TOL * limit)
-        return [check.located(dense.t, dense.theta, accel, limit)]
-
-    def bound_rows(self, mesh: BoundMesh) -> list[tuple[Any, Any, Any]]:
-        limit = mesh.case.limits.crank_accel_rad_s2
-        n = mesh.dtheta.size
-        return [(mesh.alpha, -limit * np.ones(n), limit * np.ones(n))]
+    def integrating_factor(self, mesh: RelaxedMesh) -> tuple[Any, Any, Any, Any, Any]:
+        return np.ones(mesh.theta.size), 1.0, 2 * mesh.theta, 2 * mesh.a, 2 * mesh.b
 
     def relaxed_rows(self, mesh: RelaxedMesh) -> list[tuple[Any, Any, Any]]:
-        """Each interval's mean acceleration over angle lies within the limit as every value does: the grid
-        bound's rows on the means."""
+        """The canonical relaxed rows divided by ``I_(i+1) - I_i = 2 (theta_(i+1) - theta_i)``: each interval's
+        mean acceleration over angle, ``(s_(i+1) - s_i) / (2 dtheta)`` (the mesh's ``alpha``), lies within the
+        limit as every value does: the grid bound's rows on the means."""
         return self.bound_rows(mesh)
-
-    def relaxed_envelopes(self, mesh: RelaxedMesh) -> list[Envelope]:
-        """``ds/dtheta = 2 alpha``: over a piece [a, b] of interval i, ``s <= s_i + 2 A_c (b - theta_i)`` and
-        ``s <= s_(i+1) + 2 A_c (theta_(i+1) - a)``."""
-        limit = mesh.case.limits.crank_accel_rad_s2
-        every = np.ones(mesh.cell.size, dtype=bool)
-        start, end = mesh.theta[mesh.cell], mesh.theta[mesh.cell + 1]
-        return [
-            Envelope(mesh.s_a + 2 * limit * (mesh.b - start), every, "start"),
-            Envelope(mesh.s_b + 2 * limit * (end - mesh.a), every, "end"),
-        ]

@@ -8,14 +8,15 @@ import numpy as np
 from pydantic import Field
 
 from planning.model.errors import CaseError
-from planning.model.limits.base import BoundMesh, Check, Dense, Draw, Limit, RelaxedMesh, Row, Transcription
+from planning.model.limits.base import Draw, Row, Transcription
+from planning.model.limits.canonical import SpeedCap
 from planning.model.units import RPM, CrankSpeed
-from planning.tolerances import LIMIT_REL_TOL, SAME_RELATIVE
+from planning.tolerances import SAME_RELATIVE
 
 
-class CrankSpeedLimit(Limit):
-    """crank speed <= the limit: at the speeds a law's halves join (its peaks), or at a free profile's
-    samples; a bound on the draw speed and on the bound's speeds."""
+class CrankSpeedLimit(SpeedCap):
+    """crank speed <= the limit (a speed cap with ``k = 1``): at the speeds a law's halves join (its peaks),
+    or at a free profile's samples; a bound on the draw speed and on the bound's speeds."""
 
     id = "crank_speed"
     name = "crank speed <= limits.crank_speed_rpm"
@@ -32,6 +33,7 @@ class CrankSpeedLimit(Limit):
     }
     parameters = ("crank_speed_max",)
     refined = "crank_speed_max"
+    unit_divisor = RPM
 
     def applies(self, case: Any) -> bool:
         return case.limits.crank_speed_rpm is not None
@@ -40,6 +42,12 @@ class CrankSpeedLimit(Limit):
         top, lowest = case.limits.crank_speed_rpm, case.limits.min_crank_speed_rpm
         if top is not None and top <= lowest:
             raise CaseError(self.field, f"must be above limits.min_crank_speed_rpm = {lowest:g}", top)
+
+    def limit(self, case: Any) -> float:
+        return case.limits.crank_speed_rpm
+
+    def crank_factor(self, case: Any) -> float:
+        return 1.0
 
     def top_crank_speed(self, case: Any) -> float | None:
         top = case.limits.crank_speed_rpm
@@ -57,16 +65,3 @@ class CrankSpeedLimit(Limit):
     def rows(self, nlp: Transcription) -> list[Row]:
         peaks = nlp.speeds
         return [Row("crank speed limit", peaks.values / nlp.param("crank_speed_max"), -np.inf, 1.0, peaks.sampled)]
-
-    def check(self, dense: Dense) -> list[Check]:
-        top = dense.case.limits.crank_speed_rpm
-        fastest = float(np.max(dense.omega)) / RPM
-        check = Check.of(self.id, self.name, fastest, top, self.unit, "max", LIMIT_REL_TOL * top)
-        return [check.located(dense.t, dense.theta, dense.omega / RPM, top)]
-
-    def bound_speeds(self, mesh: BoundMesh) -> tuple[np.ndarray | None, np.ndarray | None]:
-        top = mesh.case.limits.crank_speed_rpm * RPM
-        return None, np.full(mesh.dtheta.size, top**2)
-
-    def relaxed_caps(self, mesh: RelaxedMesh) -> np.ndarray:
-        return np.full(mesh.cell.size, (mesh.case.limits.crank_speed_rpm * RPM) ** 2)

@@ -10,24 +10,23 @@ from pydantic import Field
 
 from planning.model.errors import CaseError
 from planning.model.limits.base import (
-    BoundMesh,
     Check,
     Dense,
     Draw,
-    Limit,
-    RelaxedMesh,
     Row,
     Transcription,
     sample_vector,
 )
+from planning.model.limits.canonical import SpeedCap
 from planning.model.units import Height, SliderSpeed
 from planning.tolerances import LIMIT_REL_TOL, SAME_HEIGHT_MM, SAME_RELATIVE
 from press.backend import math_module
 
 
-class DieSpeedLimit(Limit):
+class DieSpeedLimit(SpeedCap):
     """|slide speed| <= ``limits.die_speed_mm_s`` wherever the slide is at or below
-    ``limits.die_height_mm``: in the draw (a bound on the draw speed), where the slide passes the die
+    ``limits.die_height_mm`` (a speed cap, ``k = h'``, where it applies; its bounds and caps derive from it):
+    in the draw (a bound on the draw speed), where the slide passes the die
     height outside the draw (rows at the crossings), and, where a transcription's crank speed may peak
     inside the die zone, at every sample below the die height (``max(h - h_die, v_die - |v|) >= 0``,
     continuous)."""
@@ -120,18 +119,10 @@ class DieSpeedLimit(Limit):
         order = np.argsort(t, kind="stable")
         return [check.located(t[order], theta[order], speed[order], limit)]
 
-    def bound_speeds(self, mesh: BoundMesh) -> tuple[np.ndarray | None, np.ndarray | None]:
-        lim = mesh.case.limits
-        d1, h = mesh.d1[:-1], mesh.h[:-1]
-        low = (h <= lim.die_height_mm * (1 + SAME_RELATIVE) + SAME_HEIGHT_MM) & (np.abs(d1) > 0)  # the crossings count
-        upper = np.full(h.shape, np.inf)
-        upper[low] = (lim.die_speed_mm_s / np.abs(d1[low])) ** 2
-        return None, upper
+    def limit(self, case: Any) -> float:
+        return case.limits.die_speed_mm_s
 
-    def relaxed_caps(self, mesh: RelaxedMesh) -> np.ndarray:
-        """On a piece wholly at or below the die height: ``(v_die / min |h'|)^2``."""
-        lim = mesh.case.limits
-        inside = (np.maximum(mesh.h_a, mesh.h_b) <= lim.die_height_mm) & (mesh.slope2_min > 0)
-        caps = np.full(mesh.cell.size, np.inf)
-        caps[inside] = lim.die_speed_mm_s**2 / mesh.slope2_min[inside]
-        return caps
+    def where(self, case: Any, h: np.ndarray, bound: bool = False) -> np.ndarray:
+        """At or below the die height (at the bound's nodes up to round-off: the crossings count)."""
+        die = case.limits.die_height_mm
+        return h <= die * (1 + SAME_RELATIVE) + SAME_HEIGHT_MM if bound else h <= die

@@ -7,14 +7,16 @@ from typing import Any
 import numpy as np
 from pydantic import Field
 
-from planning.model.limits.base import BoundMesh, Check, Dense, Draw, Limit, Row, Transcription
+from planning.model.limits.base import Draw, Row, Transcription
+from planning.model.limits.canonical import SpeedCap
 from planning.model.units import RPM, CrankSpeed
-from planning.tolerances import LIMIT_REL_TOL, SAME_RELATIVE
+from planning.tolerances import SAME_RELATIVE
 
 
-class MinCrankSpeedLimit(Limit):
-    """crank speed >= the minimum. A law's halves are monotone, so their NLP holds it by the bounds of the
-    speeds they join; a free profile holds it at its samples (refined upward, a lower limit)."""
+class MinCrankSpeedLimit(SpeedCap):
+    """crank speed >= the minimum (a lower speed cap, ``k = 1``). A law's halves are monotone, so their NLP
+    holds it by the bounds of the speeds they join; a free profile holds it at its samples (refined upward, a
+    lower limit)."""
 
     id = "min_crank_speed"
     name = "crank speed (forward, never stops)"
@@ -34,6 +36,8 @@ class MinCrankSpeedLimit(Limit):
     parameters = ("min_crank_speed",)
     refined = "min_crank_speed"
     refine_upward = True
+    lower = True
+    unit_divisor = RPM
 
     def refuse_draw_speed(self, draw: Draw, speed: float) -> str | None:
         lowest = draw.case.limits.min_crank_speed_rpm
@@ -48,12 +52,8 @@ class MinCrankSpeedLimit(Limit):
         margin = (nlp.lowest_speeds - nlp.param("min_crank_speed")) / nlp.speed_unit
         return [Row("minimum crank speed", margin, 0.0, np.inf, sampled=True)]
 
-    def check(self, dense: Dense) -> list[Check]:
-        lowest = dense.case.limits.min_crank_speed_rpm
-        slowest = float(np.min(dense.omega)) / RPM
-        check = Check.of(self.id, self.name, slowest, lowest, self.unit, "min", LIMIT_REL_TOL * lowest)
-        return [check.located(dense.t, dense.theta, dense.omega / RPM, lowest)]
+    def limit(self, case: Any) -> float:
+        return case.limits.min_crank_speed_rpm
 
-    def bound_speeds(self, mesh: BoundMesh) -> tuple[np.ndarray | None, np.ndarray | None]:
-        w_min = mesh.case.limits.min_crank_speed_rpm * RPM
-        return np.full(mesh.dtheta.size, w_min**2), None
+    def crank_factor(self, case: Any) -> float:
+        return 1.0

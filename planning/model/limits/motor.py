@@ -20,16 +20,17 @@ from planning.model.limits.base import (
     Transcription,
     trapezoid,
 )
+from planning.model.limits.canonical import SpeedCap
 from planning.model.units import RPM
 from planning.tolerances import DRIVE_BACKOFF, LIMIT_REL_TOL, RMS_PROOF_MARGIN, SAME_ANGLE_RAD
 from press.backend import math_module
 from press.dynamics import GRAVITY, drive_state, envelope_torque, forming_force, link_terms
 
 
-class MotorSpeedLimit(Limit):
-    """motor speed = gear ratio x crank speed <= ``drive.motor.max_speed_rpm``: a top crank speed, held like
-    ``limits.crank_speed_rpm`` (in every NLP of a drive case, the kinematic one too; a given draw speed
-    above it is an error in the case)."""
+class MotorSpeedLimit(SpeedCap):
+    """motor speed = gear ratio x crank speed <= ``drive.motor.max_speed_rpm`` (a speed cap, ``k`` = the gear
+    ratio): a top crank speed, held like ``limits.crank_speed_rpm`` (in every NLP of a drive case, the
+    kinematic one too; a given draw speed above it is an error in the case)."""
 
     id = "motor_speed"
     name = "motor speed"
@@ -39,6 +40,7 @@ class MotorSpeedLimit(Limit):
     parameters = ("motor_top_crank_speed",)
     refined = "motor_top_crank_speed"
     motor = True
+    unit_divisor = RPM
 
     def applies(self, case: Any) -> bool:
         return case.drive is not None
@@ -65,17 +67,11 @@ class MotorSpeedLimit(Limit):
         peaks = nlp.speeds
         return [Row("motor speed", peaks.values / nlp.param("motor_top_crank_speed"), -np.inf, 1.0, peaks.sampled)]
 
-    def check(self, dense: Dense) -> list[Check]:
-        d = dense.case.drive
-        top = float(np.max(d.gear_ratio * dense.omega)) / RPM
-        limit = d.motor.max_speed_rpm
-        return [Check.of(self.id, self.name, top, limit, self.unit, "max", LIMIT_REL_TOL * limit)]
+    def limit(self, case: Any) -> float:
+        return case.drive.motor.max_speed_rpm
 
-    def bound_speeds(self, mesh: BoundMesh) -> tuple[np.ndarray | None, np.ndarray | None]:
-        return None, np.full(mesh.dtheta.size, _top_crank_speed(mesh.case) ** 2)
-
-    def relaxed_caps(self, mesh: RelaxedMesh) -> np.ndarray:
-        return np.full(mesh.cell.size, _top_crank_speed(mesh.case) ** 2)
+    def crank_factor(self, case: Any) -> float:
+        return case.drive.gear_ratio
 
 
 def _top_crank_speed(case: Any) -> float:

@@ -9,24 +9,21 @@ import numpy as np
 from pydantic import Field
 
 from planning.model.limits.base import (
-    BoundMesh,
     Check,
-    Dense,
     Draw,
     Impossible,
-    Limit,
-    RelaxedMesh,
     Row,
     Transcription,
 )
+from planning.model.limits.canonical import SpeedCap
 from planning.model.units import SliderSpeed
-from planning.tolerances import LIMIT_REL_TOL, SAME_RELATIVE, SPEED_BACKOFF
+from planning.tolerances import SAME_RELATIVE, SPEED_BACKOFF
 
 
-class SliderSpeedLimit(Limit):
-    """|v| = |dh/dtheta w| <= the limit: at every sample of an NLP outside the draw (refined against the
-    dense check), in the draw at constant speed (a bound on the draw speed: the largest |dh/dtheta| there),
-    at every node of the bound (a bound on the speed squared, ``(v / |dh/dtheta|)^2``)."""
+class SliderSpeedLimit(SpeedCap):
+    """|v| = |dh/dtheta w| <= the limit (a speed cap, ``k = h'``): at every sample of an NLP outside the draw
+    (refined against the dense check), in the draw at constant speed (a bound on the draw speed: the largest
+    |dh/dtheta| there), at every node of the bound (a bound on the speed squared, ``(v / |dh/dtheta|)^2``)."""
 
     id = "slider_speed"
     name = "|slider speed|"
@@ -50,24 +47,14 @@ class SliderSpeedLimit(Limit):
     def applies(self, case: Any) -> bool:
         return case.limits.slider_speed_mm_s is not None
 
-    def draw_speed_bound(self, draw: Draw) -> float:
-        slope = float(np.max(np.abs(draw.d1)))
-        return draw.case.limits.slider_speed_mm_s / slope if slope > 0 else np.inf
+    def limit(self, case: Any) -> float:
+        return case.limits.slider_speed_mm_s
 
     def at_draw_speed(self, draw: Draw, speed: float) -> list[Check]:
         limit = draw.case.limits.slider_speed_mm_s
         fastest = float(np.max(np.abs(draw.d1))) * speed
-        return [
-            Check.of(
-                self.id,
-                "|slider speed| during the draw <= limits.slider_speed_mm_s",
-                fastest,
-                limit,
-                self.unit,
-                "max",
-                0.0,
-            )
-        ]
+        name = "|slider speed| during the draw <= limits.slider_speed_mm_s"
+        return [Check.of(self.id, name, fastest, limit, self.unit, "max", 0.0)]
 
     def precheck(self, case: Any, given: float | None, lowest: float) -> Impossible | None:
         if given is None:
@@ -90,22 +77,3 @@ class SliderSpeedLimit(Limit):
     def rows(self, nlp: Transcription) -> list[Row]:
         speed = nlp.outside_draw(nlp.slope * nlp.omega)
         return [Row("slider speed", speed / nlp.param("slider_speed_max"), -1.0, 1.0, sampled=True)]
-
-    def check(self, dense: Dense) -> list[Check]:
-        limit = dense.case.limits.slider_speed_mm_s
-        speed = np.abs(dense.v)
-        check = Check.of(self.id, self.name, float(np.max(speed)), limit, self.unit, "max", LIMIT_REL_TOL * limit)
-        return [check.located(dense.t, dense.theta, speed, limit)]
-
-    def bound_speeds(self, mesh: BoundMesh) -> tuple[np.ndarray | None, np.ndarray | None]:
-        d1 = np.abs(mesh.d1[:-1])
-        upper = np.full(d1.shape, np.inf)
-        moving = d1 > 0
-        upper[moving] = (mesh.case.limits.slider_speed_mm_s / d1[moving]) ** 2
-        return None, upper
-
-    def relaxed_caps(self, mesh: RelaxedMesh) -> np.ndarray:
-        caps = np.full(mesh.cell.size, np.inf)
-        moving = mesh.slope2_min > 0
-        caps[moving] = mesh.case.limits.slider_speed_mm_s**2 / mesh.slope2_min[moving]
-        return caps
