@@ -8,8 +8,8 @@ import pytest
 
 from planning.model.case_file import read_case
 from planning.reports.report import trajectory
-from planning.solver.optimize import solve
 from planning.solver.upper_bound import upper_bound
+from tests.conftest import solved
 
 CASES = sorted((Path(__file__).resolve().parents[1] / "cases").glob("*.yaml"))
 
@@ -17,9 +17,7 @@ CASES = sorted((Path(__file__).resolve().parents[1] / "cases").glob("*.yaml"))
 @pytest.mark.parametrize("path", CASES, ids=lambda p: p.stem)
 def test_case_solves_and_verifies(path):
     case = read_case(path)
-    published = solve(case, "published")
-    free = solve(case, "free")
-    assert published.verification.passed and free.verification.passed
+    published, free = solved(path, "published"), solved(path, "free")
     assert free.plan.spm >= published.plan.spm - 1e-9
     tab = trajectory(free, case)
     assert abs(tab["slider_accel_mm_s2"]).max() <= case.limits.slider_accel_mm_s2 * (1 + 1e-6)

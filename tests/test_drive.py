@@ -19,6 +19,7 @@ from press.crank_slider import CrankSlider
 from press.dynamics import DriveModel, crank_torque, motor_torque
 
 from .conftest import PUBLISHED_CASE, ROOT
+from .conftest import solved as solved_case
 
 DRIVE_CASES = [ROOT / "cases" / "wang2023-side-panel-drive.yaml", ROOT / "cases" / "cup-2000kN-drive.yaml"]
 # every mechanism's: the linkages' links carry their own masses (Lagrange's equation, ``press.dynamics``)
@@ -82,7 +83,7 @@ def test_energy_balance_over_a_cycle(path):
     stroke is the forming work of the table, integrated independently (exactly, over the height); a
     linkage's links and their weight included."""
     case = read_case(path)
-    sol = solve(case)
+    sol = solved_case(path)
     fig = drive_figures(sol.plan.profile, case)
     assert fig.forming_work_kJ > 0
     assert fig.crank_work_kJ == pytest.approx(fig.forming_work_kJ, rel=1e-9)
@@ -134,7 +135,7 @@ def test_the_rms_limit_binds_and_a_tenfold_motor_gives_back_the_kinematic_optimu
     data = data_of(DRIVE_CASES[0])
     limited = solve(case_from_data(data))
     assert "motor_rms_torque" in [c.id for c in limited.verification.binding()]  # at its limit within 1e-4
-    kinematic = solve(read_case(PUBLISHED_CASE))
+    kinematic = solved_case(PUBLISHED_CASE)
     assert limited.plan.spm < kinematic.plan.spm * 0.95
     for key in ("peak_torque_Nm", "rated_torque_Nm", "max_speed_rpm"):
         data["drive"]["motor"][key] *= 10
@@ -156,7 +157,7 @@ def test_motor_speed_caps_the_crank():
 @pytest.mark.parametrize("path", EVERY_MECHANISM, ids=lambda p: p.stem)
 def test_bound_stays_above_the_drive_plan(path):
     case = read_case(path)
-    assert time_optimal_bound(case, 720).spm >= solve(case).plan.spm
+    assert time_optimal_bound(case, 720).spm >= solved_case(path).plan.spm
 
 
 def test_a_motor_too_weak_for_the_draw_is_exit_3_naming_it(tmp_path, capsys):

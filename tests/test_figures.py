@@ -13,7 +13,7 @@ from matplotlib.lines import Line2D
 from planning.model.case_file import read_case
 from planning.reports.plots import laws_figure, plot_files, sweep_figure, tradeoff_figure
 from planning.reports.report import result_dict, trajectory
-from planning.solver.optimize import solve
+from tests.conftest import solved
 
 CASES = sorted((Path(__file__).resolve().parents[1] / "cases").glob("*.yaml"))
 
@@ -51,7 +51,7 @@ def limits_of(case) -> list[str]:  # noqa: ANN001 - a Case
 @pytest.mark.parametrize("path", CASES, ids=lambda p: p.stem)
 def test_every_limit_of_the_case_is_a_labelled_line(path):
     case = read_case(path)
-    solution = solve(case)
+    solution = solved(path)
     result = result_dict(solution, case)
     figures = plot_files(result, trajectory(solution, case), None)
     for name in ("motion_vs_angle.png", "motion_vs_time.png"):

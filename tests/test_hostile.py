@@ -194,8 +194,7 @@ def test_a_transfer_time_of_1000_s_solves():
     data = load_yaml(PUBLISHED_CASE.read_text())
     data["process"]["transfer_time_s"] = 1000.0
     data["limits"]["min_crank_speed_rpm"] = 0.01  # 132 deg at 0.01 rpm take 2200 s: 1000 s can be met
-    sol = solve(case_from_data(data))
-    assert sol.verification.passed
+    sol = solve(case_from_data(data))  # raises without a verified plan
     assert sol.plan.transfer_window() >= 1000.0 - 1e-6
 
 

@@ -10,15 +10,14 @@ import pytest
 
 from planning.model.case_file import read_case
 from planning.solver.bound import time_optimal_bound
-from planning.solver.optimize import solve
+from tests.conftest import solved
 
 CASE = Path(__file__).resolve().parents[1] / "cases" / "side-panel-servo-limits.yaml"
 
 
 @pytest.fixture(scope="module")
 def limited():
-    case = read_case(CASE)
-    return case, solve(case)
+    return read_case(CASE), solved(CASE)
 
 
 def test_motor_limits_hold_on_the_sample_times(limited):
