@@ -37,7 +37,11 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _parser() -> argparse.ArgumentParser:
-    ap = _Parser(prog="pressplan", description="Plan the crank speed of a crank-slider servo press for maximum SPM.")
+    ap = _Parser(
+        prog="pressplan",
+        description="Plan the crank speed of a servo press (crank-slider, in line or offset, link drive or knuckle "
+        "joint) for the most strokes per minute, verified.",
+    )
     ap.add_argument("--version", action="version", version=f"pressplan {_version()}")
     sub = ap.add_subparsers(dest="command", required=True, parser_class=_Parser)
     for add in (_case_commands, _batch_commands, _bound_command, _other_commands):
@@ -115,7 +119,7 @@ def _bound_command(sub) -> None:  # noqa: ANN001 - argparse's sub-parsers
     """``bound``: the time-optimal bound, the certified upper bound, the bracket."""
     b = sub.add_parser(
         "bound",
-        help="the time-optimal bound: the most strokes any motion can make",
+        help="the time-optimal bound on a mesh (from below), the certified upper bound (--certified), the bracket",
         description="The time-optimal bound: the shortest cycle any crank motion within the limits can take, "
         "on a grid of crank angles. 'idle time in the robot's window' is the time the bound waits there: the "
         "transfer time minus the time its crank needs to cross the window (window_slack_s in --json).",

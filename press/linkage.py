@@ -286,7 +286,7 @@ class Linkage(Mechanism):
                 ("rocker_pivot_x", "rocker_pivot_y", "crank_radius"),
             )
 
-    own_angle_origin = "+x, counter-clockwise (mechpress, presslink)"
+    own_angle_origin = "+x, counter-clockwise"
 
     @property
     def tdc_own_angle(self) -> float:

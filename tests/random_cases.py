@@ -73,3 +73,50 @@ def seeded_offset_case(seed: int) -> dict[str, Any]:
     """An offset crank-slider from a seed: the slide's line 0 ... 12 % of the crank radius to either side."""
     u = np.random.default_rng(seed).random(15)
     return build_case(list(u[:14]), name=f"random-offset-{seed}", offset_share=round(0.24 * u[14] - 0.12, 3))
+
+
+LINKAGES = {  # the shipped linkage presses whose geometry the random linkages scale
+    "link-drive": ("link_drive", "link-drive-side-panel.yaml"),
+    "knuckle-joint": ("knuckle_joint", "knuckle-joint-coining.yaml"),
+}
+
+
+def seeded_linkage_case(seed: int, mechanism: str) -> dict[str, Any]:
+    """A linkage press from a seed: the shipped ``mechanism``'s geometry scaled by 0.7 ... 1.4 (every length),
+    its key angles moved by up to +-8 deg, the safety height a little below the slide at theta1 and theta4,
+    the die height 0.3 ... 3 % of the stroke, the slide's acceleration limit and the speed limits around the
+    shipped ones, the transfer time 0.3 ... 3 s, the draw speed given or left to the planner (no drive)."""
+    from pathlib import Path
+
+    from planning.model.case_file import case_from_data, load_yaml
+
+    u = np.random.default_rng(seed).random(12)
+    section, file = LINKAGES[mechanism]
+    data = load_yaml((Path(__file__).resolve().parents[1] / "cases" / file).read_text(encoding="utf-8"))
+    for key in ("drive", "published", "source"):
+        data.pop(key, None)
+    scale = 0.7 + 0.7 * u[0]
+    geometry = data["press"][section]
+    for key, value in geometry.items():
+        if key.endswith("_mm"):
+            geometry[key] = round(value * scale, 2)
+    kp = data["key_points"]
+    for k, key in enumerate(("closing_deg", "draw_start_deg", "draw_end_deg", "opening_deg")):
+        kp[key] = round(kp[key] + 16 * (u[1 + k] - 0.5), 2)
+    data["name"] = f"random-{mechanism}-{seed}"
+    data["process"] = {"safety_height_mm": 1.0, "transfer_time_s": round(0.3 + 2.7 * u[5], 2)}
+    data["limits"]["die_height_mm"] = 0.0  # the machine first; the die height from it below
+    machine = case_from_data(data).machine
+    th = [math.radians(kp[key]) for key in ("closing_deg", "draw_start_deg", "draw_end_deg", "opening_deg")]
+    h1, h2, _, h4 = (float(machine.height(a)) for a in th)
+    data["process"]["safety_height_mm"] = round(min(h1, h4) * (0.9 + 0.099 * u[6]), 2)
+    limits = data["limits"]
+    limits["die_height_mm"] = round(min(machine.stroke * (0.003 + 0.027 * u[7]), 0.5 * h2), 2)
+    for k, key in enumerate(("slider_accel_mm_s2", "die_speed_mm_s", "draw_start_speed_mm_s")):
+        limits[key] = round(limits[key] * scale * (0.7 + 0.6 * u[8 + k]), 1)
+    if u[11] < 0.5:
+        from planning.model.limits import draw_speed_bounds
+
+        highest = min(draw_speed_bounds(case_from_data(data)).values())
+        data["process"]["draw_speed_rpm"] = round(highest * 60 / (2 * math.pi) * 0.9, 3)
+    return data

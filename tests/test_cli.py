@@ -145,14 +145,14 @@ def test_case_file_is_never_written(tmp_path):
 
 def test_solver_success_but_failed_verification_is_exit_3(monkeypatch, tmp_path, capsys):
     """No false successes: when every plan fails the dense check, nothing is written and exit is 3."""
-    import planning.solver.search as search
+    import planning.solver.verify as verify
     from planning.solver.verify import Check, Evaluation, Verification
 
-    def failing(plan, case, **_):
+    def failing(dense, uniform):  # every evaluation of every plan (the search's, the fallbacks') fails
         check = Check("|slider acceleration|", 9999.0, 3500.0, "mm/s^2", "max", False, "slider_accel")
-        return Evaluation(None, None, Verification((check,), 1e-3, 10))
+        return Evaluation(dense, uniform, Verification((check,), 1e-3, 10))
 
-    monkeypatch.setattr(search, "evaluate", failing)
+    monkeypatch.setattr(verify, "_judged", failing)
     out = tmp_path / "o"
     assert main(["solve", str(PUBLISHED_CASE), "--out", str(out)]) == 3
     err = capsys.readouterr().err

@@ -126,8 +126,8 @@ def test_the_tradeoff_shows_the_saving_and_an_energy_axis_around_the_data(tmp_pa
             "baseline_rms_motor_torque_Nm": 16000 + 100 * s,
             "peak_motor_torque_Nm": 60000,
             "baseline_peak_motor_torque_Nm": 61000,
-            "supply_energy_kJ": 1064 + s,
-            "baseline_supply_energy_kJ": 1080 + s,
+            "energy_kJ": 1064 + s,
+            "baseline_energy_kJ": 1080 + s,
         }
         for s in (5.0, 6.0, 7.0, 8.0)
     ]

@@ -231,8 +231,8 @@ def test_the_stage_names_are_in_words(free_solution):
     assert segment_in_words("feed:accel4") == "feed, 4th acceleration sub-segment"
     assert segment_in_words("return:decel2") == "return, 2nd deceleration sub-segment"
     assert segment_in_words("feed:accel") == "feed, acceleration"
-    assert segment_in_words("transfer:dwell") == "transfer, constant speed"
-    assert segment_in_words("transfer:24") == "transfer, interval 24"
+    assert segment_in_words("transfer:dwell") == "dwell, constant speed"  # the dwell, not the robot's window
+    assert segment_in_words("transfer:24") == "window, interval 24"  # the optimal law's phase theta4 -> theta1
     structure = free_solution.plan.structure
     assert all(":" not in where and where.endswith("% in") for where in structure.values()), structure
 

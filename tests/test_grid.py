@@ -7,9 +7,11 @@ from __future__ import annotations
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
+import yaml
 from scipy.optimize import linprog
 
 from planning.cli import main
@@ -290,7 +292,18 @@ GOLDEN_RUNS = {  # folder: the command's arguments
 }
 GOLDEN_EVERY = 10  # the golden tables keep their header and every 10th row
 GOLDEN_REL = 1e-9  # relative agreement of every number (the same machine gives them bit for bit)
-ADDED_SINCE = {"peak_time_s", "peak_angle_deg"}  # keys result.json gained since (where each check peaked)
+# keys result.json gained since: where each check peaked, whose the draw speed is, the energy the objectives weigh
+ADDED_SINCE = {"peak_time_s", "peak_angle_deg", "draw_speed_given", "draw_speed_highest_rpm", "energy_kJ", "energy_at"}
+RENAMED = (  # words of the summary changed since, on purpose (issue 37: one word for one thing)
+    (re.compile(r"^  crank speed: transfer "), "  crank speed: dwell "),
+    (re.compile(r"^  transfer window theta4"), "  robot window theta4"),
+    (re.compile(r"^  transfer    "), "  dwell       "),  # the stage table's row of the constant-speed stage
+    (re.compile(r"transfer, constant speed"), "dwell, constant speed"),
+)
+SAID_SINCE = re.compile(  # words the summary says since: whose the draw speed is, where the energy is counted
+    r" \((given|the highest the limits allow|the planner's choice; the limits allow up to [0-9.]+"
+    r"|at the DC bus, losses counted|at the motors' shaft)\)"
+)
 
 
 def _golden_same(a, b, path: str = "") -> list[str]:  # noqa: ANN001 - JSON data
@@ -305,6 +318,8 @@ def _golden_same(a, b, path: str = "") -> list[str]:  # noqa: ANN001 - JSON data
         return [d for i, (x, y) in enumerate(zip(a, b, strict=True)) for d in _golden_same(x, y, f"{path}[{i}]")]
     if isinstance(a, float | int) and isinstance(b, float | int) and not isinstance(a, bool):
         return [] if math.isclose(a, b, rel_tol=GOLDEN_REL, abs_tol=1e-12) else [f"{path}: {a} != {b}"]
+    if isinstance(a, str) and isinstance(b, str):  # the constant-speed stage's new word (issue 37)
+        a = "dwell" if a == "transfer" else a.replace("transfer, constant speed", "dwell, constant speed")
     return [] if a == b else [f"{path}: {a!r} != {b!r}"]
 
 
@@ -315,12 +330,21 @@ def test_without_the_new_keys_every_output_is_the_golden_one(name, tmp_path):
     grid's work (``tests/data/golden_drive``), timing aside."""
     import csv
 
-    assert main([*GOLDEN_RUNS[name], "--out", str(tmp_path), "--no-plots"]) == 0
+    data = load_yaml(CUP.read_text(encoding="utf-8"))
+    del data["press"]["capacity"]  # the press's capacity came since: the golden case has none
+    case_file = tmp_path / "cup.yaml"
+    case_file.write_text(yaml.safe_dump(data), encoding="utf-8")
+    out = tmp_path / "out"
+    assert main([GOLDEN_RUNS[name][0], str(case_file), *GOLDEN_RUNS[name][2:], "--out", str(out), "--no-plots"]) == 0
     folder = GOLDEN / name
-    now, then = (json.loads((f / "result.json").read_text()) for f in (tmp_path, folder))
+    now, then = (json.loads((f / "result.json").read_text()) for f in (out, folder))
     assert not _golden_same(then, now)
-    lines = [(f / "summary.txt").read_text().splitlines() for f in (tmp_path, folder)]
-    assert [x for x in lines[0] if "solver:" not in x] == [x for x in lines[1] if "solver:" not in x]
+    mine = [SAID_SINCE.sub("", x) for x in (out / "summary.txt").read_text().splitlines() if "solver:" not in x]
+    theirs = [x for x in (folder / "summary.txt").read_text().splitlines() if "solver:" not in x]
+    for pattern, words in RENAMED:
+        theirs = [pattern.sub(words, x) for x in theirs]
+    assert mine == theirs
+    tmp_path = out
     for table in ("trajectory.csv", "cam_table.csv"):
         rows = list(csv.reader((tmp_path / table).open()))
         kept = [rows[0]] + rows[1::GOLDEN_EVERY]

@@ -115,13 +115,13 @@ def test_compare_without_published_solution_is_bad_input(tmp_path, capsys):
 
 
 def test_the_stage_table_covers_the_cycle_and_names_where_limits_bind(solved):
-    """result.json's stages: transfer, feed, draw, return end to end over one turn and one cycle time; the
+    """result.json's stages: dwell, feed, draw, return end to end over one turn and one cycle time; the
     draw's peak is the draw speed, the feed's and return's the law's peaks; on the published case the
-    slider acceleration binds in the return, the least crank speed in the transfer, the transfer time over
+    slider acceleration binds in the return, the least crank speed in the dwell, the transfer time over
     the cycle."""
     result = json.loads((solved / "result.json").read_text())
     stages = result["stages"]
-    assert [s["name"] for s in stages] == ["transfer", "feed", "draw", "return"]
+    assert [s["name"] for s in stages] == ["dwell", "feed", "draw", "return"]
     assert sum(s["duration_s"] for s in stages) == pytest.approx(result["cycle_time_s"], rel=1e-12)
     for a, b in zip(stages, stages[1:], strict=False):
         assert b["start_angle_deg"] == pytest.approx(a["end_angle_deg"] % 360.0, abs=1e-9)
@@ -131,6 +131,6 @@ def test_the_stage_table_covers_the_cycle_and_names_where_limits_bind(solved):
     assert peaks["feed"] == pytest.approx(result["feed_peak_speed_rpm"], rel=1e-5)  # sampled at 1 ms
     assert peaks["return"] == pytest.approx(result["return_peak_speed_rpm"], rel=1e-5)
     binds = {s["name"]: s["binding"] for s in stages}
-    expected = {"transfer": ["limits.min_crank_speed_rpm"], "return": ["limits.slider_accel_mm_s2"]}
+    expected = {"dwell": ["limits.min_crank_speed_rpm"], "return": ["limits.slider_accel_mm_s2"]}
     assert binds == {"feed": [], "draw": [], **expected}
     assert result["binding_over_cycle"] == ["process.transfer_time_s"]

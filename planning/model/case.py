@@ -26,6 +26,7 @@ from planning.model.units import (
     CrankSpeed,
     ForceKN,
     ForceTable,
+    Height,
     Inertia,
     Length,
     Mass,
@@ -134,11 +135,38 @@ class KnuckleJointModel(_Model):
     )  # h
 
 
+class CapacityModel(_Model):
+    """The press's own capacity (``press.capacity``): its tonnage curve, from the rated force at the rated
+    distance above BDC or as the builder's table of force against height, and its crank (gear) torque
+    capacity (by default the torque the rating implies)."""
+
+    rated_force_kN: ForceKN | None = Field(
+        None,
+        title="rated force [kN]",
+        description="The press's nominal force, allowed up to the rated distance above BDC.",
+    )
+    rated_distance_mm: Height | None = Field(
+        None,
+        title="rated distance [mm above BDC]",
+        description="Where the rated force is allowed up to; above it the force falls as the crank's lever grows.",
+    )
+    force_table_kN: ForceTable | None = Field(
+        None,
+        title="tonnage curve [mm, kN]",
+        description="The builder's curve instead of the rating: (height above BDC, allowed force) pairs.",
+    )
+    crank_torque_kNm: Annotated[float, Field(gt=0, le=1e6)] | None = Field(
+        None,
+        title="crank torque capacity [kN m]",
+        description="The crank's (the gears') torque capacity; empty: the torque the rating implies.",
+    )
+
+
 class PressModel(_Model):
     """The machine: ``mechanism`` (crank-slider by default). A crank-slider of ``crank_radius_mm`` [mm] and
     ``rod_length_mm`` [mm], its slide's line ``offset_mm`` [mm] to the side of the crank axis (0: in line;
     ``press.crank_slider``); a link drive's dimensions in ``link_drive``, a knuckle joint's in
-    ``knuckle_joint`` (``press.linkage``)."""
+    ``knuckle_joint`` (``press.linkage``); its ``capacity`` (tonnage curve, crank torque), optional."""
 
     mechanism: MechanismKind = Field(
         "crank-slider",
@@ -163,6 +191,7 @@ class PressModel(_Model):
     )
     link_drive: LinkDriveModel | None = None
     knuckle_joint: KnuckleJointModel | None = None
+    capacity: CapacityModel | None = None
 
 
 class KeyPointsModel(_Model):
@@ -197,7 +226,10 @@ class ProcessModel(_Model):
     draw_speed_rpm: CrankSpeed | None = Field(
         None,
         title="draw speed [rpm]",
-        description="The crank's constant speed in the draw; empty: the highest the limits allow.",
+        description=(
+            "The crank's constant speed in the draw; empty: the planner chooses it, at most the highest the "
+            "limits allow (pressplan check prints it)."
+        ),
     )
     forming_force_kN: ForceTable | None = Field(
         None,

@@ -217,6 +217,9 @@ def _pydantic_line(exc: ValidationError, data: Any, label: str) -> str:
     kind = err["type"]
     value = err.get("input")
     if kind == "extra_forbidden":
+        home = _section_of(loc[-1]) if len(loc) == 2 else None
+        if home is not None and home != loc[0]:  # a key of another section: say where it belongs
+            return f"{label}: {field}: unknown key here; it belongs under {home}: ({home}.{loc[-1]})"
         valid = _fields_at(Case, loc[:-1])
         hint = difflib.get_close_matches(loc[-1], valid, n=1, cutoff=0.5)
         did = f"; did you mean '{hint[0]}'?" if hint else f"; valid keys: {', '.join(valid)}"
@@ -226,6 +229,12 @@ def _pydantic_line(exc: ValidationError, data: Any, label: str) -> str:
     msg = err["msg"]
     msg = msg[0].lower() + msg[1:] if msg else kind
     return f"{label}: {field}: {msg} (got {show_value(value)})"
+
+
+def _section_of(key: str) -> str | None:
+    """The top-level section of the case whose own keys include ``key`` (None: none, or several)."""
+    homes = [name for name in Case.model_fields if key in _fields_at(Case, [name])]
+    return homes[0] if len(homes) == 1 else None
 
 
 def _fields_at(model: type[BaseModel], path: list[str]) -> list[str]:

@@ -128,12 +128,28 @@ def _ordinal(n: int) -> str:
     return f"{n}{'th' if 10 <= n % 100 <= 20 else {1: 'st', 2: 'nd', 3: 'rd'}.get(n % 10, 'th')}"
 
 
+STAGE_WORDS = {"transfer": "dwell"}  # a law's constant-speed stage between the return and the feed: the dwell
+WINDOW_PHASE = "window"  # the optimal law's phase from theta4 to theta1: the robot's window
+
+
+def stage_of(name: str) -> str:
+    """The stage a segment ``name`` (``stage:part``) belongs to, in the words the reports use: a law's
+    ``transfer:dwell`` is the ``dwell`` (the crank at constant speed between the return and the feed, wherever
+    the robot's window lies), the optimal law's ``transfer:24`` the ``window`` (its phase from theta4 to
+    theta1); the others as they are (``feed``, ``draw``, ``return``)."""
+    stage, _, part = name.partition(":")
+    if stage == "transfer":
+        return WINDOW_PHASE if part.isdigit() else STAGE_WORDS[stage]
+    return stage
+
+
 def segment_in_words(name: str) -> str:
     """A segment's name (``stage:part``) as a press engineer reads it: ``feed:accel4`` -> ``feed, 4th
     acceleration sub-segment``; ``feed:accel`` -> ``feed, acceleration``; ``draw:constant`` -> ``draw,
-    constant speed``; ``transfer:dwell`` -> ``transfer, constant speed``; the optimal law's ``transfer:24``
-    -> ``transfer, interval 24``."""
-    stage, _, part = name.partition(":")
+    constant speed``; ``transfer:dwell`` -> ``dwell, constant speed``; the optimal law's ``transfer:24``
+    -> ``window, interval 24`` (:func:`stage_of`)."""
+    _, _, part = name.partition(":")
+    stage = stage_of(name)
     if part.isdigit():
         return f"{stage}, interval {part}"
     if part in ("constant", "dwell"):

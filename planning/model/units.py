@@ -13,7 +13,20 @@ from typing import Annotated
 
 from pydantic import Field
 
+from planning.tolerances import SAME_RELATIVE
+
 RPM = 2.0 * math.pi / 60.0  # [rad/s] per rpm
+HIGHEST_DECIMALS = 4  # a highest allowed value is printed rounded down to this many decimals
+
+
+def rounded_down(value: float, decimals: int = HIGHEST_DECIMALS) -> str:
+    """``value`` printed rounded down to ``decimals`` decimals: a highest allowed value typed back as it is
+    printed is allowed (``10.19937`` prints ``10.1993``)."""
+    if not math.isfinite(value):
+        return str(value)
+    scale = 10.0**decimals
+    nudged = value * scale * (1 + SAME_RELATIVE)  # a value on a printed digit up to round-off is that digit
+    return f"{math.floor(nudged) / scale:.{decimals}f}"
 
 Length = Annotated[float, Field(ge=0.1, le=20_000)]  # [mm] press dimensions
 Offset = Annotated[float, Field(ge=-20_000, le=20_000)]  # [mm] a sideways offset, either side

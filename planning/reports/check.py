@@ -11,6 +11,7 @@ from planning.model.case import KEY_POINT_NAMES, RPM, Case
 from planning.model.limits import draw_speed_bounds, limits_of
 from planning.model.limits.base import Check, Draw
 from planning.model.limits.robot_window import radians_hint
+from planning.model.units import rounded_down
 from planning.tolerances import SAME_SCORE
 
 ROUND_OFF = SAME_SCORE  # relative: a check at the highest draw speed sits on its limit up to floating-point round-off
@@ -99,12 +100,21 @@ def _check(check: Check) -> dict[str, Any]:
     }
 
 
+LIMIT_WORDS = {"motor_speed": "motor speed (on the crank)"}  # a draw-speed bound's words, by limit id
+
+
+def _rpm(value: float, given: str) -> str:
+    """A draw speed as ``check`` prints it: a given one as it is, the highest allowed rounded down (typed back
+    into the case, it is allowed)."""
+    return f"{value:.3f}" if given == "given" else rounded_down(value)
+
+
 def check_text(report: dict[str, Any]) -> str:
     """Console table of a :func:`check_case` report."""
     given = "given" if report["draw_speed_given"] else "highest allowed"
     p = report["press"]
     lines = [
-        f"{report['case']}: key points at the draw speed {report['draw_speed_rpm']:.3f} rpm ({given})",
+        f"{report['case']}: key points at the draw speed {_rpm(report['draw_speed_rpm'], given)} rpm ({given})",
         f"  {p['mechanism']}: stroke {p['stroke_mm']:.3f} mm; TDC at {p['tdc_own_deg']:.2f} deg, BDC at "
         f"{p['bdc_own_deg']:.2f} deg of the crank's own angle (from {p['own_angle_origin']})",
         f"  key angles count from TDC: the slide goes down for {p['down_deg']:.2f} deg "
@@ -124,8 +134,10 @@ def check_text(report: dict[str, Any]) -> str:
             f"  {mark}  {c['name']}: {c['value']:.1f} {c['unit']} (limit {c['limit']:g}, margin {c['margin']:+.1f})"
         )
     by = ", ".join(
-        f"{k.replace('_', ' ')} {v:.3f}" for k, v in report["max_draw_speed_by_limit_rpm"].items() if v is not None
+        f"{LIMIT_WORDS.get(k, k.replace('_', ' '))} {rounded_down(v)}"
+        for k, v in report["max_draw_speed_by_limit_rpm"].items()
+        if v is not None
     )
-    lines += ["", f"  highest draw speed the limits allow: {report['max_draw_speed_rpm']:.3f} rpm ({by})"]
+    lines += ["", f"  highest draw speed the limits allow: {rounded_down(report['max_draw_speed_rpm'])} rpm ({by})"]
     lines += [f"  WARNING: {w}" for w in report["warnings"]]
     return "\n".join(lines)

@@ -43,6 +43,9 @@ press:
   crank_radius_mm: 450               # half the stroke
   rod_length_mm: 1200                # crank pin to the slide's pin
   offset_mm: 0                       # the slide's line to the side of the crank axis (0: in line)
+  # capacity:                        # optional: the press's rating, its tonnage curve (a forming force table
+  #   rated_force_kN: 8000           #   above it is refused) and, with a drive, the crank torque it allows
+  #   rated_distance_mm: 13          #   (rated force x the crank's lever at the rated distance above BDC)
 key_points:                          # crank angle from TDC [deg], in this order
   closing_deg: 66                    # theta1: the slide passes the robot's safety height going down
   draw_start_deg: 131.5              # theta2: the upper die meets the blank; the draw starts
@@ -50,7 +53,7 @@ key_points:                          # crank angle from TDC [deg], in this order
   opening_deg: 294                   # theta4: the slide is back above the safety height
 """
     + _SIDE_PANEL_PROCESS
-    + "  # draw_speed_rpm: 6.7              # a fixed crank speed for the draw; leave out to let the limits choose\n"
+    + "  # draw_speed_rpm: 6.7              # a fixed crank speed for the draw; leave out to let the planner choose\n"
     + _SIDE_PANEL_LIMITS
     + """\
   # crank_speed_rpm: 30              # optional: the crank's top speed, acceleration, jerk, the slide's top

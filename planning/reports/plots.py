@@ -145,10 +145,10 @@ def _draw_limits(axes_of: dict[str, Any], lines: list[LimitLine]) -> None:
 
 
 def _figure(result, traj, published, axis: str) -> Figure:
-    """Four panels against time or crank angle: slide height and crank speed; crank acceleration; crank
-    jerk; slide speed and acceleration. Every limit the case sets (``limit_lines``) is a dashed line over
-    the part of the cycle where it applies, named by its case field in the legend; the legends sit right
-    of the panels."""
+    """Five panels against time or crank angle: slide height; crank speed; crank acceleration; crank jerk;
+    slide speed and acceleration (two axes, their zeros on one line). Every limit the case sets
+    (``limit_lines``) is a dashed line over the part of the cycle where it applies, named by its case field
+    in the legend; the legends sit right of the panels."""
     traj, published = _thin(traj), _thin(published)
     lim = result.get("limits", {})
     x = traj["time_s"] if axis == "time" else traj["crank_angle_deg"]
@@ -157,10 +157,10 @@ def _figure(result, traj, published, axis: str) -> Figure:
         xp = published["time_s"] if axis == "time" else published["crank_angle_deg"]
     paper = published is not None  # the paper's figure numbers only beside the paper's own solution
     xlabel = "time from TDC [s]" if axis == "time" else "crank angle from TDC [deg]"
-    fig = Figure(figsize=(13.5, 13), dpi=80)
-    fig.subplots_adjust(left=0.07, right=LEGEND_RIGHT, top=0.93, bottom=0.05, hspace=0.3)
+    fig = Figure(figsize=(13.5, 15), dpi=80)
+    fig.subplots_adjust(left=0.07, right=LEGEND_RIGHT, top=0.94, bottom=0.05, hspace=0.32)
     FigureCanvasAgg(fig)
-    axes = fig.subplots(4, 1, sharex=True)
+    axes = fig.subplots(5, 1, sharex=True)
     title = (
         f"{result['case']}: {result['spm']:.2f} strokes/min, cycle {result['cycle_time_s']:.3f} s "
         f"({result['motion_law']}, {result['placement']} placement, {result['status']})"
@@ -169,9 +169,9 @@ def _figure(result, traj, published, axis: str) -> Figure:
     for ax in axes:
         _decorate(ax, result, axis, x, ax is axes[0])
     _key_ticks(axes[0], result, axis)
-    height_ax, speed_ax = axes[0], axes[0].twinx()
-    accel_ax, jerk_ax = axes[1], axes[2]
-    slide_ax, slide_accel_ax = axes[3], axes[3].twinx()
+    height_ax, speed_ax = axes[0], axes[1]
+    accel_ax, jerk_ax = axes[2], axes[3]
+    slide_ax, slide_accel_ax = axes[4], axes[4].twinx()
 
     height_ax.plot(x, traj["slider_height_mm"], color="tab:blue", lw=1.6, label="slide height")
     speed_ax.plot(x, traj["crank_speed_rpm"], color="tab:red", lw=1.6, label="crank speed")
@@ -196,20 +196,22 @@ def _figure(result, traj, published, axis: str) -> Figure:
     for ax in (accel_ax, jerk_ax):
         ax.axhline(0, color="black", lw=0.6)
     speed_ax.set_ylim(0, 1.1 * max(float(np.max(traj["crank_speed_rpm"])), lim.get("crank_speed_rpm") or 0.0))
-    if lim.get("slider_accel_mm_s2") is not None:
-        slide_accel_ax.set_ylim(-1.15 * lim["slider_accel_mm_s2"], 1.15 * lim["slider_accel_mm_s2"])
+    _zeros_on_one_line(slide_ax, traj["slider_speed_mm_s"], lim.get("slider_speed_mm_s"))
+    _zeros_on_one_line(slide_accel_ax, traj["slider_accel_mm_s2"], lim.get("slider_accel_mm_s2"))
     height_ax.set_ylabel("slide height above BDC [mm]", color="tab:blue")
     speed_ax.set_ylabel("crank speed [rpm]", color="tab:red")
     accel_ax.set_ylabel("crank acceleration [rad/s²]")
     jerk_ax.set_ylabel("crank jerk [rad/s³]")
     slide_ax.set_ylabel("slide speed [mm/s]", color="tab:green")
     slide_accel_ax.set_ylabel("slide acceleration [mm/s²]", color="tab:orange")
-    _legend(height_ax, speed_ax)
+    _legend(height_ax)
+    _legend(speed_ax)
     _legend(accel_ax)
     _legend(jerk_ax)
     _legend(slide_ax, slide_accel_ax)
     for ax, what, figure_number in (
-        (height_ax, "slide height and crank speed", 7),
+        (height_ax, "slide height", 7),
+        (speed_ax, "crank speed", 7),
         (accel_ax, "crank acceleration", 8),
         (jerk_ax, "crank jerk", None),
         (slide_ax, "slide speed and acceleration", 9),
@@ -219,6 +221,12 @@ def _figure(result, traj, published, axis: str) -> Figure:
     axes[-1].set_xlabel(xlabel)
     axes[-1].set_xlim(x[0], x[-1])
     return fig
+
+
+def _zeros_on_one_line(ax, values: np.ndarray, limit: float | None) -> None:  # noqa: ANN001 - an Axes
+    """A y-axis symmetric about zero (the data and the limit within it): two axes so set share their zero."""
+    top = 1.15 * max(float(np.max(np.abs(values))), limit or 0.0)
+    ax.set_ylim(-top, top)
 
 
 def plot_files(
@@ -231,25 +239,74 @@ def plot_files(
         out[f"drive.{fmt}"] = drive_figure(result, traj)
     if "power" in result:
         out[f"energy.{fmt}"] = energy_figure(result, traj)
+    if "capacity" in result:
+        out[f"capacity.{fmt}"] = capacity_figure(result, traj)
     return out
+
+
+def capacity_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
+    """The press's own capacity (``press.capacity``): the forming force table against the tonnage curve over
+    the slide's height; with a drive, the crank torque over the cycle against its capacity, both signs."""
+    c = result["capacity"]
+    drive = "crank_torque_Nm" in traj and c["crank_torque_capacity_kNm"] is not None
+    fig = Figure(figsize=(12, 4.8), layout="constrained")
+    FigureCanvasAgg(fig)
+    force, torque = fig.subplots(1, 2) if drive else (fig.subplots(1, 1), None)
+    if c["tonnage_curve"] is not None:
+        h, f = np.array(c["tonnage_curve"]).T
+        force.plot(h, f, color="#b22222", lw=1.6, label="tonnage curve (press.capacity)")
+    table = result.get("process", {}).get("forming_force_kN")
+    if table:
+        h, f = np.array(sorted(table)).T
+        force.plot(h, f, "o-", color="#1f77b4", lw=1.4, ms=4, label="process.forming_force_kN")
+    use = c.get("tonnage_use")
+    if use:
+        closest = f"closest: {100 * use['share']:.0f} % of the curve"
+        force.plot([use["height_mm"]], [use["force_kN"]], "x", color="k", ms=8, label=closest)
+    tops = [max(h for h, _ in table)] if table else []
+    tops += [4 * c["rated_distance_mm"]] if c.get("rated_distance_mm") else []
+    if tops and c["tonnage_curve"] is not None:  # where the process works, not the whole stroke
+        force.set_xlim(0.0, min(2.0 * max(tops), c["tonnage_curve"][-1][0]))
+    force.set_xlabel("slide height above BDC [mm]")
+    force.set_ylabel("force [kN]")
+    force.set_title("the forming force against the press's tonnage curve", fontsize=9, loc="left")
+    force.set_ylim(bottom=0)
+    force.grid(True, lw=0.3, alpha=0.6)
+    force.legend(fontsize=8)
+    if torque is not None:
+        x = traj["crank_angle_deg"]
+        _decorate(torque, result, "angle", x, True)
+        _key_ticks(torque, result, "angle")
+        torque.plot(x, np.asarray(traj["crank_torque_Nm"]) / 1e3, color="#1f77b4", lw=1.4, label="crank torque")
+        cap = c["crank_torque_capacity_kNm"]
+        _limit(torque, x, cap, f"press.capacity.crank_torque_kNm = {cap:.1f} kN m", "#b22222", both=True)
+        torque.set_ylabel("crank torque [kN m]")
+        torque.set_xlabel("crank angle from TDC [deg]")
+        torque.set_title("the crank's torque over the cycle", fontsize=9, loc="left")
+        _legend(torque)
+    fig.suptitle(f"{result['case']}: the press's capacity at {result['spm']:.3f} strokes/min")
+    return fig
 
 
 def energy_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
     """From the motor to the grid over the cycle: shaft, bus and grid power with the grid's limit and the mean
-    bus power; the storage's energy between empty and full; the stages shaded (README, "From the motor to the
-    grid")."""
+    bus power; with a storage, its energy between empty and full; the stages shaded (README, "From the motor
+    to the grid")."""
     p = result["power"]
     t = _thin(traj)
     x = t["crank_angle_deg"]
-    fig = Figure(figsize=(12, 7.5), layout="constrained")
+    storage = p["storage_usable_kJ"] > 0
+    fig = Figure(figsize=(12, 7.5 if storage else 5), layout="constrained")
     FigureCanvasAgg(fig)
-    power, store = fig.subplots(2, 1, sharex=True, height_ratios=(1.6, 1))
+    power, store = fig.subplots(2, 1, sharex=True, height_ratios=(1.6, 1)) if storage else (fig.subplots(1, 1), None)
     for ax, label in ((power, True), (store, False)):
-        _decorate(ax, result, "angle", x, label)
+        if ax is not None:
+            _decorate(ax, result, "angle", x, label)
     _key_ticks(power, result, "angle")
     power.plot(x, t["motor_power_kW"], color="#2ca02c", lw=1.2, label="motor shaft power")
     power.plot(x, t["bus_power_kW"], color="#1f77b4", lw=1.2, label="DC-bus power (losses in)")
-    power.plot(x, t["grid_power_kW"], color="#d62728", lw=1.6, label="grid power (with the storage)")
+    grid_label = "grid power (with the storage)" if storage else "grid power (no storage: the bus less braking)"
+    power.plot(x, t["grid_power_kW"], color="#d62728", lw=1.6, label=grid_label)
     power.axhline(
         p["mean_bus_power_kW"],
         color="#555555",
@@ -262,6 +319,10 @@ def energy_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure
     power.axhline(0.0, color="#444444", lw=0.6)
     power.set_ylabel("power [kW] (drawn > 0)")
     _legend(power)
+    fig.suptitle(_energy_title(result, p))
+    if store is None:
+        power.set_xlabel("crank angle from TDC [deg]")
+        return fig
     store.plot(x, t["storage_energy_kJ"], color="#9467bd", lw=1.4, label="stored energy")
     usable = p["storage_usable_kJ"]
     _limit(store, x, usable, f"drive.storage.usable_energy_kJ = {usable:g} kJ", "#b22222")
@@ -269,14 +330,17 @@ def energy_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure
     store.set_ylabel("storage [kJ]")
     store.set_xlabel("crank angle from TDC [deg]")
     _legend(store)
-    fig.suptitle(
+    return fig
+
+
+def _energy_title(result: dict[str, Any], p: dict[str, Any]) -> str:
+    return (
         f"{result['case']}: from the motor to the grid at {result['spm']:.3f} strokes/min\n"
         f"grid peak {p['grid_peak_kW']:.0f} kW (without storage {p['bus_peak_kW']:.0f} kW), "
         f"{p['grid_energy_kJ']:.0f} kJ per stroke from the grid; losses: copper {p['copper_loss_kJ']:.0f}, "
         f"converter {p['converter_loss_kJ']:.0f}, gear {p['gear_loss_kJ']:.0f}, storage {p['storage_loss_kJ']:.0f}, "
         f"resistor {p['resistor_loss_kJ']:.0f} kJ"
     )
-    return fig
 
 
 def _plus_minus(ax, value: float, label: str, **style) -> None:  # noqa: ANN001 - a matplotlib Axes
@@ -479,7 +543,7 @@ def tradeoff_figure(rows: list[dict[str, Any]], case: Any, title: str) -> Figure
     curves = (  # axis, column, scale, marker, colour, label; each optimised (solid) and baseline (dashed)
         (top, "rms_motor_torque_Nm", 1e-3, "o", "tab:blue", "RMS"),
         (top, "peak_motor_torque_Nm", 1e-3, "s", "tab:orange", "peak"),
-        (middle, "supply_energy_kJ", 1.0, "o", "tab:green", "energy"),
+        (middle, "energy_kJ", 1.0, "o", "tab:green", "energy"),
     )
     for ax, name, unit, marker, colour, what in curves if ok else ():
         for prefix, style, label in (
@@ -503,10 +567,11 @@ def tradeoff_figure(rows: list[dict[str, Any]], case: Any, title: str) -> Figure
             label="grid peak, baseline",
         )
         right.set_ylabel("grid peak [kW]", color="tab:purple")
-        right.set_ylim(bottom=0)
+        highest = max(float(np.max(column("grid_peak_kW"))), float(np.max(column("baseline_grid_peak_kW"))))
+        right.set_ylim(0, 1.1 * highest)  # the highest point inside the frame, not on its edge
     savings = (
         ("rms_motor_torque_Nm", "o", "tab:blue", "RMS torque"),
-        ("supply_energy_kJ", "o", "tab:green", "energy per stroke"),
+        ("energy_kJ", "o", "tab:green", "energy per stroke"),
     ) + ((("grid_peak_kW", "D", "tab:purple", "grid peak"),) if grid else ())
     for name, marker, colour, what in savings:
         if ok:

@@ -14,14 +14,17 @@ import numpy as np
 from planning.model.case import KEY_POINT_NAMES, RPM, Case
 from planning.model.cycle import HALVES
 from planning.model.laws.improved_scurve import ImprovedSCurve
+from planning.model.limits import draw_speed_bounds
+from planning.model.limits.capacity import curve, has_curve, tonnage_use, torque_capacity_kNm
 from planning.model.limits.slider_accel import SliderAccelLimit
 from planning.model.outcome import Outcome
 from planning.model.profile import MAX_STEP_S, Profile
+from planning.model.units import rounded_down
 from planning.reports.source_solution import paper_solution
 from planning.reports.stages import stage_table
-from planning.solver.solution import GRID_PEAK, Solution
+from planning.solver.solution import ENERGY, GRID_PEAK, Solution
 from planning.solver.verify import Evaluation
-from planning.tolerances import KNOT_TIME_S, SAME_RELATIVE
+from planning.tolerances import BINDING_SHARE, KNOT_TIME_S, SAME_RELATIVE
 from press.mechanism import Mechanism
 
 TRAJECTORY_COLUMNS = (
@@ -146,6 +149,8 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
         "motion_law": plan.motion_law,
         "structure": plan.structure,
         "draw_speed_rpm": float(p.draw_speed) / RPM,
+        "draw_speed_given": case.process.draw_speed_rpm is not None,
+        "draw_speed_highest_rpm": min(draw_speed_bounds(case).values()) / RPM,
         "transfer_speed_rpm": float(p.transfer_speed) / RPM,
         "feed_peak_speed_rpm": float(p.feed_peak_speed) / RPM,
         "return_peak_speed_rpm": float(p.return_peak_speed) / RPM,
@@ -164,6 +169,7 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
         "segments": segments(solution),
         "paper_solution": paper_solution(plan) if plan.motion_law == ImprovedSCurve.name else None,
         **({"drive": drive_block(solution, case)} if case.drive is not None else {}),
+        **({"capacity": capacity_block(case)} if case.press.capacity is not None else {}),
         **({"power": solution.drive.power.as_dict()} if solution.drive and solution.drive.power else {}),
         **objective_block(solution, case),
         "verification": {
@@ -199,6 +205,30 @@ def drive_block(solution: Solution, case: Case) -> dict[str, Any]:
     return {**solution.drive.as_dict(), "motor": motor, "gear_ratio": case.drive.gear_ratio}
 
 
+CURVE_POINTS = 101  # points of the tonnage curve result.json carries (the figure draws it from them)
+
+
+def capacity_block(case: Case) -> dict[str, Any]:
+    """The ``capacity`` block of ``result.json``: the press's rating, its crank torque capacity [kN m], its
+    tonnage curve on :data:`CURVE_POINTS` heights ``[[height mm, force kN], ...]`` (``press.capacity``) and,
+    with a forming force table, where the table comes closest to the curve."""
+    c = case.press.capacity
+    out: dict[str, Any] = {
+        "rated_force_kN": c.rated_force_kN,
+        "rated_distance_mm": c.rated_distance_mm,
+        "crank_torque_capacity_kNm": torque_capacity_kNm(case),
+        "tonnage_curve": None,
+    }
+    if has_curve(case):
+        heights, forces = curve(case)
+        h = np.linspace(float(heights[0]), float(heights[-1]), CURVE_POINTS)
+        out["tonnage_curve"] = [[float(x), float(y)] for x, y in zip(h, np.interp(h, heights, forces), strict=True)]
+        if case.process.forming_force_kN is not None:
+            use, at, force, allowed = tonnage_use(case)
+            out["tonnage_use"] = {"share": use, "height_mm": at, "force_kN": force, "allowed_kN": allowed}
+    return out
+
+
 def objective_block(solution: Solution, case: Case) -> dict[str, Any]:
     """The objective keys of ``result.json``: ``objective``, ``target_spm``; at a target rate also the
     ``baseline``'s figures (the max-SPM planner with the spare time given to the transfer: its RMS motor
@@ -207,16 +237,19 @@ def objective_block(solution: Solution, case: Case) -> dict[str, Any]:
     out: dict[str, Any] = {"objective": case.planner.objective, "target_spm": case.planner.target_spm}
     a = solution.at_rate
     if a is not None:
+        out["energy_kJ"] = solution.energy_kJ
+        out["energy_at"] = "bus" if solution.drive.power is not None else "shaft"
         b = a.baseline
         out["baseline"] = {
             "rms_motor_torque_Nm": b.drive.rms_motor_torque_Nm,
             "supply_energy_kJ": b.drive.supply_energy_kJ,
+            "energy_kJ": b.energy_kJ,
             "transfer_window_s": b.plan.transfer_window(),
             "spm": b.plan.spm,
         }
         out["saving_pct"] = {
             "rms_torque": solution.saving_pct("rms_motor_torque_Nm"),
-            "energy": solution.saving_pct("supply_energy_kJ"),
+            "energy": solution.saving_pct(ENERGY),
         }
         if b.drive.power is not None and solution.drive.power is not None:  # the grid's side (Case.electrical)
             out["baseline"]["grid_peak_kW"] = b.drive.power.grid_peak_kW
@@ -251,8 +284,8 @@ def _plan_lines(r: dict[str, Any]) -> list[str]:
         f"{r['case']}: {r['spm']:.3f} strokes/min, cycle {r['cycle_time_s']:.4f} s "
         f"({r['motion_law']}, {r['placement']} placement, {r['status']})",
         f"  theta1 (closing) in {r['structure']['closing']}, theta4 (opening) in {r['structure']['opening']}",
-        f"  crank speed: transfer {r['transfer_speed_rpm']:.3f} rpm, feed peak {r['feed_peak_speed_rpm']:.3f} rpm, "
-        f"draw {r['draw_speed_rpm']:.3f} rpm, return peak {r['return_peak_speed_rpm']:.3f} rpm",
+        f"  crank speed: dwell {r['transfer_speed_rpm']:.3f} rpm, feed peak {r['feed_peak_speed_rpm']:.3f} rpm, "
+        f"draw {r['draw_speed_rpm']:.3f} rpm{_draw_words(r)}, return peak {r['return_peak_speed_rpm']:.3f} rpm",
         f"  peaks: crank acceleration {r['peak_crank_accel_rad_s2']:.3f} rad/s^2, "
         f"crank jerk {r['peak_crank_jerk_rad_s3']:.3f} rad/s^3",
         f"  halves: feed {hd['feed_accel']:.4f} / {hd['feed_decel']:.4f} s, return {hd['return_accel']:.4f} / "
@@ -260,9 +293,18 @@ def _plan_lines(r: dict[str, Any]) -> list[str]:
         if hd
         else f"  free profile: {r['segment_count']} segments of constant jerk (no halves), "
         f"|jerk| <= {r['limits']['crank_jerk_rad_s3']:g} rad/s^3",
-        f"  transfer window theta4 -> theta1: {r['transfer_window_s']:.4f} s; "
+        f"  robot window theta4 -> theta1: {r['transfer_window_s']:.4f} s; "
         f"max |slider accel| {r['max_abs_slider_accel_mm_s2']:.1f} mm/s^2",
     ]
+
+
+def _draw_words(r: dict[str, Any]) -> str:
+    """Whose the draw speed is: the case's, or the planner's choice up to the highest the limits allow."""
+    if r.get("draw_speed_given", True):
+        return " (given)"
+    if r["draw_speed_rpm"] >= r["draw_speed_highest_rpm"] * (1 - BINDING_SHARE):
+        return " (the highest the limits allow)"
+    return f" (the planner's choice; the limits allow up to {rounded_down(r['draw_speed_highest_rpm'])})"
 
 
 def _key_point_lines(r: dict[str, Any]) -> list[str]:
@@ -329,6 +371,9 @@ def _drive_lines(r: dict[str, Any]) -> list[str]:
     return lines
 
 
+ENERGY_AT = {"bus": "at the DC bus, losses counted", "shaft": "at the motors' shaft"}
+
+
 def _objective_lines(r: dict[str, Any]) -> list[str]:
     """At the line's rate: the objective's figures against the baseline's."""
     if not r.get("baseline"):
@@ -338,9 +383,9 @@ def _objective_lines(r: dict[str, Any]) -> list[str]:
         "",
         f"  objective {r['objective']} at {r['target_spm']:g} strokes/min (the limits allow up to "
         f"{r['fastest_spm']:.3f}): RMS motor torque {d['rms_motor_torque_Nm'] / 1e3:.2f} kN m, "
-        f"energy from the supply {d['supply_energy_kJ']:.1f} kJ per stroke",
+        f"energy from the supply {r['energy_kJ']:.1f} kJ per stroke ({ENERGY_AT[r['energy_at']]})",
         f"  baseline (max-SPM plan, spare time in the transfer dwell; window {b['transfer_window_s']:.3f} s): "
-        f"RMS {b['rms_motor_torque_Nm'] / 1e3:.2f} kN m, energy {b['supply_energy_kJ']:.1f} kJ; "
+        f"RMS {b['rms_motor_torque_Nm'] / 1e3:.2f} kN m, energy {b['energy_kJ']:.1f} kJ; "
         f"saving {saving['rms_torque']:.1f} % "
         f"RMS torque, {saving['energy']:.1f} % energy"
         + (

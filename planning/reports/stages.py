@@ -16,11 +16,12 @@ from typing import Any
 
 import numpy as np
 
+from planning.model.plan import stage_of
 from planning.model.units import RPM
 from planning.solver.verify import Evaluation
 from planning.tolerances import KNOT_TIME_S
 
-STAGE_ORDER = ("transfer", "feed", "draw", "return")  # the table starts with the transfer
+STAGE_ORDER = ("dwell", "window", "feed", "draw", "return")  # the table starts with the dwell (or the window)
 
 
 def stage_runs(segments: list[dict[str, Any]]) -> list[dict[str, Any]]:
@@ -28,7 +29,9 @@ def stage_runs(segments: list[dict[str, Any]]) -> list[dict[str, Any]]:
     [deg from TDC; the end past 360 for a stage through TDC], start time [s from TDC], duration [s]."""
     runs: list[dict[str, Any]] = []
     for seg in segments:
-        stage = seg["name"].partition(":")[0]
+        if seg["duration_s"] <= KNOT_TIME_S:  # a stage of no length (a dwell the plan does not use): no row
+            continue
+        stage = stage_of(seg["name"])
         if runs and runs[-1]["name"] == stage:
             runs[-1]["end_angle_deg"] = seg["end_angle_deg"]
             runs[-1]["duration_s"] += seg["duration_s"]
@@ -46,7 +49,8 @@ def stage_runs(segments: list[dict[str, Any]]) -> list[dict[str, Any]]:
         first = runs.pop(0)
         runs[-1]["end_angle_deg"] = first["end_angle_deg"] + 360.0
         runs[-1]["duration_s"] += first["duration_s"]
-    start = next((k for k, r in enumerate(runs) if r["name"] == STAGE_ORDER[0]), 0)
+    first = next((name for name in STAGE_ORDER if any(r["name"] == name for r in runs)), None)
+    start = next((k for k, r in enumerate(runs) if r["name"] == first), 0)
     return runs[start:] + runs[:start]
 
 

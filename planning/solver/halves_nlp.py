@@ -66,7 +66,7 @@ from planning.solver.nlp import (
     objective_terms,
     sample_states,
 )
-from planning.solver.parameters import DRAW_SAMPLES_DRIVE, ParameterLayout, drive_links, time_limit
+from planning.solver.parameters import DRAW_SAMPLES_DRIVE, EXIT_SAMPLES, ParameterLayout, drive_links, time_limit
 from press.mechanism import Formula
 
 # Decision variables and the kind of scale each is measured in (see :func:`variable_scales`)
@@ -89,6 +89,8 @@ VARIABLES: tuple[tuple[str, str], ...] = (
 VARIABLE_INDEX = {name: i for i, (name, _) in enumerate(VARIABLES)}
 # the rate NLP of the least grid peak adds the bus power's peak at the samples [W] (an epigraph variable)
 PEAK_VARIABLE = ("bus_peak", "power")
+# the denser variant adds the times at which the crank passes the die exit's angles (from theta3) [s]
+EXIT_VARIABLES = tuple((f"die_exit_time_{k}", "time") for k in range(EXIT_SAMPLES))
 SAMPLES_CONSTANT = 20  # samples on the constant-speed transfer dwell
 MIN_HALF_S = 4e-3  # [s] lower bound on the duration of a half (1 ms per improved-S-curve sub-segment)
 TOP_SPEED = 1e3  # [rad/s] upper bound of the crank speeds (far above any press)
@@ -135,6 +137,31 @@ def variable_bounds(
         if parameters[layout.index(f"{k}_active")] == 0.0:
             lo[i[f"{k}_time"]] = hi[i[f"{k}_time"]] = 0.0
     return lo, hi
+
+
+def exit_variable_scales(case: Case) -> np.ndarray:
+    """:func:`variable_scales` and the die exit's times' (the other times' scale)."""
+    scales = variable_scales(case)
+    return np.append(scales, np.full(EXIT_SAMPLES, scales[VARIABLE_INDEX["die_up_time"]]))
+
+
+def exit_variable_bounds(
+    case: Case, layout: ParameterLayout, w2_lo: float, w2_hi: float, parameters: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`variable_bounds` and the die exit's times: within the cycle, or 0 where it has no exit."""
+    lo, hi = variable_bounds(case, layout, w2_lo, w2_hi, parameters)
+    top = time_limit(case) if parameters[layout.index("die_exit_active")] else 0.0
+    return np.append(lo, np.zeros(EXIT_SAMPLES)), np.append(hi, np.full(EXIT_SAMPLES, top))
+
+
+def complete_exit(values: dict[str, float]) -> dict[str, float]:
+    """``values`` with the die exit's times where a start lacks them: evenly up to the die-height crossing
+    (the exit's angles lie evenly from theta3, time 0, to it)."""
+    missing = [k for k in range(EXIT_SAMPLES) if f"die_exit_time_{k}" not in values]
+    if not missing:
+        return values
+    up = values["die_up_time"]
+    return {**values, **{f"die_exit_time_{k}": up * (k + 1) / (EXIT_SAMPLES + 1) for k in missing}}
 
 
 def peak_variable_scales(case: Case) -> np.ndarray:
@@ -275,6 +302,20 @@ def _key_point_rows(rows: Rows, c: _Cycle) -> tuple[int, tuple[ca.SX, ca.SX]]:
     return published_rows, (omd, omu)
 
 
+def _exit_rows(rows: Rows, c: _Cycle, first: int) -> list[tuple[ca.SX, ca.SX]]:
+    """The crank at the die exit's angles (their times the variables from ``first`` on): a row each that the
+    time is the angle's (switched off without an exit); the crank speed there with ``|dh/dtheta|``, which the
+    die-speed limit holds (``planning.model.limits.die_speed``)."""
+    q = c.q
+    out, angles = [], []
+    for k in range(EXIT_SAMPLES):
+        theta, omega = _angle_at(c.x[first + k] * c.p_scale[first + k], *c.before)
+        angles.append(q["die_exit_active"] * (theta - q[f"die_exit_angle_{k}"]))
+        out.append((omega, q[f"die_exit_slope_{k}"]))
+    rows.add("die exit angles", ca.vertcat(*angles), 0.0, 0.0, "limits.die_height_mm")
+    return out
+
+
 def _sampled(c: _Cycle, law, drive: bool) -> tuple[tuple[ca.SX, ca.SX, ca.SX], ca.SX, int]:  # noqa: ANN001
     """The states at sample points of every segment, one vector per quantity, and their times; the draw's
     samples last (``drive`` only: otherwise every limit holds in the draw by the draw speed's bounds)."""
@@ -335,13 +376,15 @@ def _build(
 ) -> CycleNLP:
     law = get_law(law_name)
     drive = drive or rate
-    zone = zone or rate
-    layout = ParameterLayout(formula, limit_ids, drive, rate, links if drive else ())
-    variables = VARIABLES + ((PEAK_VARIABLE,) if peak else ())
+    die_exit = zone and not rate  # the denser variant: the die exit held at its angles (smooth rows)
+    zone = rate  # the rate NLP: every sample in the die zone held (its crank speed may peak there)
+    layout = ParameterLayout(formula, limit_ids, drive, rate, links if drive else (), die_exit)
+    variables = VARIABLES + ((PEAK_VARIABLE,) if peak else ()) + (EXIT_VARIABLES if die_exit else ())
     c = _cycle(law_name, layout, variables)
     rows = Rows()
     _shape_rows(rows, c, law)
     published_rows, (omd, omu) = _key_point_rows(rows, c)
+    exit_speeds = _exit_rows(rows, c, len(variables) - EXIT_SAMPLES) if die_exit else []
     states, times, draw_count = _sampled(c, law, drive)
     samples, torque, lift = sample_states(formula, layout, c.q, c.p_case, states, times, draw_count)
     p = c.params
@@ -355,6 +398,7 @@ def _build(
         jerks=Extremes(ca.vertcat(*p.peak_jerks())),
         lowest_speeds=None,  # the variable bounds of w1, w2 (the halves are monotone)
         crossings=[(omd, c.q["die_down_slope"]), (omu, c.q["die_up_slope"])],
+        exit_speeds=exit_speeds,
         zone=zone,
         rate=rate,
         speed_unit=c.unit["draw_speed"],
@@ -362,22 +406,26 @@ def _build(
     refinable = add_limit_rows(rows, nlp, layout)
     objective = _objective(rows, c, torque, states, times, (rate, peak, losses))
     problem = {"x": c.x, "p": ca.vertcat(c.p_case, c.p_scale), "f": objective, "g": ca.vertcat(*rows.g)}
-    kind = ("_rate" if rate else "_drive" if drive else "") + ("_zone" if zone and not rate else "")
+    kind = ("_rate" if rate else "_drive" if drive else "") + ("_exit" if die_exit else "")
     kind += ("_peak" if peak else "") + ("_losses" if losses else "")
     options = {**CYCLE_OPTIONS, **(DRIVE_OPTIONS if drive else {}), **(RATE_OPTIONS if rate else {})}
     program = NLPSolver("press_cycle_" + law_name.replace("-", "_") + kind, problem, options, lift=lift)
+    scales = peak_variable_scales if peak else exit_variable_scales if die_exit else variable_scales
+    bounds = peak_variable_bounds if peak else exit_variable_bounds if die_exit else variable_bounds
+    denser = None if zone or die_exit else partial(halves_nlp, law_name, formula, limit_ids, drive, rate, True, links)
     return CycleNLP(
         program,
         *rows.bounds(),
         tuple(rows.blocks),
         layout,
         variables,
-        peak_variable_scales if peak else variable_scales,
-        peak_variable_bounds if peak else variable_bounds,
+        scales,
+        bounds,
         make_plan,
         published_rows,
         refinable,
-        None if zone else partial(halves_nlp, law_name, formula, limit_ids, drive, rate, True, links, peak, losses),
+        denser,
+        complete_exit if die_exit else None,
     )
 
 

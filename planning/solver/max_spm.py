@@ -19,7 +19,7 @@ from planning.solver.halves_nlp import halves_nlp_for
 from planning.solver.neighbour import can_answer, can_start, known_evaluation, plan_of
 from planning.solver.search import Ran, Search, prepare
 from planning.solver.solution import Solution
-from planning.solver.starts import free_starts, published_starts
+from planning.solver.starts import constant_speed, free_starts, published_starts
 from planning.solver.verify import evaluate
 
 MOTOR_LIMITS = frozenset(limit.id for limit in BY_ID.values() if limit.motor)  # the motor's limits
@@ -41,6 +41,8 @@ def solve_max_spm(
     _multi_start(search, neighbour, ran)
     if search.best is None:
         _try_harder(search, neighbour)
+    if search.best is None:
+        _constant_speed(search)
     return search.answer()
 
 
@@ -101,6 +103,18 @@ def _try_harder(search: Search, neighbour: Plan | None) -> None:
         if limit.harder_backoff is not None:
             search.parameters[search.parameter(limit.refined)] *= (1 - limit.harder_backoff) / (1 - limit.backoff)
     _multi_start(search, neighbour)
+
+
+def _constant_speed(search: Search) -> None:
+    """No start reached a plan: the crank at one constant speed all round (``planning.solver.starts.
+    constant_speed``: a motion of every law with halves, with no jerk at all) is a candidate as it is, where
+    it holds (a crank-jerk limit near zero leaves the NLP no room to move from it)."""
+    x0 = constant_speed(search.case, search.draw_speed_range[1], 1.0)
+    plan = search.plan_of(x0, "published", "constant speed")
+    evaluation = evaluate(plan, search.case)
+    if evaluation.verification.passed:
+        solution = Solution(plan, evaluation)
+        search.consider(solution, search.score_of(solution))
 
 
 def adopt(search: Search, neighbour: Plan | Solution | None) -> Plan | None:

@@ -99,8 +99,9 @@ def add_limit_rows(rows: Rows, nlp: Transcription, layout: ParameterLayout) -> d
     for limit in layout.limits:
         for row in limit.rows(nlp):
             rows.add(row.name, row.expr, row.lo, row.hi, limit.field, limit.id)
-            if row.sampled and limit.refined is not None:
-                refinable[limit.id] = Refinement(layout.index(limit.refined), limit.refine_upward)
+            refined = row.refined or limit.refined
+            if row.sampled and refined is not None:
+                refinable[limit.id] = Refinement(layout.index(refined), limit.refine_upward)
     return refinable
 
 
@@ -132,6 +133,11 @@ class CycleNLP:
     published_rows: slice = field(default_factory=lambda: slice(0, 0))
     refinable: dict[str, Refinement] = field(default_factory=dict)
     denser: Callable[[], CycleNLP] | None = None
+    complete: Callable[[dict[str, float]], dict[str, float]] | None = None  # a start's missing variables
+
+    def completed(self, values: dict[str, float]) -> dict[str, float]:
+        """``values`` with the variables a start of another NLP lacks filled in (:attr:`complete`)."""
+        return values if self.complete is None else self.complete(values)
 
     def values_of(self, result: NLPResult) -> dict[str, float]:
         """The variables of a solve by name."""
@@ -169,6 +175,7 @@ class CycleNLP:
         (:attr:`layout` order), physical bounds ``lbx``/``ubx`` and the variables' ``scale``;
         ``warm_start``: the multipliers of a nearby solve; ``fixed_period``: see :meth:`bounds`."""
         lbg, ubg = self.bounds(placement, fixed_period)
+        start = self.completed(start)
         x0 = np.array([start[k] for k, _ in self.variables])
         return self.program.solve(x0, lbx, ubx, lbg, ubg, p=case_parameters, scale=scale, warm_start=warm_start)
 
@@ -287,6 +294,7 @@ def sample_states(
         "param": q.__getitem__,
         "motor_torque": None if torque is None else torque.tm,
         "motor_speed": None if torque is None else torque.speed,
+        "crank_torque": None if torque is None else torque.tc,
     }
     return fields, torque, lift
 

@@ -63,6 +63,10 @@ OBJECTIVE = (
     "copper_coefficient",  # [W/(N m)^2] copper loss = k T_m^2 (drive.motor.copper_loss_at_rated_kW / rated^2)
     "converter_efficiency",  # eta_c, the bus power's P_el / eta_c
 )
+# the die exit (a halves NLP's denser variant): where the draw ends with the slide below the die height, the
+# die speed is held at fixed crank angles from theta3 to the die-height crossing (smooth rows, exact there)
+EXIT_SAMPLES = 12
+EXIT = tuple(f"die_exit_{part}_{k}" for k in range(EXIT_SAMPLES) for part in ("angle", "slope")) + ("die_exit_active",)
 DRAW_SAMPLES_DRIVE = 80  # with a drive the draw is sampled finer: the forming force changes fast there
 FORMING_SAMPLES = DRAW_SAMPLES_DRIVE + 1  # forming force [N] at the draw's samples, theta2 ... theta3
 POWER_SMOOTHING = 1e-3  # epsilon of the rate NLP's smooth max(P, 0), as a share of rated torque x base speed
@@ -79,6 +83,7 @@ class ParameterLayout:
     drive: bool = False
     rate: bool = False
     links: tuple[str, ...] = ()
+    die_exit: bool = False  # the die exit's angles (:data:`EXIT`; a halves NLP's denser variant)
 
     @property
     def limits(self) -> tuple[Limit, ...]:
@@ -88,6 +93,7 @@ class ParameterLayout:
     def names(self) -> tuple[str, ...]:
         """Every parameter's name but the forming force's, in vector order."""
         names = [f"geometry_{g}" for g in self.formula.geometry_names] + list(STRUCTURE)
+        names += EXIT if self.die_exit else ()
         for limit in self.limits:
             names += [p for p in limit.parameters if p not in names]
         if self.drive:
@@ -127,6 +133,8 @@ class ParameterLayout:
         names = (f"geometry_{g}" for g in self.formula.geometry_names)
         values = dict(zip(names, case.machine.geometry, strict=True))
         values |= structure_values(case)
+        if self.die_exit:
+            values |= exit_values(case)
         for limit in self.limits:
             values |= limit.parameter_values(case)
         if self.drive:
@@ -159,6 +167,23 @@ def structure_values(case: Case) -> dict[str, float]:
         "die_up_active": 1.0 if up > th3 else 0.0,
         "length_unit": m.length_scale,
     }
+
+
+def exit_values(case: Case) -> dict[str, float]:
+    """The die exit's angles, evenly inside theta3 ... the die-height crossing the slide rises through, and
+    ``|dh/dtheta|`` there; inactive (``die_exit_active`` 0, every slope 0) where the draw ends above the die
+    height."""
+    m = case.machine
+    th3 = float(case.key_angles[2])
+    up = float(m.angles_at_height(case.limits.die_height_mm)[1])
+    active = up > th3
+    share = np.arange(1, EXIT_SAMPLES + 1) / (EXIT_SAMPLES + 1)
+    angles = th3 + (up - th3) * share if active else np.full(EXIT_SAMPLES, th3)
+    slopes = np.abs(m.derivatives(angles)[0]) if active else np.zeros(EXIT_SAMPLES)
+    out = {"die_exit_active": 1.0 if active else 0.0}
+    for k in range(EXIT_SAMPLES):
+        out[f"die_exit_angle_{k}"], out[f"die_exit_slope_{k}"] = float(angles[k]), float(slopes[k])
+    return out
 
 
 def drive_values(case: Case) -> dict[str, float]:

@@ -133,7 +133,8 @@ class Search:
                 self.stopped = True
                 return found
             if any(c.id not in self.nlp.refinable for c in bad):
-                if not self._densify(bad):
+                q = self._densify(bad, q)
+                if q is None:
                     return found
                 multipliers = None  # the denser NLP from the same values, its sampled limits as they were
                 continue
@@ -149,16 +150,28 @@ class Search:
                     q[refine.index] *= (c.limit / c.value) * (1 - REFINE_MARGIN)
         return found
 
-    def _densify(self, bad: list) -> bool:
+    def _densify(self, bad: list, q: np.ndarray) -> np.ndarray | None:
         """Turn to the NLP's denser variant (``CycleNLP.denser``) when it holds every failed check at its
-        samples; the search keeps it from here on. Whether it did."""
+        samples; the search keeps it from here on (its parameters, bounds and scales; the parameters the
+        search has set carried over by name). The attempt's parameters ``q`` for it, or None where it did not."""
         if self.nlp.denser is None:
-            return False
+            return None
         denser = self.nlp.denser()
         if any(c.id not in denser.refinable for c in bad):
-            return False
-        self.nlp = denser
-        return True
+            return None
+        old = self.nlp.layout
+        fresh = denser.layout.values(self.case)
+        carried = [(denser.layout.index(name), i) for i, name in enumerate(old.names) if name in denser.layout.names]
+        to, frm = (np.array(ix, dtype=int) for ix in zip(*carried, strict=True))
+        fresh[to] = self.parameters[frm]
+        local = fresh.copy()
+        local[to] = q[frm]
+        if old.drive:  # the forming force at the draw's samples, last in both
+            fresh[denser.layout.forming], local[denser.layout.forming] = q[old.forming], q[old.forming]
+        self.nlp, self.parameters = denser, fresh
+        self.lbx, self.ubx = denser.variable_bounds(self.case, denser.layout, *self.draw_speed_range, fresh)
+        self.scale = denser.variable_scales(self.case)
+        return local
 
     def _room(self, res: NLPResult, verification: Verification) -> tuple[int, float] | None:
         """``(parameter index, limit / exact value)`` of the first limit whose NLP row can overstate its
@@ -177,6 +190,7 @@ class Search:
 
     def key(self, values: dict[str, float]) -> np.ndarray:
         """``values`` as the NLP's variable vector (to compare starts)."""
+        values = self.nlp.completed(values)
         return np.array([values[k] for k, _ in self.nlp.variables])
 
     def consider(self, solution: Solution, score: float) -> None:
@@ -197,7 +211,7 @@ class Search:
             if self.stopped:
                 break
             key = self.key(x0)
-            if any(np.allclose(key, other, rtol=SAME_START_REL, atol=SAME_ANGLE_RAD) for other in tried):
+            if any(_same_start(key, other) for other in tried):
                 continue  # the same start again would only repeat its answer
             tried.append(key)
             out = self.attempt(x0, placement)
@@ -234,6 +248,12 @@ class Search:
             plan = replace(plan, placement="free")
         info = SolverInfo(self.iterations, time.perf_counter() - self.t_start, self.starts, plan.solver.status)
         return replace(self.best, plan=replace(plan, solver=info))
+
+
+def _same_start(a: np.ndarray, b: np.ndarray) -> bool:
+    """Two starts of an NLP the same to round-off (a start of the denser variant has more variables)."""
+    n = min(a.size, b.size)
+    return bool(np.allclose(a[:n], b[:n], rtol=SAME_START_REL, atol=SAME_ANGLE_RAD))
 
 
 @dataclass(frozen=True)

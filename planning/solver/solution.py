@@ -13,6 +13,7 @@ from planning.model.plan import Plan
 from planning.solver.verify import Evaluation, Verification
 
 GRID_PEAK = "grid_peak_kW"  # the power figures' key of the grid's peak
+ENERGY = "energy_kJ"  # the energy per stroke the objectives weigh (Solution.energy_kJ)
 
 
 @dataclass(frozen=True)
@@ -35,12 +36,28 @@ class Solution:
         """The drive's figures of the plan (the evaluation's; a case with a drive)."""
         return self.evaluation.drive
 
+    @property
+    def energy_kJ(self) -> float:
+        """The energy per stroke the objectives weigh and report [kJ]: with the drive's electrical side at the
+        bus, its copper and converter losses counted (``power.bus_supply_energy_kJ``), else at the motors'
+        shaft (``drive.supply_energy_kJ``); both take back ``drive.regen_efficiency`` of what is returned."""
+        power = self.drive.power
+        return power.bus_supply_energy_kJ if power is not None else self.drive.supply_energy_kJ
+
+    def figure(self, key: str) -> float:
+        """A drive figure by name: :attr:`energy_kJ` (``energy_kJ``), the grid's peak (``grid_peak_kW``), or
+        a field of the drive's figures (``rms_motor_torque_Nm``, ...)."""
+        if key == ENERGY:
+            return self.energy_kJ
+        if key == GRID_PEAK:
+            return self.drive.power.grid_peak_kW
+        return getattr(self.drive, key)
+
     def saving_pct(self, key: str) -> float:
-        """How much lower this plan's drive figure ``key`` (``rms_motor_torque_Nm``, ``supply_energy_kJ`` or,
-        from the power figures, ``grid_peak_kW``: what an objective at a rate saves) is than the baseline's at
-        the same rate [%] (needs ``at_rate``)."""
-        base, ours = ((s.drive.power if key == GRID_PEAK else s.drive) for s in (self.at_rate.baseline, self))
-        base, ours = getattr(base, key), getattr(ours, key)
+        """How much lower this plan's drive figure ``key`` (:meth:`figure`: ``rms_motor_torque_Nm``,
+        ``energy_kJ``, ``grid_peak_kW``: what an objective at a rate saves) is than the baseline's at the
+        same rate [%] (needs ``at_rate``)."""
+        base, ours = self.at_rate.baseline.figure(key), self.figure(key)
         return 100.0 * (base - ours) / base if base else 0.0
 
 
@@ -66,6 +83,4 @@ def objective_value(solution: Solution, objective: str) -> float:
     d = solution.drive
     if objective == "min-grid-peak":
         return d.power.grid_peak_kW
-    if objective == "min-energy" and d.power is not None:
-        return d.power.bus_supply_energy_kJ
-    return d.rms_motor_torque_Nm**2 if objective == "min-rms-torque" else d.supply_energy_kJ
+    return d.rms_motor_torque_Nm**2 if objective == "min-rms-torque" else solution.energy_kJ

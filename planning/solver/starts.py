@@ -76,23 +76,105 @@ def transfer_speeds(case: Case) -> tuple[float, float]:
 
 def published_starts(case: Case, w2: float, neighbour: Plan | None) -> list[dict[str, float]]:
     """Starts of the published placement at draw speed ``w2`` [rad/s]: the neighbour's values when it has
-    that placement, then guesses from the case."""
+    that placement, then guesses from the case, the constant-speed motion last (:func:`constant_speed`)."""
     w_transfer, w_min = transfer_speeds(case)
     starts = [guess(case, w2, w_transfer, share, 1.0) for share in (0.9, 0.6)]
     starts.append(guess(case, w2, 0.5 * (w_transfer + w_min), 0.75, 1.0))
+    starts.append(constant_speed(case, w2, 1.0))
     if neighbour is not None and neighbour.placement == "published":
         starts = [neighbour.nlp_values] + starts
     return starts
+
+
+def constant_speed(case: Case, w2: float, inside: float) -> dict[str, float]:
+    """The crank at one constant speed all round (every half a speed change of zero: a motion of every law
+    with halves, whatever its jerk limit), the speed the draw's, the transfer time's and the slide's
+    acceleration at constant speed allow, the lowest of them (at least the minimum crank speed): a start that
+    holds where the others cannot reach a plan (a crank-jerk limit near zero). Key points ``inside`` quarters
+    into the halves, as :func:`guess` places them."""
+    th1, th2, th3, th4 = case.key_angles
+    w_transfer, w_min = transfer_speeds(case)
+    w_window = (th1 + 2 * math.pi - th4) / case.process.transfer_time_s
+    w_accel = math.sqrt(case.limits.slider_accel_mm_s2 / case.machine.peak_curvature)
+    w = max(min(w2, w_window, w_accel, top_crank_speed(case) or math.inf), w_min)
+    share = inside / sc.SUBSEGMENTS  # theta4 this share before the return's end, theta1 after the feed's start
+    D_r = (th4 - th3) / ((2 - share) * w)  # the return's halves sweep theta3 .. theta4 and the share past it
+    D_f = (th2 - th1) / ((2 - share) * w)
+    T_c = max((th1 + 2 * math.pi - th4) / w - share * (D_r + D_f), 0.0)
+    t4 = D_r + (1 - share) * D_r
+    t1 = 2 * D_r + T_c + share * D_f
+    law = get_law(case.planner.motion_law)
+    return {
+        "transfer_speed": w,
+        "draw_speed": w,
+        "feed_peak_speed": w,
+        "return_peak_speed": w,
+        "feed_accel_duration": D_f,
+        "feed_decel_duration": D_f,
+        "return_accel_duration": D_r,
+        "return_decel_duration": D_r,
+        "transfer_dwell": T_c,
+        "law_parameter": law.parameter.start if law.parameter else 0.0,
+        "closing_time": t1,
+        "opening_time": t4,
+        "die_down_time": 0.5 * (t1 + t1 - share * D_f + 2 * D_f),
+        "die_up_time": 0.5 * t4,
+    }
 
 
 def free_starts(
     case: Case, w2: float, neighbour: Plan | None, published: dict[str, float] | None
 ) -> list[dict[str, float]]:
     """Starts of the free placement: the neighbour's values when it has that placement, the best
-    published-placement plan, then guesses from the case."""
+    published-placement plan, the die exit's start where the draw ends in the die zone (:func:`die_exit`),
+    then guesses from the case."""
     w_transfer, w_min = transfer_speeds(case)
     starts = [neighbour.nlp_values] if neighbour is not None and neighbour.placement == "free" else []
     starts += [published] if published is not None else []
+    exit_start = die_exit(case, w2)
+    starts += [exit_start] if exit_start is not None else []
     starts.append(guess(case, w2, w_transfer, 0.9, 1.5))
     starts.append(guess(case, w2, 2 * w_min, 0.95, 2.0))
+    starts.append(constant_speed(case, w2, 1.5))
     return starts
+
+
+def die_exit(case: Case, w2: float) -> dict[str, float] | None:
+    """Where the draw ends with the slide still below the die height (the check warns of it), the die speed
+    caps the crank at the crossing the slide rises through after theta3: ``v_die / |h'|`` there. A start of
+    that structure: the return's halves sweep theta3 to that crossing only, and the transfer runs at the cap
+    (or the speed the transfer time needs, the lower) from the crossing through the robot's window, theta4
+    in the transfer. None where the draw ends above the die height."""
+    m = case.machine
+    th1, _, th3, th4 = case.key_angles
+    die = case.limits.die_height_mm
+    if float(m.height(th3)) >= die:
+        return None
+    up = float(m.angles_at_height(min(die, m.stroke))[1])
+    if not th3 < up < th4:
+        return None
+    cap = case.limits.die_speed_mm_s / abs(float(m.derivatives(up)[0]))
+    w_transfer, w_min = transfer_speeds(case)
+    w1 = max(min(w_transfer, cap), w_min)
+    x0 = guess(case, w2, w1, 0.9, 1.0)
+    wm2 = 1.1 * max(w1, w2)
+    ratio = math.sqrt((wm2 - w1) / (wm2 - w2))  # one jerk for both halves (Eq. 14)
+    D_ra = (up - th3) / ((w2 + wm2) / 2 + ratio * (wm2 + w1) / 2)
+    D_rd = ratio * D_ra
+    D_fa, wm1 = x0["feed_accel_duration"], x0["feed_peak_speed"]
+    share = 1.0 / sc.SUBSEGMENTS  # theta1 a sub-segment into the feed's acceleration, as in guess()
+    feed_start = th1 + 2 * math.pi - share * D_fa * (w1 + wm1) / 2
+    dwell = max((feed_start - up) / w1, 0.0)
+    closing = D_ra + D_rd + dwell + share * D_fa
+    return {
+        **x0,
+        "transfer_speed": w1,
+        "return_peak_speed": wm2,
+        "return_accel_duration": D_ra,
+        "return_decel_duration": D_rd,
+        "transfer_dwell": dwell,
+        "opening_time": D_ra + D_rd + (th4 - up) / w1,
+        "closing_time": closing,
+        "die_up_time": D_ra + D_rd,
+        "die_down_time": 0.5 * (closing + D_ra + D_rd + dwell + D_fa + x0["feed_decel_duration"]),
+    }

@@ -31,7 +31,7 @@ from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 
-from planning.model.units import RPM
+from planning.model.units import RPM, rounded_down
 from planning.tolerances import BINDING_SHARE, SAME_RELATIVE, TINY_SCALE
 from press.backend import math_module
 
@@ -129,13 +129,14 @@ def spans(t: np.ndarray, mask: np.ndarray) -> tuple[tuple[float, float], ...]:
 class Row(NamedTuple):
     """A block of NLP rows ``lo <= expr <= hi`` named ``name``; ``sampled``: the limit holds at the NLP's
     samples only (the dense check may find it exceeded between them: the search then tightens the limit's
-    :attr:`Limit.refined` parameter)."""
+    :attr:`Limit.refined` parameter, or the row's own ``refined`` one)."""
 
     name: str
     expr: Any
     lo: Any
     hi: Any
     sampled: bool = False
+    refined: str | None = None
 
 
 class Extremes(NamedTuple):
@@ -158,10 +159,12 @@ class Transcription:
     ``jerks``: the crank's extremes as the transcription can state them (``jerks`` None: its variable
     bounds hold the jerk); ``lowest_speeds``: expressions whose minimum is the lowest crank speed (None:
     its variable bounds hold it). ``crossings``: ``(omega, |dh/dtheta|)`` where the slide passes the die
-    height outside the draw; ``zone``: the crank speed may peak while the slide is below the die height
-    (rows at every sample there). ``rate``: the NLP of a target rate. ``speed_unit`` [rad/s] and
-    ``length_unit`` [mm]: scales of rows. ``motor_torque`` [N m] and ``motor_speed`` [rad/s] at the
-    samples in a drive NLP, else None. ``param(name)``: a case parameter's symbol.
+    height outside the draw; ``exit_speeds``: the same at the die exit's fixed angles, from theta3 to the
+    crossing the slide rises through (a denser variant's; held at these samples only, refined); ``zone``:
+    the crank speed may peak while the slide is below the die height (rows at every sample there).
+    ``rate``: the NLP of a target rate. ``speed_unit`` [rad/s] and ``length_unit`` [mm]: scales of rows.
+    ``motor_torque`` [N m], ``motor_speed`` [rad/s] and ``crank_torque`` [N m] at the samples in a drive
+    NLP, else None. ``param(name)``: a case parameter's symbol.
     """
 
     theta: Any
@@ -186,6 +189,8 @@ class Transcription:
     param: Callable[[str], Any]
     motor_torque: Any = None
     motor_speed: Any = None
+    crank_torque: Any = None
+    exit_speeds: list[tuple[Any, Any]] = field(default_factory=list)
 
     def outside_draw(self, values: Any) -> Any:
         """The entries of a sample vector before the draw's."""
@@ -356,7 +361,7 @@ class Limit:
         bound = self.draw_speed_bound(draw)
         if bound is None or speed <= bound * (1 + SAME_RELATIVE):
             return None
-        return f"is above the {bound / RPM:.3f} rpm that {self.field} allows"
+        return f"is above the {rounded_down(bound / RPM)} rpm that {self.field} allows"
 
     def draw_speed_bound(self, draw: Draw) -> float | None:
         """The highest constant draw speed [rad/s] this limit allows (None: it sets none)."""

@@ -50,7 +50,7 @@ class DieSpeedLimit(SpeedCap):
             Field(..., title="die speed [mm/s]", description="The slide's highest speed at and below the die height."),
         ),
     }
-    parameters = ("die_speed", "die_height")
+    parameters = ("die_speed", "die_height", "die_exit_speed")
     refined = "die_speed"
     refuses_draw_speed_above_bound = True
 
@@ -89,12 +89,16 @@ class DieSpeedLimit(SpeedCap):
         return [Check.of(self.id, name, value, lim.die_speed_mm_s, self.unit, "max", 0.0)]
 
     def parameter_values(self, case: Any) -> dict[str, float]:
-        return {"die_speed": case.limits.die_speed_mm_s, "die_height": case.limits.die_height_mm}
+        v_die = case.limits.die_speed_mm_s
+        return {"die_speed": v_die, "die_height": case.limits.die_height_mm, "die_exit_speed": v_die}
 
     def rows(self, nlp: Transcription) -> list[Row]:
         v_die = nlp.param("die_speed")
         speeds = sample_vector([slope * omega for omega, slope in nlp.crossings])
         out = [Row("die-height speed", speeds / v_die, -np.inf, 1.0)]
+        if nlp.exit_speeds:  # refined on their own: the crossing's row keeps the limit as it is
+            exits = sample_vector([slope * omega for omega, slope in nlp.exit_speeds])
+            out.append(Row("die exit speed", exits / nlp.param("die_exit_speed"), -np.inf, 1.0, True, "die_exit_speed"))
         if nlp.zone:
             h = nlp.outside_draw(nlp.height)
             v = nlp.outside_draw(nlp.slope) * nlp.outside_draw(nlp.omega)

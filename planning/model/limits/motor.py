@@ -142,22 +142,30 @@ class MotorPeakTorqueLimit(Limit):
         torque: ``T_c / (i eta) + J_m i alpha`` and ``T_c eta / i + J_m i alpha``, with ``T_c`` linear in s and
         alpha (``press.dynamics``, a linkage's links included). Both <= peak is exactly ``T_m <= peak``. The
         forming force is taken on each interval's side of theta2 and BDC."""
-        case = mesh.case
-        d = case.drive_model
-        m = case.machine
-        peak = case.drive.motor.peak_torque_Nm
+        d = mesh.case.drive_model
+        peak = mesh.case.drive.motor.peak_torque_Nm
         n = mesh.dtheta.size
         rows = []
-        ends = ((mesh.theta[:-1] + SAME_ANGLE_RAD, mesh.s), (mesh.theta[1:] - SAME_ANGLE_RAD, mesh.s_next))
-        for theta, speed2 in ends:
-            h, d1, d2, _ = m.jets(theta)
-            d1, d2 = d1 * 1e-3, d2 * 1e-3
-            f_env = forming_force(theta, h, d) + d.F_cb - d.M * GRAVITY
-            J, dJ, weight = link_terms(m.frames(theta), d.links) if d.links else (0.0, 0.0, 0.0)
-            tc = (d.J0 + d.M * d1**2 + J) * mesh.alpha + (d.M * d1 * d2 + 0.5 * dJ) * speed2 - f_env * d1 + weight
+        for tc in crank_torque_at_ends(mesh):
             for form in (tc / (d.i * d.eta) + d.J_m * d.i * mesh.alpha, tc * d.eta / d.i + d.J_m * d.i * mesh.alpha):
                 rows.append((form, np.full(n, -np.inf), np.full(n, peak)))
         return rows
+
+
+def crank_torque_at_ends(mesh: BoundMesh) -> list[Any]:
+    """The crank torque [N m] at the start and at the end of every interval of the bound's mesh, linear in the
+    speed squared there and the interval's acceleration (``press.dynamics``, a linkage's links included); the
+    forming force taken on each interval's side of theta2 and BDC."""
+    case = mesh.case
+    d, m = case.drive_model, case.machine
+    out = []
+    for theta, speed2 in ((mesh.theta[:-1] + SAME_ANGLE_RAD, mesh.s), (mesh.theta[1:] - SAME_ANGLE_RAD, mesh.s_next)):
+        h, d1, d2, _ = m.jets(theta)
+        d1, d2 = d1 * 1e-3, d2 * 1e-3
+        f_env = forming_force(theta, h, d) + d.F_cb - d.M * GRAVITY
+        J, dJ, weight = link_terms(m.frames(theta), d.links) if d.links else (0.0, 0.0, 0.0)
+        out.append((d.J0 + d.M * d1**2 + J) * mesh.alpha + (d.M * d1 * d2 + 0.5 * dJ) * speed2 - f_env * d1 + weight)
+    return out
 
 
 class MotorRMSTorqueLimit(Limit):

@@ -1,7 +1,7 @@
 """The figures: ``motion_vs_time`` and ``motion_vs_angle`` (the slide and the crank, every limit where it
-applies), ``drive`` (with a drive: the torque-speed plane, torque and power) and ``energy`` (with the drive's
-electrical side); drawn from ``result.json``'s data and the trajectory (``pressplan plot`` redraws them
-from those files)."""
+applies), ``drive`` (with a drive: the torque-speed plane, torque and power), ``energy`` (with the drive's
+electrical side) and ``capacity`` (with ``press.capacity``: the tonnage curve, the crank torque); drawn from
+``result.json``'s data and the trajectory (``pressplan plot`` redraws them from those files)."""
 
 from __future__ import annotations
 
@@ -48,7 +48,7 @@ def redraw(folder: Path, plot_format: str = "png") -> dict[str, Writer]:
 OUTPUT = Output(
     "motion_vs_time.*",
     "the figures",
-    ("motion_vs_time.*", "motion_vs_angle.*", "drive.*", "energy.*"),
+    ("motion_vs_time.*", "motion_vs_angle.*", "drive.*", "energy.*", "capacity.*"),
     _writers,
     order=90,
     figure=True,

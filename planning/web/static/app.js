@@ -358,7 +358,7 @@ function render(answer, seq, confirmed) {
   setStatus(`${r.motion_law}, ${r.placement} placement, ${r.status}: every limit holds on the dense ${(r.verification.step_s * 1e3).toFixed(3)} ms grid` +
     (confirmed ? "" : "; confirming against the cold solve…"), confirmed ? "" : "busy");
   $("#objective-line").textContent = r.baseline
-    ? `${r.objective} at ${r.target_spm} SPM: RMS ${(r.drive.rms_motor_torque_Nm / 1e3).toFixed(2)} kN m, energy ${r.drive.supply_energy_kJ.toFixed(1)} kJ/stroke; ` +
+    ? `${r.objective} at ${r.target_spm} SPM: RMS ${(r.drive.rms_motor_torque_Nm / 1e3).toFixed(2)} kN m, energy ${r.energy_kJ.toFixed(1)} kJ/stroke (${r.energy_at === "bus" ? "at the bus" : "at the shaft"}); ` +
       `saving ${r.saving_pct.rms_torque.toFixed(1)} % RMS, ${r.saving_pct.energy.toFixed(1)} % energy` +
       (r.saving_pct.grid_peak !== undefined ? `, ${r.saving_pct.grid_peak.toFixed(1)} % grid peak (${r.baseline.grid_peak_kW.toFixed(0)} → ${r.power.grid_peak_kW.toFixed(0)} kW)` : "") +
       " against waiting"
