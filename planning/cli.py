@@ -172,6 +172,22 @@ def _other_commands(sub) -> None:  # noqa: ANN001 - argparse's sub-parsers
     sv.add_argument(
         "--cases", default="cases", help="folder whose *.yaml the page offers (default: cases, else the project's)"
     )
+    cm = sub.add_parser(
+        "cam",
+        help="the plan as a controller's cam (CSV, CODESYS, TwinCAT, PLCopen XML), proved as the controller runs it",
+        description="Write the plan of a case (solved here) or of an output folder of `pressplan solve` (its "
+        "plan.json) as a cam for a press controller, run it as the controller interpolates it through the dense "
+        "verification, and refuse it (exit 3) when a limit breaks. Prints the proof: the slide's deviation from "
+        "the plan, each limit's margin, the highest master speed that keeps every limit.",
+    )
+    cm.add_argument("source", help="a case file (YAML), or an output folder of `pressplan solve`")
+    _set_option(cm, "replace a dotted case field for this run (a case file only; repeatable)")
+    cm.add_argument("--out", help="output folder (default: the folder given, or out/<case name>)")
+    cm.add_argument("--json", action="store_true", help="print cam_proof.json instead of the proof")
+    from planning.reports.outputs._cam import COMMAND_OPTIONS
+
+    for option in COMMAND_OPTIONS:
+        cm.add_argument(option.flag, **option.kwargs)
     pl = sub.add_parser("plot", help="redraw the figures of a finished output folder (no solve)")
     pl.add_argument("folder", help="output folder of `pressplan solve`")
     pl.add_argument("--format", choices=PLOT_FORMATS, default="png", help="figure format (default png)")
@@ -190,14 +206,14 @@ def _version() -> str:
 def _case_argument(parser: argparse.ArgumentParser) -> None:
     """The case file and ``--set FIELD=VALUE`` (repeatable): a case field replaced for this run."""
     parser.add_argument("case", help="case file (YAML)")
-    parser.add_argument(
-        "--set",
-        action="append",
-        type=_setting,
-        default=[],
-        metavar="FIELD=VALUE",
-        help="replace a dotted case field for this run, e.g. --set limits.crank_jerk_rad_s3=2000 (repeatable)",
+    _set_option(
+        parser, "replace a dotted case field for this run, e.g. --set limits.crank_jerk_rad_s3=2000 (repeatable)"
     )
+
+
+def _set_option(parser: argparse.ArgumentParser, text: str) -> None:
+    """``--set FIELD=VALUE``, repeatable, with its help ``text``."""
+    parser.add_argument("--set", action="append", type=_setting, default=[], metavar="FIELD=VALUE", help=text)
 
 
 def _setting(text: str) -> tuple[str, object]:
@@ -241,12 +257,14 @@ def _exit_code(exc: Exception, case_path: str | None) -> tuple[str, int] | None:
     from planning.model.case import CaseError
     from planning.model.case_file import CaseFileError
     from planning.reports.folder import OutputError
+    from planning.reports.outputs._cam import CamOptionError
+    from planning.reports.plan_file import PlanFileError
     from planning.solver.outcomes import PlanningError
     from planning.sweep import SweepError
 
     if isinstance(exc, CommandError):
         return str(exc), exc.code
-    if isinstance(exc, (CaseFileError, OutputError, SweepError)):
+    if isinstance(exc, (CaseFileError, OutputError, SweepError, CamOptionError, PlanFileError)):
         return str(exc), EXIT_INPUT
     if isinstance(exc, CaseError):  # a case changed by an option (--law) that no longer holds together
         return exc.line(case_path), EXIT_INPUT
@@ -271,13 +289,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         "plot": _plot,
         "serve": _serve,
         "new": _new,
+        "cam": _cam,
     }[args.command]
     try:
-        if args.command in ("plot", "serve", "new"):
+        if args.command in ("plot", "serve", "new", "cam"):
             return command(args)
         return command(_read(args), args)
     except Exception as exc:
-        known = _exit_code(exc, getattr(args, "case", None))
+        known = _exit_code(exc, getattr(args, "case", None) or getattr(args, "source", None))
         if known is None:
             raise
         return _fail(*known)
@@ -338,7 +357,49 @@ def _solve(case, args) -> int:
         _load_plots()  # here, where a signal is held through the import, not inside the writers
     written = Written(solution, case, {o.kwargs["dest"]: getattr(args, o.kwargs["dest"]) for o in output_options()})
     writers = writers_of(written, figures)
-    return _write_and_report(out, writers, written.result, summary_text(written.result), args, owned_files())
+    text = summary_text(written.result)
+    if written.cam is not None:
+        from planning.reports.cam_export import proof_lines
+
+        text += "\n\n" + "\n".join(proof_lines(written.cam))
+    return _write_and_report(out, writers, written.result, text, args, owned_files())
+
+
+def _cam(args) -> int:
+    """``pressplan cam``: the cam of a case's plan (solved here) or of a folder's ``plan.json``, proved."""
+    from planning.reports.cam_export import proof_dict, proof_lines
+    from planning.reports.outputs import Written, writers_of
+    from planning.reports.outputs._cam import OPTIONS
+
+    source = Path(args.source)
+    if source.is_dir():
+        from planning.reports.plan_file import read_plan
+
+        if args.set:
+            raise CommandError("--set: changes a case file's fields; a folder's plan is solved already")
+        case, solution = read_plan(source)
+        out = Path(args.out) if args.out else source
+    else:
+        from planning.solver.optimize import solve
+
+        args.case = args.source
+        case = _read(args)
+        out = _output_folder(case, args, ())
+        solution = solve(case)
+    options = {o.kwargs["dest"]: getattr(args, o.kwargs["dest"]) for o in OPTIONS}
+    written = Written(solution, case, options)
+    owned = tuple(pattern for output in _cam_outputs() for pattern in output.files)
+    writers = {name: w for name, w in writers_of(written, figures=False).items() if name in owned}
+    args.case = None if source.is_dir() else args.source
+    data, text = proof_dict(written.cam), "\n".join(proof_lines(written.cam))
+    return _write_and_report(out, writers, data, text, args, owned)
+
+
+def _cam_outputs() -> tuple:
+    """The cam outputs of the registry (their files are the ones ``pressplan cam`` owns)."""
+    from planning.reports.outputs import OUTPUTS
+
+    return tuple(o for o in OUTPUTS if o.name.startswith("cam_") and o.name != "cam_table.csv")
 
 
 def _with_law(case, args):  # noqa: ANN001, ANN202 - a Case and the parsed arguments

@@ -33,6 +33,13 @@ ENERGY_REL_TOL = 1e-6  # relative to the larger of the forming work and integral
 KNOT_PROBE_S = 1e-7  # [s] the continuity check looks this far either side of a knot (at most a quarter of
 # the shorter neighbouring segment): short enough that the O(eps^2) remainder is round-off
 ROUND_OFF_REL = 1e-14  # relative: round-off of a closed-form value near the largest term (a few ulps)
+CAM_POINT_GAP_DEG = 1e-2  # [deg of the master] two of a law's segment ends this close are one point of a cam:
+# a quintic over a shorter interval loses its higher coefficients to round-off (they divide by its width^5)
+CAM_END_TOL = 1e-9  # [deg, deg/deg, deg/deg^2] a cam's position, slope and curvature continue across its end
+# (360 deg back to 0) within this: the points there are the plan's at TDC, equal up to round-off
+CAM_TIGHTEST_MM = 1e-9  # [mm] the tightest slide tolerance a cam's points are placed to (the slide's height
+# carries about 1e-13 mm of round-off)
+SPEED_RESOLUTION = 1e-4  # relative: a cam's highest master speed is found to this share (0.01 %)
 BINDING_SHARE = 1e-4  # relative: a check within this share of its limit binds (the reports' binding list,
 # where a limit binds in the stage table)
 CROSSED_PCT = 1e-4  # [%] a verified motion this far above the certified upper bound is within the

@@ -45,7 +45,7 @@ BLOCK = re.compile(
     r"(?P=indent)<!-- output:end -->",
     re.S,
 )
-OUT_OPTION = ("solve", "laws", "compare")  # commands that write a folder: sent to the scratch folder
+OUT_OPTION = ("solve", "laws", "compare", "cam")  # commands that write a folder: sent to the scratch folder
 DROPPED = re.compile(r"^\s+(wrote |solver: )")  # lines that depend on the run, not on the case
 NUMBER = re.compile(r"[-+]?\d+(?:\.\d+)?")
 

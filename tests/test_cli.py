@@ -148,7 +148,7 @@ def test_solver_success_but_failed_verification_is_exit_3(monkeypatch, tmp_path,
     import planning.solver.verify as verify
     from planning.solver.verify import Check, Evaluation, Verification
 
-    def failing(dense, uniform):  # every evaluation of every plan (the search's, the fallbacks') fails
+    def failing(dense, uniform, cam=False):  # every evaluation of every plan (the search's, the fallbacks') fails
         check = Check("|slider acceleration|", 9999.0, 3500.0, "mm/s^2", "max", False, "slider_accel")
         return Evaluation(dense, uniform, Verification((check,), 1e-3, 10))
 

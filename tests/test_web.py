@@ -760,3 +760,30 @@ def test_a_drive_added_and_its_forming_force_edited_in_the_page(page) -> None:
     wait_rendered(page, before)
     assert page.locator("#spm").inner_text() == "12.123" and page.locator("#drive-line").inner_text() == ""
     assert page.locator("#add-drive").count() == 1
+
+
+@browser
+def test_the_cam_is_proved_on_the_page_and_downloaded_as_the_cli_writes_it(page, tmp_path: Path) -> None:
+    """The cam panel, with the mouse: a CODESYS cam of the confirmed plan is proved (its numbers beside the
+    button) and downloaded byte for byte as `pressplan cam` writes it; a linear table too coarse is refused with
+    the limit it breaks, and nothing can be downloaded."""
+    page.select_option("#cam-target", "codesys")
+    page.locator("#cam-prove").click()
+    page.wait_for_function("document.querySelector('#cam-proof').textContent.includes('points')", timeout=60_000)
+    proof = page.locator("#cam-proof").inner_text()
+    assert proof.startswith("cam_codesys.st: 19 points") and "every limit holds up to 100.00 %" in proof
+    with page.expect_download(timeout=60_000) as info:
+        page.locator("#cam-download").click()
+    info.value.save_as(tmp_path / "page.st")
+    out = tmp_path / "cli"
+    command = [sys.executable, "-m", "planning.cli", "cam", str(PUBLISHED), "--cam", "codesys", "--out", str(out)]
+    cli = subprocess.run(command)
+    assert cli.returncode == 0
+    assert (tmp_path / "page.st").read_bytes() == (out / "cam_codesys.st").read_bytes()
+    page.select_option("#cam-target", "csv")
+    page.select_option("#cam-interpolation", "linear")
+    page.locator("#cam-count").fill("3600")
+    page.locator("#cam-prove").click()
+    page.wait_for_function("document.querySelector('#cam-message').textContent !== ''", timeout=60_000)
+    assert "|slider acceleration|" in page.locator("#cam-message").inner_text()
+    assert page.locator("#cam-download").is_disabled()

@@ -3,15 +3,16 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
 from planning.model.case import Placement
 from planning.model.cycle import CycleParameters, cycle_segments
-from planning.model.free_profile import FreeProfileParameters
+from planning.model.free_profile import FreeProfileParameters, Layout
 from planning.model.laws import DEFAULT_LAW
-from planning.model.profile import Profile, advance_segment, knot_states, split_segment
+from planning.model.profile import Profile, Segment, advance_segment, knot_states, split_segment
 from planning.tolerances import KNOT_TIME_S, TINY
 
 
@@ -113,6 +114,32 @@ def _numeric(seg):
         dv=float(seg.dv),
         span=None if seg.span is None else float(seg.span),
     )
+
+
+def plan_of(
+    case: Any, values: dict[str, float], placement: Placement, info: SolverInfo, layout: Layout | None = None
+) -> Plan:
+    """The plan of an NLP's variable ``values`` (inside units) for ``case``: a law's cycle of halves rotated to
+    start at TDC, or (``layout``: the optimal law's phases) the free profile propagated from theta3 through
+    its segments' closed forms, then the draw; with where theta1 and theta4 fall (``structure``) and the values
+    themselves (a neighbour's warm start; ``plan.json``'s plan)."""
+    th1, th2, th3, th4 = (float(a) for a in case.key_angles)
+    if layout is None:
+        params: PlanParameters = params_from_numbers(values, th2, th3, case.planner.motion_law)
+        profile = profile_from_tdc(params)
+    else:
+        durations, jerks = [], []
+        for phase, n in layout:
+            durations += [values[f"{phase}_step"]] * n
+            jerks += [values[f"{phase}_jerk_{k}"] for k in range(n)]
+        params = FreeProfileParameters(tuple(durations), tuple(jerks), values["draw_speed"], th2, th3, layout=layout)
+        segs = [seg for seg in params.segments() if seg.duration > 0]
+        draw = Segment("draw:constant", params.draw_time, 0.0, 0.0)
+        profile = rotate_to_tdc([*segs, draw], th3, params.draw_speed)
+    plan = Plan(params, profile, (th1, th2, th3, th4), placement, info, motion_law=params.motion_law)
+    t = plan.key_times()
+    structure = {"closing": plan.segment_at(float(t[0])), "opening": plan.segment_at(float(t[3]))}
+    return replace(plan, structure=structure, nlp_values=dict(values))
 
 
 def params_from_numbers(values: dict[str, float], theta2: float, theta3: float, law: str) -> CycleParameters:

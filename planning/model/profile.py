@@ -229,9 +229,14 @@ def sample_times(period: float, knot_times: np.ndarray, max_step: float = MAX_ST
 def max_abs_jerk(prof: Profile) -> float:
     """Largest |crank jerk| [rad/s^3] of a profile: at a segment's ends where the jerk is linear; for a
     shaped segment the closed-form peak of its whole half (``|dv| / D^2`` times the shape's peak), which a
-    piece cut off at TDC may not reach, so the figure errs on the safe side."""
+    piece cut off at TDC may not reach, so the figure errs on the safe side; a cam's fifth power
+    (``planning.model.cam.FifthPower``) gives its segment's exact peak."""
     out = 0.0
     for s in prof.segments:
+        exact = getattr(s.shape, "segment_peak_jerk", None)  # a shape that knows its segment's peak exactly
+        if exact is not None:
+            out = max(out, exact(s))
+            continue
         j = max(abs(float(s.j0)), abs(float(s.j0) + float(s.j1) * float(s.duration)))
         if s.shape is not None:
             j += abs(float(s.dv)) / float(s.span) ** 2 * float(s.shape.peak_jerk())

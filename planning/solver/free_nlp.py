@@ -19,7 +19,6 @@ meaning: theta1 and theta4 are where the phases meet.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from functools import cache, partial
 from typing import Any
 
@@ -27,11 +26,10 @@ import casadi as ca
 import numpy as np
 
 from planning.model.case import Case
-from planning.model.free_profile import PHASES, FreeProfileParameters, Layout
-from planning.model.laws.optimal import OptimalLaw
+from planning.model.free_profile import PHASES, Layout
 from planning.model.limits.base import Extremes, Transcription
-from planning.model.plan import Plan, SolverInfo, rotate_to_tdc
-from planning.model.profile import Segment, advance
+from planning.model.plan import Plan, SolverInfo, plan_of
+from planning.model.profile import advance
 from planning.solver.ipopt import NLPSolver
 from planning.solver.nlp import (
     CYCLE_OPTIONS,
@@ -135,21 +133,10 @@ def variable_bounds(
 def make_plan(
     case: Case, values: dict[str, float], placement: str, info: SolverInfo, phases: Layout = PHASES
 ) -> Plan:
-    """The plan of the NLP's values: the profile propagated from theta3 through the segments' closed forms
-    (the NLP's knot states agree with it to its tolerance), then the draw."""
-    th1, th2, th3, th4 = (float(a) for a in case.key_angles)
-    durations, jerks = [], []
-    for phase, n in phases:
-        durations += [values[f"{phase}_step"]] * n
-        jerks += [values[f"{phase}_jerk_{k}"] for k in range(n)]
-    params = FreeProfileParameters(tuple(durations), tuple(jerks), values["draw_speed"], th2, th3, layout=phases)
-    segs = [seg for seg in params.segments() if seg.duration > 0]
-    draw = Segment("draw:constant", params.draw_time, 0.0, 0.0)
-    profile = rotate_to_tdc([*segs, draw], th3, params.draw_speed)
-    plan = Plan(params, profile, (th1, th2, th3, th4), "free", info, motion_law=OptimalLaw.name)
-    t = plan.key_times()
-    structure = {"closing": plan.segment_at(float(t[0])), "opening": plan.segment_at(float(t[3]))}
-    return replace(plan, structure=structure, nlp_values=dict(values))
+    """The plan of the NLP's values (``planning.model.plan.plan_of``): the profile propagated from theta3
+    through the segments' closed forms (the NLP's knot states agree with it to its tolerance), then the draw;
+    the optimal law's placement is free."""
+    return plan_of(case, values, "free", info, phases)
 
 
 def _shooting(phases: Layout, physical: ca.MX, v: dict, unit: dict, q: dict, index: dict) -> dict[str, Any]:

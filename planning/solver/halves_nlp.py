@@ -39,7 +39,7 @@ the die zone at every sample (a plan at a target rate may peak in speed there) a
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from functools import cache, partial
 
 import casadi as ca
@@ -49,7 +49,7 @@ from planning.model.case import RPM, Case, Placement
 from planning.model.cycle import HALVES, CycleParameters, cycle_segments
 from planning.model.laws import get_law
 from planning.model.limits.base import Extremes, Transcription
-from planning.model.plan import Plan, SolverInfo, params_from_numbers, profile_from_tdc
+from planning.model.plan import Plan, SolverInfo, plan_of
 from planning.model.profile import Segment, advance_segment, knot_states, shape_part
 from planning.solver.ipopt import NLPSolver
 from planning.solver.nlp import (
@@ -179,16 +179,9 @@ def peak_variable_bounds(
 
 
 def make_plan(case: Case, values: dict[str, float], placement: Placement, info: SolverInfo) -> Plan:
-    """The plan of the NLP's variable ``values``: the law's cycle rotated to start at TDC, with where theta1
-    and theta4 fall (``structure``) and the values themselves (a neighbour's warm start)."""
-    th = case.key_angles
-    law = case.planner.motion_law
-    params = params_from_numbers(values, float(th[1]), float(th[2]), law)
-    profile = profile_from_tdc(params)
-    plan = Plan(params, profile, tuple(float(a) for a in th), placement, info, motion_law=law)
-    t = plan.key_times()
-    structure = {"closing": plan.segment_at(float(t[0])), "opening": plan.segment_at(float(t[3]))}
-    return replace(plan, structure=structure, nlp_values=dict(values))
+    """The plan of the NLP's variable ``values`` (``planning.model.plan.plan_of``): the law's cycle rotated to
+    start at TDC, with where theta1 and theta4 fall and the values themselves."""
+    return plan_of(case, values, placement, info)
 
 
 def _angle_at(t: ca.SX, starts: list, states: list, segs: list[Segment]) -> tuple[ca.SX, ca.SX]:

@@ -28,7 +28,6 @@ import hashlib
 import itertools
 import json
 import math
-import tempfile
 import threading
 from collections import OrderedDict
 from dataclasses import dataclass, field
@@ -46,6 +45,20 @@ from planning.model.laws import LAWS
 from planning.model.outcome import Outcome
 from planning.reports.new_case import MECHANISMS, drive_template
 from planning.reports.outputs import downloads
+from planning.reports.outputs._cam import CamOptionError
+from planning.solver.outcomes import PlanningError
+from planning.web.cams import (
+    CAM_FILES,
+    CamCache,
+    CamRequestError,
+    attachment,
+    cam_file,
+    cam_meta,
+    options_of,
+    proof_answer,
+    proved,
+    refused,
+)
 
 STATIC = Path(__file__).resolve().parent / "static"
 MAX_REQUEST_BYTES = 2 * MAX_BYTES  # a case as JSON, with the page's own fields
@@ -66,6 +79,7 @@ class Session:
     newest: int = -1
     plan: Any = None
     shown: tuple[str, Any, Any] | None = None  # the last confirmed plan: (its case's key, case, solution)
+    cam: CamCache = field(default_factory=CamCache)  # the last cam proved of it (planning.web.cams)
 
 
 class FairQueue:
@@ -238,6 +252,7 @@ def _page_routes(app: Flask, shared: _Shared) -> None:
                 "drive_templates": {kind: drive_template(kind) for kind in MECHANISMS},
                 "outcomes": {outcome.name: outcome.value for outcome in Outcome},
                 "downloads": [{"name": o.name, "title": o.title} for o in downloads()],
+                "cam": cam_meta(),
             }
         )
 
@@ -314,12 +329,34 @@ def _solve_routes(app: Flask, shared: _Shared) -> None:
         if name == "case.yaml":
             text = yaml.safe_dump(_data(case), sort_keys=False, allow_unicode=True)
             return Response(text, mimetype="application/x-yaml", headers=_attachment(f"{case.name}.yaml"))
-        if name not in {o.name for o in downloads()}:
+        if name not in {o.name for o in downloads()} and name not in CAM_FILES:
             return jsonify({"status": Outcome.BAD_INPUT, "message": f"{name}: no such file"}), 404
         session = shared.sessions.get(str(body.get("session", ""))[:80])
         with session.guard:
             shown = session.shown
+        if name in CAM_FILES:
+            return _cam_response(session, shown, body, label, name)
         return files_of(shown, body.get("case"), label, name)
+
+    @app.post("/api/cam")
+    def cam_endpoint() -> Response:
+        body = _body()
+        session = shared.sessions.get(str(body.get("session", ""))[:80])
+        with session.guard:
+            shown = session.shown
+        return _cam_response(session, shown, body, _label_of(body), None)
+
+
+def _cam_response(session: Session, shown: Any, body: dict[str, Any], label: str, name: str | None) -> Any:
+    """The cam of the confirmed plan on screen: its proof (``name`` None) or its file ``name``."""
+    if shown is None or shown[0] != case_key(body.get("case")):
+        message = f"{label}: no confirmed plan of this case on the page yet; wait for the plan, then prove its cam"
+        return jsonify({"status": Outcome.BAD_INPUT, "message": message}), 409
+    try:
+        written = proved(session.cam, shown, options_of(body))
+    except (CamRequestError, CamOptionError, PlanningError) as exc:  # the options, or a limit the cam breaks
+        return refused(exc)
+    return proof_answer(written) if name is None else cam_file(written, name)
 
 
 def _answer(shared: _Shared, session: Session, body: dict[str, Any], seq: int) -> dict[str, Any]:
@@ -605,12 +642,7 @@ def files_of(shown: tuple[str, Any, Any] | None, data: Any, label: str, name: st
     write = writer_of(solution, case, name)
     if write is None:
         return jsonify({"status": Outcome.BAD_INPUT, "message": f"{name}: this plan has no such file"}), 404
-    with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / name
-        write(path)
-        blob = path.read_bytes()
-    mime = "application/json" if name.endswith(".json") else "text/csv"
-    return Response(blob, mimetype=mime, headers=_attachment(name))
+    return attachment(write, name)
 
 
 def _rounded(column: np.ndarray) -> list[float]:

@@ -322,8 +322,9 @@ class Limit:
     loosens the parameter once by the room), ``motor`` (a limit of the motor: a plan of the NLP without
     the drive's rows cannot be trusted to keep it), ``uses_drive`` (its rows need the drive's torque at
     the samples: drive NLPs only), ``refuses_draw_speed_above_bound`` (a draw speed given in the case above
-    the limit's bound is an error in the case, exit 2, rather than an infeasible plan). Every method has a
-    default that does nothing."""
+    the limit's bound is an error in the case, exit 2, rather than an infeasible plan), ``goal`` (a goal of
+    the plan, such as a target rate, rather than a limit of the press or the process: a cam, which an
+    operator may run faster or slower, is not held to it). Every method has a default that does nothing."""
 
     id: ClassVar[str]
     name: ClassVar[str]
@@ -340,6 +341,7 @@ class Limit:
     motor: ClassVar[bool] = False
     uses_drive: ClassVar[bool] = False
     refuses_draw_speed_above_bound: ClassVar[bool] = False
+    goal: ClassVar[bool] = False
 
     def applies(self, case: Any) -> bool:
         """Whether ``case`` sets this limit (an NLP of the case has its rows only then)."""

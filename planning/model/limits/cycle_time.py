@@ -21,6 +21,7 @@ class CycleTimeLimit(Limit):
     field = "planner.target_spm"
     order = 110
     parameters = ("target_period",)
+    goal = True
 
     def applies(self, case: Any) -> bool:
         return case.drive is not None

@@ -48,8 +48,7 @@ class DrawStartSpeedLimit(Limit):
 
     def check(self, dense: Dense) -> list[Check]:
         plan, case = dense.plan, dense.case
-        w2 = float(plan.parameters.draw_speed)
-        v2 = abs(float(case.machine.slider(plan.key_angles[1], w2)[1]))
+        v2 = abs(float(dense.key_motion["v"][1]))  # at theta2's time: the draw speed times h' there
         limit = case.limits.draw_start_speed_mm_s
         check = Check.of(self.id, self.name, v2, limit, self.unit, "max", LIMIT_REL_TOL * limit)
         t2 = dense.key_times[1:2]

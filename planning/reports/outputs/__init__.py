@@ -23,20 +23,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from planning.reports.arguments import Option
+
 if TYPE_CHECKING:  # the registry is read by the CLI's parser: nothing heavy (the solver, CasADi) loads here
     from planning.model.case import Case
     from planning.solver.solution import Solution
 
 Writer = Callable[[Path], None]  # writes one file at the path it is given
-
-
-@dataclass(frozen=True)
-class Option:
-    """A command-line option of ``pressplan solve`` that an output takes: ``flag`` and argparse's keyword
-    arguments (``dest`` is the name the output reads in :attr:`Written.options`)."""
-
-    flag: str
-    kwargs: dict[str, Any]
 
 
 @dataclass(frozen=True)
@@ -78,6 +71,14 @@ class Written:
         from planning.reports.report import trajectory
 
         return trajectory(self.solution, self.case)
+
+    @cached_property
+    def cam(self) -> Any:
+        """The proved cam the ``--cam`` options ask for (``planning.reports.cam_export.CamExport``; None
+        without ``--cam``): made once for every cam output."""
+        from planning.reports.cam_export import export_of
+
+        return export_of(self)
 
     @cached_property
     def published(self) -> np.ndarray | None:
@@ -153,13 +154,13 @@ def writers_of(written: Written, figures: bool = True) -> dict[str, Writer]:
     return writers
 
 
-def writer_of(solution: Solution, case: Case, name: str) -> Writer | None:
-    """The writer of the one file ``name`` (an output the page offers), built alone; None when the solution
-    has no such file."""
-    output = BY_NAME.get(name)
+def writer_of(solution: Solution, case: Case, name: str, options: dict[str, Any] | None = None) -> Writer | None:
+    """The writer of the one file ``name`` (an output the page offers), built alone (``options``: the outputs'
+    options by dest); None when the solution has no such file."""
+    output = next((o for o in OUTPUTS if o.name == name or name in o.files), None)
     if output is None:
         return None
-    return output.writers(Written(solution, case)).get(name)
+    return output.writers(Written(solution, case, dict(options or {}))).get(name)
 
 
 def write_outputs(

@@ -346,6 +346,7 @@ function setStatus(text, kind) {
 
 // ---- rendering --------------------------------------------------------------------------------------
 function render(answer, seq, confirmed) {
+  if (state.meta.cam && seq !== state.shownSeq) camReset(); // the cam proved was of another plan
   if (seq !== state.shownSeq) { $("#bound-share").textContent = "…"; $("#bound-share").title = "the bound follows once the edits rest"; } // never the last plan's bracket
   state.last = answer;
   state.shownSeq = seq;
@@ -649,11 +650,12 @@ async function upload(file) {
   showLoaded(answer);
 }
 
-async function download(name) {
+async function download(name, cam) {
   const data = caseFromForm();
-  const response = await post("/api/download/" + name, { session: SESSION, label: state.label, case: data });
+  const response = await post("/api/download/" + name, { session: SESSION, label: state.label, case: data, cam });
   if (!response.ok) {
     const answer = await readJson(Promise.resolve(response));
+    if (cam) { $("#cam-message").textContent = answer.message; return; }
     clearMessages();
     showMessage(answer.field || "", answer.message);
     return;
@@ -665,6 +667,48 @@ async function download(name) {
   document.body.appendChild(a);
   a.click();
   setTimeout(() => { URL.revokeObjectURL(a.href); a.remove(); }, 1000);
+}
+
+// ---- the cam for the controller: the confirmed plan on screen, proved as its controller runs it -------------
+function camOptions() {
+  return { target: $("#cam-target").value, interpolation: $("#cam-interpolation").value, count: $("#cam-count").value.trim() || "auto" };
+}
+
+function camReset() { // a new plan or other options: the cam must be proved again before it is downloaded
+  $("#cam-download").disabled = true;
+  $("#cam-proof").textContent = "";
+  $("#cam-proof").className = "muted";
+  $("#cam-message").textContent = "";
+  state.camFile = null;
+}
+
+function camInterpolations() { // the interpolations the target takes
+  const select = $("#cam-interpolation"), before = select.value;
+  select.innerHTML = "";
+  for (const name of state.meta.cam.targets[$("#cam-target").value]) select.add(new Option(name, name));
+  if ([...select.options].some((o) => o.value === before)) select.value = before;
+}
+
+async function camProve() {
+  camReset();
+  $("#cam-proof").textContent = "proving…";
+  const answer = await readJson(post("/api/cam", { session: SESSION, label: state.label, case: caseFromForm(), cam: camOptions() }));
+  $("#cam-proof").textContent = "";
+  if (answer.status !== OUTCOME.VERIFIED) { $("#cam-message").textContent = answer.message; return; }
+  const speed = answer.highest_speed_pct.toFixed(2);
+  $("#cam-proof").textContent = `${answer.file}: ${answer.points} points, slide within ${answer.deviation_mm.toPrecision(3)} mm of the plan; ` +
+    `every limit holds up to ${speed} % of the plan's master speed` + (answer.above.length ? ` (above: ${answer.above.join(", ")})` : "");
+  $("#cam-proof").title = answer.lines.join("\n");
+  $("#cam-proof").className = "held";
+  state.camFile = answer.file;
+  $("#cam-download").disabled = false;
+}
+
+// a field's help, in the one fixed box above the form (shown on focus or hover; the form never moves)
+function showHelp(event) {
+  const row = event.target.closest && event.target.closest(".field");
+  const help = row && row.querySelector(".help");
+  if (help) $("#field-help").textContent = help.textContent;
 }
 
 async function start() {
@@ -687,6 +731,13 @@ async function start() {
   $("#pin").addEventListener("click", () => { if (state.last) { state.pinned = state.last; render(state.last, state.shownSeq, document.body.dataset.state !== "confirming"); } });
   $("#unpin").addEventListener("click", () => { state.pinned = null; if (state.last) render(state.last, state.shownSeq, document.body.dataset.state !== "confirming"); });
   $("#download-case").addEventListener("click", () => download("case.yaml"));
+  for (const kind of ["focusin", "mouseover"]) $("#case-form").addEventListener(kind, showHelp);
+  for (const target of Object.keys(state.meta.cam.targets)) $("#cam-target").add(new Option(target, target));
+  camInterpolations();
+  $("#cam-target").addEventListener("change", () => { camInterpolations(); camReset(); });
+  for (const id of ["#cam-interpolation", "#cam-count"]) $(id).addEventListener("change", camReset);
+  $("#cam-prove").addEventListener("click", camProve);
+  $("#cam-download").addEventListener("click", () => { if (state.camFile) download(state.camFile, camOptions()); });
   for (const b of document.querySelectorAll("[data-download]")) b.addEventListener("click", () => download(b.dataset.download));
   if (state.meta.initial) { select.value = state.meta.initial; loadCase(state.meta.initial); }
   else setStatus("no case: upload one", "failed");
