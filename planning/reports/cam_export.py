@@ -199,4 +199,5 @@ def refusal(export: CamExport) -> str:
         if p.highest_speed > 0
         else "it holds at no master speed searched"
     )
-    return f"{cam} breaks {broken} at {100 * p.speed:.2f} % of the plan's master speed; {where}; more points or poly5"
+    remedy = "more points" if p.cam.interpolation is Interpolation.POLY5 else "more points, or poly5"
+    return f"{cam} breaks {broken} at {100 * p.speed:.2f} % of the plan's master speed; {where}; {remedy}"
