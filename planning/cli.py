@@ -172,6 +172,7 @@ def _other_commands(sub) -> None:  # noqa: ANN001 - argparse's sub-parsers
     sv.add_argument(
         "--cases", default="cases", help="folder whose *.yaml the page offers (default: cases, else the project's)"
     )
+    sv.add_argument("--recipes", help="folder where the page saves cases under a name and reopens them (made)")
     cm = sub.add_parser(
         "cam",
         help="the plan as a controller's cam (CSV, CODESYS, TwinCAT, PLCopen XML), proved as the controller runs it",
@@ -733,8 +734,22 @@ def _serve(args) -> int:
         cases = Path(__file__).resolve().parents[1] / "cases"
     if case_path is None and (cases / SERVE_FIRST).is_file():  # the published case first, as in the README
         case_path = (cases / SERVE_FIRST).resolve()
-    serve(case_path, args.host, args.port, cases if cases.is_dir() else None)
+    serve(case_path, args.host, args.port, cases if cases.is_dir() else None, _recipes_folder(args.recipes))
     return EXIT_OK
+
+
+def _recipes_folder(name: str | None) -> Path | None:
+    """The recipes' folder of ``serve --recipes``, made when missing; a file of that name is bad input."""
+    if name is None:
+        return None
+    folder = Path(name)
+    if folder.exists() and not folder.is_dir():
+        raise CommandError(f"--recipes {name}: not a folder")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise CommandError(f"--recipes {name}: cannot be made ({exc.strerror})") from None
+    return folder.resolve()
 
 
 class _Terminated(BaseException):

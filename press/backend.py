@@ -16,6 +16,10 @@ import numpy as np
 def math_module(*values: Any) -> Any:
     """``casadi`` when any of ``values`` is a CasADi SX/MX/DM, else ``numpy`` (sin, cos, sqrt, exp, log)."""
     ca = sys.modules.get("casadi")
-    if ca is not None and any(isinstance(v, (ca.SX, ca.MX, ca.DM)) for v in values):
-        return ca
-    return np
+    if ca is None:
+        return np
+    try:
+        symbols = (ca.SX, ca.MX, ca.DM)
+    except AttributeError:  # CasADi half imported by another thread (the server's): no value is its symbol yet
+        return np
+    return ca if any(isinstance(v, symbols) for v in values) else np

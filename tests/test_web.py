@@ -8,7 +8,6 @@ from __future__ import annotations
 import copy
 import io
 import json
-import os
 import subprocess
 import sys
 from pathlib import Path
@@ -23,24 +22,12 @@ from planning.reports.report import result_dict
 from planning.solver.optimize import solve
 from planning.solver.upper_bound import upper_bound
 
-from .web_page import (
-    ARTIFACTS,
-    CASES,
-    chromium_profile,
-    edit,
-    missing_browser,
-    pick_case,
-    running_server,
-    wait_rendered,
-)
+from .web_page import ARTIFACTS, CASES, browser_mark, chromium_profile, edit, pick_case, running_server, wait_rendered
 
 PUBLISHED = CASES / "wang2023-side-panel.yaml"
 LABEL = "cases/wang2023-side-panel.yaml"
 
-why = missing_browser()
-if why is not None and os.environ.get("CI") == "true":
-    raise RuntimeError(f"the browser tests must run in CI: {why}")
-browser = pytest.mark.skipif(why is not None, reason=why or "")
+browser = browser_mark()
 
 
 @pytest.fixture(scope="module")
@@ -160,15 +147,19 @@ def test_a_bad_value_shows_the_cli_line_next_to_the_field(page, tmp_path: Path) 
 
 @browser
 def test_an_upload_too_large_shows_the_servers_message(page) -> None:
-    """An upload over the request limit is answered 413 as JSON, and the page shows its message (it used to
-    parse an HTML page and show nothing)."""
+    """A file larger than a case may be: the page says so with the CLI's words for a case file (it used to
+    parse an HTML page and show nothing, then logged the server's 413 in the console), and keeps its case."""
+    from planning.model.case_file import MAX_BYTES, too_large_words
     from planning.web.server import MAX_REQUEST_BYTES
 
+    logged = []
+    page.on("console", lambda message: logged.append(message.text))
     page.set_input_files(
         "#upload", files=[{"name": "huge.yaml", "mimeType": "text/yaml", "buffer": b"#" * (MAX_REQUEST_BYTES + 10)}]
     )
     page.wait_for_function("document.querySelector('#load-message').textContent.length > 0", timeout=10_000)
-    assert "larger than" in page.locator("#load-message").inner_text()
+    assert page.locator("#load-message").inner_text() == f"huge.yaml: {too_large_words()}"
+    assert str(MAX_BYTES) in too_large_words() and logged == []
     assert page.locator("#case-label").inner_text() == LABEL  # the case on screen is still the one shown
 
 
@@ -335,11 +326,12 @@ def test_uploads_and_requests_are_checked() -> None:
     client = create_app(CASES).test_client()
     big = b"name: x\n" + b"#" * 300_000
     answer = client.post("/api/upload", data={"file": (io.BytesIO(big), "big.yaml")})
-    assert answer.status_code in (400, 413)
+    assert answer.status_code == 200 and answer.get_json()["status"] == Outcome.BAD_INPUT  # a refused case: an answer
+    assert answer.get_json()["message"] == "big.yaml: too large for a case file (more than 256000 bytes)"
     ok = client.post("/api/upload", data={"file": (io.BytesIO(PUBLISHED.read_bytes()), "mine.yaml")})
     assert "case" in ok.get_json() and ok.get_json()["label"] == "mine.yaml"
     bad = client.post("/api/upload", data={"file": (io.BytesIO(b"a: [1,\n"), "broken.yaml")})
-    assert bad.status_code == 400 and bad.get_json()["message"].startswith("broken.yaml: YAML syntax error")
+    assert bad.status_code == 200 and bad.get_json()["message"].startswith("broken.yaml: YAML syntax error")
     assert client.get("/api/case/..%2Fpyproject.toml").status_code == 404  # names are looked up, never paths
     assert client.get("/static/../pyproject.toml").status_code == 404
     too_much = client.post("/api/solve", data=b"{" + b" " * MAX_REQUEST_BYTES + b"}", content_type="application/json")
@@ -408,7 +400,7 @@ def test_every_error_is_json_with_a_4xx() -> None:
         answer = client.post(url, data=b"[1, 2]", content_type="application/json")
         assert answer.status_code == 400 and "not a JSON object" in answer.get_json()["message"], url
     too_big = client.post("/api/solve", data=b"{" + b" " * MAX_REQUEST_BYTES + b"}", content_type="application/json")
-    assert too_big.status_code == 413 and "larger than" in too_big.get_json()["message"]
+    assert too_big.status_code == 413 and "too large" in too_big.get_json()["message"]
     upload = client.post("/api/upload", data={"file": (io.BytesIO(b"#" * (MAX_REQUEST_BYTES + 10)), "big.yaml")})
     assert upload.status_code == 413 and upload.get_json()["status"] == Outcome.BAD_INPUT
     assert client.get("/api/nothing").status_code == 404 and client.get("/api/nothing").get_json()["message"]
@@ -466,6 +458,8 @@ def test_the_charts_draw_every_limit_of_the_case_and_the_robot_window(page) -> N
     """On the servo-limited case (crank speed, acceleration and jerk bind) every limit of the case is a
     named line on the charts (the figures' own lines), the robot window is shaded with its time written."""
     pick_case(page, "side-panel-servo-limits.yaml")
+    for box in page.locator("[data-panel]").all():  # every panel shown (four are by default)
+        box.check()
     names = page.evaluate("document.getElementById('motion-chart').data.map((t) => t.name)")
     case = read_case(CASES / "side-panel-servo-limits.yaml")
     set_limits = [f"limits.{k}" for k, v in case.limits.model_dump().items() if v is not None]
@@ -474,7 +468,7 @@ def test_the_charts_draw_every_limit_of_the_case_and_the_robot_window(page) -> N
     assert not missing, missing
     assert "crank jerk [rad/s³]" in names
     notes = page.evaluate("document.getElementById('motion-chart').layout.annotations.map((a) => a.text)")
-    assert any(n.startswith("robot window θ4 → θ1: 2.000 s") for n in notes), notes
+    assert any("window" in n and "2.000 s" in n for n in notes), notes  # shortened where the shading is narrow
     assert "draw θ2 → θ3" in notes  # the draw's shading named too
     screenshot(page, "web-limits")
 
@@ -515,6 +509,7 @@ def test_the_page_shows_the_clis_summary_lines(page, tmp_path: Path, capsys) -> 
 
     assert main(["solve", str(PUBLISHED), "--no-plots", "--out", str(tmp_path / "o")]) == 0
     cli = [line for line in capsys.readouterr().out.splitlines() if not line.lstrip().startswith(("solver:", "wrote"))]
+    page.locator("#summary").locator("xpath=..").locator("summary").click()  # the summary unfolded
     shown = [line for line in page.locator("#summary").inner_text().splitlines() if "solver:" not in line]
     assert shown == cli
 
@@ -577,7 +572,7 @@ def test_sigterm_stops_the_server_and_every_process_it_started(tmp_path: Path) -
         [sys.executable, "-m", "planning.cli", "serve", "--port", str(port)],
         cwd=root,
         stdout=subprocess.PIPE,
-        stderr=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
         text=True,
     )
     try:
@@ -597,6 +592,7 @@ def test_sigterm_stops_the_server_and_every_process_it_started(tmp_path: Path) -
         assert workers  # the bound ran in a worker process
         server.send_signal(signal.SIGTERM)
         assert server.wait(timeout=20) == 143
+        assert "leaked semaphore" not in server.stderr.read()  # the bound's pool closed, queues and all
         deadline = time.time() + 10
         while time.time() < deadline and any(Path(f"/proc/{p}").exists() for p in workers):
             time.sleep(0.1)

@@ -38,14 +38,25 @@ def missing_browser() -> str | None:
     return None
 
 
+def browser_mark():  # noqa: ANN201 - a pytest mark
+    """The mark of a browser test: skipped with the reason where no browser can run, except under CI
+    (``CI=true``), where a missing browser is an error."""
+    import pytest
+
+    why = missing_browser()
+    if why is not None and os.environ.get("CI") == "true":
+        raise RuntimeError(f"the browser tests must run in CI: {why}")
+    return pytest.mark.skipif(why is not None, reason=why or "")
+
+
 @contextmanager
-def running_server(initial: Path | None = None) -> Iterator[str]:
-    """The app on a free port of 127.0.0.1 in a thread; yields its address."""
+def running_server(initial: Path | None = None, recipes: Path | None = None) -> Iterator[str]:
+    """The app on a free port of 127.0.0.1 in a thread (with a recipes folder when given); yields its address."""
     from werkzeug.serving import make_server
 
     from planning.web.server import create_app
 
-    server = make_server("127.0.0.1", 0, create_app(CASES, initial), threaded=True)
+    server = make_server("127.0.0.1", 0, create_app(CASES, initial, recipes_dir=recipes), threaded=True)
     thread = threading.Thread(target=server.serve_forever, daemon=True)
     thread.start()
     try:

@@ -155,6 +155,11 @@ def _check_duplicate_keys(node: yaml.Node, label: str, path: tuple[str, ...] = (
             _check_duplicate_keys(item, label, (*path, str(i)))
 
 
+def too_large_words() -> str:
+    """The one wording of a case file's size limit."""
+    return f"too large for a case file (more than {MAX_BYTES} bytes)"
+
+
 def case_from_data(data: Any, label: str = "<case>") -> Case:
     """Validate already-parsed data (a mapping) as a case; ``label`` names it in error messages."""
     if data is None:
@@ -185,7 +190,7 @@ def _read_text(path: Path) -> str:
     except OSError as exc:
         raise CaseFileError(f"{path}: cannot be read ({exc.strerror})") from None
     if len(blob) > MAX_BYTES:
-        raise CaseFileError(f"{path}: too large for a case file ({len(blob)} bytes > {MAX_BYTES})")
+        raise CaseFileError(f"{path}: {too_large_words()} ({len(blob)} bytes)")
     if b"\x00" in blob:
         raise CaseFileError(f"{path}: binary file, expected a YAML case")
     try:

@@ -11,6 +11,7 @@ from planning.model.case import KEY_POINT_NAMES, RPM, Case
 from planning.model.limits import draw_speed_bounds, limits_of
 from planning.model.limits.base import Check, Draw
 from planning.model.limits.robot_window import radians_hint
+from planning.model.plausibility import warnings_of
 from planning.model.units import rounded_down
 from planning.tolerances import SAME_SCORE
 
@@ -65,23 +66,10 @@ def check_case(case: Case) -> dict[str, Any]:
 
 
 def warnings(case: Case) -> list[str]:
-    """What a press engineer should know before solving: key angles that look like radians; a draw end
-    (theta3) where the slide is still below the die height, so the return cannot speed up until it has
-    left the die zone."""
+    """What a press engineer should know before solving: key angles that look like radians, and the entries
+    that are valid but probably not meant (``planning.model.plausibility``), each naming its field."""
     hint = radians_hint(case)
-    out = [hint.removeprefix("; ")] if hint else []
-    m = case.machine
-    die = case.limits.die_height_mm
-    th3 = case.key_angles[2]
-    h3 = float(m.height(th3))
-    if h3 < die and die < m.stroke:
-        leave = float(m.angles_at_height(die)[1])
-        out.append(
-            f"the slide is still below limits.die_height_mm = {die:g} mm at theta3 = "
-            f"{math.degrees(th3):.2f} deg ({h3:.2f} mm); it leaves the die zone at {math.degrees(leave):.2f} deg. "
-            "Until then the die-height speed limit holds the return back, whatever the motion law"
-        )
-    return out
+    return ([hint.removeprefix("; ")] if hint else []) + [f"{w.field}: {w.message}" for w in warnings_of(case)]
 
 
 def _check(check: Check) -> dict[str, Any]:

@@ -37,10 +37,10 @@ from typing import Any
 import numpy as np
 import yaml
 from flask import Flask, Response, jsonify, request, send_file
-from werkzeug.exceptions import HTTPException
+from werkzeug.exceptions import HTTPException, RequestEntityTooLarge
 
 from planning.model.case import OBJECTIVES, Case
-from planning.model.case_file import MAX_BYTES, CaseFileError, case_from_data, load_yaml, read_case
+from planning.model.case_file import MAX_BYTES, CaseFileError, case_from_data, load_yaml, read_case, too_large_words
 from planning.model.laws import LAWS
 from planning.model.outcome import Outcome
 from planning.reports.new_case import MECHANISMS, drive_template
@@ -173,13 +173,18 @@ class _Shared:
     bounds: OrderedDict = field(default_factory=OrderedDict)
     bounds_lock: threading.Lock = field(default_factory=threading.Lock)
     bound_pool: Any = None
+    recipes: Path | None = None
 
 
 def create_app(
-    cases_dir: Path | None = None, initial: Path | None = None, allowed_hosts: tuple[str, ...] = ()
+    cases_dir: Path | None = None,
+    initial: Path | None = None,
+    allowed_hosts: tuple[str, ...] = (),
+    recipes_dir: Path | None = None,
 ) -> Flask:
     """The application: the page, its static files and the JSON endpoints. Requests are answered for the
-    host names of this machine and ``allowed_hosts`` (the address ``serve`` binds) only."""
+    host names of this machine and ``allowed_hosts`` (the address ``serve`` binds) only. With
+    ``recipes_dir`` the page saves cases under a name there and reopens them (``planning.web.recipes``)."""
     import logging
 
     logging.getLogger("werkzeug").setLevel(logging.WARNING)  # no line per request
@@ -188,13 +193,14 @@ def create_app(
     offered = case_files(cases_dir)
     if initial is not None:
         offered = {initial.name: initial, **{k: v for k, v in offered.items() if k != initial.name}}
-    shared = _Shared(offered, bound_pool=_BoundPool())
+    shared = _Shared(offered, bound_pool=_BoundPool(), recipes=recipes_dir)
     app.extensions["pressplan_bound_pool"] = shared.bound_pool  # serve() stops its worker on the way out
     app.extensions["pressplan_sessions"] = shared.sessions  # the tests hold a session's lock to see superseding
     app.extensions["pressplan_queues"] = shared.queues  # the edits' fast answers never wait behind cold solves
     _guard(app, allowed_hosts)
     _page_routes(app, shared)
     _solve_routes(app, shared)
+    _recipe_routes(app, shared)
     return app
 
 
@@ -207,7 +213,7 @@ def _guard(app: Flask, allowed_hosts: tuple[str, ...]) -> None:
     def host_allowed() -> tuple[Response, int] | None:
         """Only the names of this machine and the address it binds: a page on another site that rebinds
         its own name to 127.0.0.1 (DNS rebinding) reaches nothing."""
-        host = _hostname(request.host or "")
+        host = _hostname(request.host or "").lower()  # host names are case-insensitive
         if everyone or host in allowed:
             return None
         return jsonify({"status": Outcome.BAD_INPUT, "message": f"host {host!r} is not served here"}), 403
@@ -219,7 +225,7 @@ def _guard(app: Flask, allowed_hosts: tuple[str, ...]) -> None:
     @app.errorhandler(HTTPException)
     def http_error(exc: HTTPException) -> Response:
         """Every HTTP error as JSON the page reads (413 too large, 404 no such route, 405 wrong method)."""
-        messages = {413: f"the request is larger than {MAX_REQUEST_BYTES} bytes"}
+        messages = {413: too_large_request()}
         message = messages.get(exc.code, f"{exc.code} {exc.name}")
         return jsonify({"status": Outcome.BAD_INPUT, "message": message}), exc.code
 
@@ -236,7 +242,7 @@ def _page_routes(app: Flask, shared: _Shared) -> None:
     def static_file(name: str) -> Response:
         files = {"app.js": STATIC / "app.js", "style.css": STATIC / "style.css", "plotly.min.js": _plotly_js()}
         if name not in files:
-            return Response("not found", status=404)
+            return jsonify({"status": Outcome.BAD_INPUT, "message": f"/static/{name}: no such file"}), 404
         return send_file(files[name], max_age=3600)
 
     @app.get("/api/meta")
@@ -253,6 +259,8 @@ def _page_routes(app: Flask, shared: _Shared) -> None:
                 "outcomes": {outcome.name: outcome.value for outcome in Outcome},
                 "downloads": [{"name": o.name, "title": o.title} for o in downloads()],
                 "cam": cam_meta(),
+                "max_case_bytes": MAX_BYTES,
+                "recipes": shared.recipes is not None,
             }
         )
 
@@ -271,20 +279,61 @@ def _page_routes(app: Flask, shared: _Shared) -> None:
     def upload() -> Response:
         file = request.files.get("file")
         if file is None:
-            return jsonify({"status": Outcome.BAD_INPUT, "message": "no file sent"}), 400
+            return jsonify({"status": Outcome.BAD_INPUT, "message": "the request sends no file"}), 400
         name = Path(file.filename or "upload.yaml").name[:100]
         blob = file.read(MAX_BYTES + 1)
-        try:
+        try:  # a case refused is an answer (its outcome and line), not an HTTP error: the page shows it
             if len(blob) > MAX_BYTES:
-                raise CaseFileError(f"{name}: too large for a case file (> {MAX_BYTES} bytes)")
+                raise CaseFileError(f"{name}: {too_large_words()}")
             try:
                 text = blob.decode("utf-8")
             except UnicodeDecodeError:
                 raise CaseFileError(f"{name}: not UTF-8 text, expected a YAML case") from None
             case = case_from_data(load_yaml(text, name), name)
         except CaseFileError as exc:
-            return jsonify({"status": Outcome.BAD_INPUT, "message": str(exc), "field": exc.field}), 400
+            return jsonify({"status": Outcome.BAD_INPUT, "message": str(exc), "field": exc.field})
         return jsonify({"label": name, "case": _data(case)})
+
+
+def _recipe_routes(app: Flask, shared: _Shared) -> None:
+    """The recipes of the folder the server is given: listed, saved under a name, reopened."""
+    from planning.web.recipes import RecipeError, recipe_names, recipe_path, save_recipe
+
+    def folder() -> Path:
+        if shared.recipes is None:
+            raise BadRequest("no recipes here: start the server with --recipes DIR")
+        return shared.recipes
+
+    @app.get("/api/recipes")
+    def recipes() -> Response:
+        return jsonify({"names": recipe_names(folder())})
+
+    @app.get("/api/recipe/<name>")
+    def open_recipe(name: str) -> Response:
+        try:
+            path = recipe_path(folder(), name)
+        except RecipeError as exc:
+            return jsonify({"status": Outcome.BAD_INPUT, "message": str(exc), "field": "recipe"}), 400
+        if not path.is_file():
+            return jsonify({"status": Outcome.BAD_INPUT, "message": f"{name}: no such recipe here"}), 404
+        try:
+            case = read_case(path)
+        except CaseFileError as exc:
+            return jsonify({"status": Outcome.BAD_INPUT, "message": str(exc), "field": exc.field}), 400
+        return jsonify({"label": f"recipe {name}", "case": _data(case)})
+
+    @app.post("/api/recipe/<name>")
+    def keep_recipe(name: str) -> Response:
+        body = _body()
+        try:
+            path = recipe_path(folder(), name)
+            case = case_from_data(body.get("case"), _label_of(body))
+        except RecipeError as exc:
+            return jsonify({"status": Outcome.BAD_INPUT, "message": str(exc), "field": "recipe"}), 400
+        except CaseFileError as exc:  # only a case that reads is kept
+            return jsonify({"status": Outcome.BAD_INPUT, "message": str(exc), "field": exc.field}), 400
+        save_recipe(folder(), name, _data(case))
+        return jsonify({"saved": path.stem, "names": recipe_names(folder())})
 
 
 def _solve_routes(app: Flask, shared: _Shared) -> None:
@@ -394,6 +443,11 @@ def _hostname(host: str) -> str:
     return host.rsplit(":", 1)[0] if host.count(":") == 1 else host
 
 
+def too_large_request() -> str:
+    """The one wording of the request's size limit (a case file's own limit, and the page's fields with it)."""
+    return f"the request is too large (more than {MAX_REQUEST_BYTES} bytes; {too_large_words()})"
+
+
 class BadRequest(Exception):
     """A request the page never sends: answered 400 with ``{"status": Outcome.BAD_INPUT, "message": ...}``."""
 
@@ -405,7 +459,13 @@ def _body() -> dict[str, Any]:
     """The request's JSON object; :class:`BadRequest` when it is not one (malformed, nested deeper than
     :data:`MAX_JSON_DEPTH`, another type). The depth is counted before parsing, so no input reaches the
     parser's recursion limit."""
-    raw = request.get_data(cache=True)
+    if request.content_length is None:  # chunked: at most one byte past the limit, then refused (the
+        # request's own stream stops at the limit without a word: the server's decoded input is read)
+        raw = request.environ["wsgi.input"].read(MAX_REQUEST_BYTES + 1)
+        if len(raw) > MAX_REQUEST_BYTES:
+            raise RequestEntityTooLarge()
+    else:
+        raw = request.get_data(cache=True)
     if _depth(raw) > MAX_JSON_DEPTH:
         raise BadRequest(f"the request nests deeper than {MAX_JSON_DEPTH} levels")
     try:
@@ -414,6 +474,8 @@ def _body() -> dict[str, Any]:
         raise BadRequest("the request's body is not JSON") from None
     if not isinstance(body, dict):
         raise BadRequest("the request's body is not a JSON object")
+    if "case" not in body:  # every POST of the page sends the case it shows
+        raise BadRequest("the request sends no case")
     return body
 
 
@@ -520,7 +582,7 @@ def solve_case(data: Any, label: str, session: Session, confirm: bool = True) ->
             solution = solve(case, neighbour=session.plan)  # the cold solve's answer or better
     except PlanningError as exc:
         limit = exc.limit if isinstance(exc, Infeasible) else None
-        return {"status": exc.outcome, "message": f"{label}: {exc}", "field": limit, "confirmed": True}
+        return {"status": exc.outcome, "message": f"{label}: {exc}", "field": limit, "confirmed": True, **_warned(case)}
     session.plan = solution.plan
     if confirmed:  # the downloads' plan: the last confirmed one (a fast answer on screen is confirmed next)
         with session.guard:
@@ -536,7 +598,36 @@ def solve_case(data: Any, label: str, session: Session, confirm: bool = True) ->
         "limit_lines": chart_limits(result, columns),
         "summary": summary_text(result),
         "mechanism": mechanism_drawing(case),
+        "utilisation": utilisation(solution.verification, case),
+        **_warned(case),
     }
+
+
+def utilisation(verification: Any, case: Case) -> list[dict[str, Any]]:
+    """Each limit's use by the plan, in the case's order of limits: the check's value over its limit (a lower
+    limit: the limit over the value), whether it binds."""
+    from planning.model.limits import limits_of
+    from planning.solver.verify import field_of_check
+
+    order = {limit.id: k for k, limit in enumerate(limits_of(case))}
+    rows = []
+    for check in verification.checks:
+        if check.id not in order or check.kind not in ("max", "min"):
+            continue
+        value, limit = abs(check.value), abs(check.limit)
+        share = value / limit if check.kind == "max" else (limit / value if value else math.inf)
+        if limit == 0 or not math.isfinite(share):
+            continue
+        field = field_of_check(check.id)
+        rows.append({"id": check.id, "name": check.name, "field": field, "pct": 100 * share, "binds": check.binds})
+    return sorted(rows, key=lambda row: order[row["id"]])
+
+
+def _warned(case: Case) -> dict[str, Any]:
+    """The case's plausibility warnings (``planning.model.plausibility``): shown beside their fields."""
+    from planning.model.plausibility import warnings_of
+
+    return {"warnings": [{"field": w.field, "message": w.message} for w in warnings_of(case)]}
 
 
 def chart_limits(result: dict[str, Any], columns: dict[str, np.ndarray]) -> list[dict[str, Any]]:
@@ -601,11 +692,11 @@ class _BoundPool:
         if pool is None:
             return
         processes = list(getattr(pool, "_processes", {}).values())  # the executor keeps no public handle
-        pool.shutdown(wait=False, cancel_futures=True)
         for process in processes:
             process.terminate()
         for process in processes:
             process.join(timeout=5)
+        pool.shutdown(wait=True, cancel_futures=True)  # its queues closed: no semaphore left to the tracker
 
 
 def bound_of(data: Any, label: str) -> dict[str, Any]:
@@ -661,9 +752,11 @@ def _finite(value: Any) -> Any:
     return value
 
 
-def serve(case_path: Path | None, host: str, port: int, cases_dir: Path | None) -> None:
+def serve(
+    case_path: Path | None, host: str, port: int, cases_dir: Path | None, recipes_dir: Path | None = None
+) -> None:
     """Run the server until Ctrl-C; prints the address."""
-    app = create_app(cases_dir, case_path, (host,))
+    app = create_app(cases_dir, case_path, (host,), recipes_dir)
     print(f"pressplan: serving on http://{host}:{port}/ (Ctrl-C stops)", flush=True)
     try:
         app.run(host=host, port=port, threaded=True, use_reloader=False)

@@ -137,7 +137,11 @@ function forceTable(spec, value) {
   const msg = document.createElement("span");
   msg.className = "msg";
   msg.dataset.for = spec.name;
+  const warn = document.createElement("span");
+  warn.className = "warn";
+  warn.dataset.warnFor = spec.name;
   row.appendChild(msg);
+  row.appendChild(warn);
   return row;
 }
 
@@ -190,7 +194,11 @@ function fieldRow(spec, value) {
   const msg = document.createElement("span");
   msg.className = "msg";
   msg.dataset.for = spec.name;
+  const warn = document.createElement("span");
+  warn.className = "warn";
+  warn.dataset.warnFor = spec.name;
   row.appendChild(msg);
+  row.appendChild(warn);
   if (spec.kind !== "label") input.addEventListener("change", onEdit);
   if (spec.kind !== "choice" && spec.kind !== "label") input.addEventListener("input", typed); // typing: solve once the keys rest (a change solves at once)
   return row;
@@ -208,10 +216,12 @@ function formValue(input) {
   return numberOf(text);
 }
 
-// a number as typed, or the text itself (the server then says what is wrong with it)
+// a number as typed, or the text itself (the server then says what is wrong with it); a decimal comma, as
+// many locales write it, is a decimal point ("1,8" is 1.8; a comma with a point as well is left to the server)
 function numberOf(text) {
-  const number = Number(text);
-  return Number.isFinite(number) && /^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$/.test(text) ? number : text;
+  const typed = /^[-+]?\d*,\d+([eE][-+]?\d+)?$/.test(text) ? text.replace(",", ".") : text;
+  const number = Number(typed);
+  return Number.isFinite(number) && /^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$/.test(typed) ? number : text;
 }
 
 function caseFromForm() {
@@ -257,6 +267,7 @@ async function askSolve(data, seq, confirm) {
 async function solveNow() {
   const data = caseFromForm();
   state.solvedJson = JSON.stringify(data);
+  remember(state.solvedJson);
   const seq = ++state.seq;
   setStatus("solving…", "busy");
   document.body.dataset.state = "solving";
@@ -273,6 +284,7 @@ async function solveNow() {
     if (answer.status === OUTCOME.INTERRUPTED || seq < state.seq) return;
   }
   clearMessages();
+  showWarnings(answer.warnings || []);
   if (answer.status === OUTCOME.VERIFIED) {
     state.data = data;
     render(answer, seq, true);
@@ -283,6 +295,7 @@ async function solveNow() {
     // keep the last good plan of this case on screen; say what is wrong, next to the field when one is named
     const field = answer.field || "";
     showMessage(field, answer.message);
+    showBadge(answer.message);
     setStatus(answer.message + (field && answer.status !== OUTCOME.BAD_INPUT ? ` (the limit: ${field})` : ""), "failed");
     document.body.dataset.state = answer.status;
     document.body.dataset.rendered = String(seq);
@@ -298,11 +311,13 @@ function clearPlan() {
   Plotly.purge("motion-chart");
   for (const id of ["drive-chart", "energy-chart"]) { Plotly.purge(id); $("#" + id).style.display = "none"; }
   $("#mechanism-svg").innerHTML = "";
+  $("#utilisation").innerHTML = "";
+  showBadge("no plan");
 }
 
 async function requestBound(data, seq) {
   const answer = await readJson(post("/api/bound", { label: state.label, case: data }));
-  if (seq !== state.shownSeq) return;
+  if (seq !== state.shownSeq || !state.last) return; // another plan, or none, on screen since it was asked
   const spm = state.last.result.spm;
   // the share of the certified upper bound (no motion within the limits makes more: never above 100 %)
   const bounded = answer.upper_spm != null; // else the answer says why there is no bound
@@ -311,6 +326,37 @@ async function requestBound(data, seq) {
     ? `bracket: ${spm.toFixed(3)} strokes/min verified … ${answer.upper_spm.toFixed(3)} certified upper bound (no motion within the limits makes more` +
       (answer.left_out.length ? `; left out: ${answer.left_out.join(", ")}` : "") + `); the grid bound ${answer.spm.toFixed(3)}`
     : answer.message;
+}
+
+// valid entries that look unintended (planning.model.plausibility): beside their fields, never refusals
+function showWarnings(warnings) {
+  for (const el of document.querySelectorAll(".warn[data-warn-for]")) el.textContent = "";
+  for (const w of warnings) {
+    const el = document.querySelector(`.warn[data-warn-for="${CSS.escape(w.field)}"]`);
+    if (el) el.textContent = "⚠ " + w.message;
+  }
+}
+
+// which plan is on screen: the live one, or the last good one while the form's case has none (``refused``)
+function showBadge(refused) {
+  const badge = $("#plan-badge");
+  const r = state.last ? state.last.result : null;
+  const stale = Boolean(refused);
+  document.body.dataset.stale = stale && r ? "1" : "";
+  for (const b of document.querySelectorAll("#downloads button, #cam-prove")) {
+    b.disabled = stale;
+    b.title = stale ? "the case on the form has no plan: fix the value marked, then download" : "";
+  }
+  if (!r) { badge.textContent = refused ? "no plan" : ""; badge.className = "badge none"; return; }
+  const what = `${r.motion_law}, ${r.placement} placement, ${r.spm.toFixed(3)} strokes/min`;
+  if (stale) {
+    badge.textContent = `showing the last good plan (${what}): the case on the form has none`;
+    badge.className = "badge stale";
+  } else {
+    const confirmed = document.body.dataset.state !== "confirming";
+    badge.textContent = `live plan: ${what}, ` + (confirmed ? "confirmed" : "fast answer, confirming…");
+    badge.className = "badge " + (confirmed ? "live" : "busy");
+  }
 }
 
 function clearMessages() {
@@ -393,13 +439,95 @@ function render(answer, seq, confirmed) {
     tr.innerHTML = `<td>the cycle</td><td colspan="5"></td><td class="binds">${r.binding_over_cycle.join(", ")}</td>`;
     stages.appendChild(tr);
   }
+  drawUtilisation(answer.utilisation || []);
+  document.body.dataset.state = confirmed ? "ready" : "confirming";
+  showBadge(null); // before the charts: the chart takes the room the lines above it leave
+  showWarnings(answer.warnings || []);
   drawCharts();
   drawMechanism();
   // the edit-to-chart benchmark reads them: the first chart of an edit, and the confirmed one
   if (!confirmed || window.firstRenderedSeq !== seq) { window.firstRenderedAt = performance.now(); window.firstRenderedSeq = seq; }
   window.renderedAt = performance.now();
-  document.body.dataset.state = confirmed ? "ready" : "confirming";
   document.body.dataset.rendered = String(seq);
+}
+
+// each limit's use by the plan as a bar, in the case's order of limits; the binding ones marked
+function drawUtilisation(rows) {
+  const box = $("#utilisation");
+  box.innerHTML = "";
+  for (const row of rows) {
+    const line = document.createElement("div");
+    line.className = row.binds ? "binds" : "";
+    line.dataset.limit = row.field || row.id;
+    const pct = Math.min(row.pct, 100);
+    line.innerHTML = `<span class="name"></span><span class="bar"><span style="width:${pct.toFixed(1)}%"></span></span><span class="pct">${row.pct.toFixed(row.pct >= 99.95 ? 0 : 1)} %</span>`;
+    const name = line.querySelector(".name");
+    name.textContent = row.name;
+    name.title = `${row.field || row.id}: ${row.pct.toFixed(3)} % of the limit` + (row.binds ? " (binds)" : "");
+    box.appendChild(line);
+  }
+}
+
+// ---- undo and redo: the cases sent to the server, in order (a case loaded starts a new history) ---------
+const HISTORY_LENGTH = 50;
+const history = { cases: [], at: -1, moving: false };
+
+function remember(json) {
+  if (history.moving) { history.moving = false; return; } // an undo or redo solves a case already in the list
+  if (history.cases[history.at] === json) return;
+  history.cases = history.cases.slice(0, history.at + 1);
+  history.cases.push(json);
+  if (history.cases.length > HISTORY_LENGTH) history.cases.shift();
+  history.at = history.cases.length - 1;
+  historyButtons();
+}
+
+function forgetHistory() {
+  history.cases = [];
+  history.at = -1;
+  historyButtons();
+}
+
+function historyButtons() {
+  $("#undo").disabled = history.at <= 0;
+  $("#redo").disabled = history.at >= history.cases.length - 1;
+}
+
+function moveInHistory(step) {
+  const at = history.at + step;
+  if (at < 0 || at >= history.cases.length) return;
+  clearTimeout(editTimer);
+  history.at = at;
+  history.moving = true;
+  historyButtons();
+  state.data = JSON.parse(history.cases[at]);
+  buildForm(state.data);
+  solveNow();
+}
+
+// ---- recipes: cases kept under a name in the server's recipes folder (serve --recipes DIR) -------------
+async function listRecipes(selected) {
+  const answer = await readJson(fetch("/api/recipes"));
+  const select = $("#recipe-select");
+  select.innerHTML = "";
+  select.add(new Option(answer.names && answer.names.length ? "open…" : "none saved", ""));
+  for (const name of answer.names || []) select.add(new Option(name, name));
+  select.value = selected || "";
+}
+
+async function saveRecipe() {
+  const name = $("#recipe-name").value.trim();
+  const answer = await readJson(post("/api/recipe/" + encodeURIComponent(name), { label: state.label, case: caseFromForm() }));
+  if (answer.saved == null) { $("#load-message").textContent = answer.message; return; }
+  $("#load-message").textContent = `saved as recipe ${answer.saved}`;
+  await listRecipes(answer.saved);
+}
+
+async function openRecipe(name) {
+  if (!name) return;
+  const answer = await readJson(fetch("/api/recipe/" + encodeURIComponent(name)));
+  showLoaded(answer);
+  if (answer.case != null) { $("#recipe-name").value = name; $("#case-select").value = ""; }
 }
 
 function xOf(curves) {
@@ -408,7 +536,35 @@ function xOf(curves) {
 
 // the robot's window theta4 -> TDC -> theta1 and the draw theta2 -> theta3 shaded, the key points dotted,
 // the window's time written on it (the figures of `pressplan solve` show the same)
-function cycleShapes(r, x, axis) {
+// the motion chart's panels, one quantity each (its own axis, its zero where the data crosses it); the user
+// picks which (the page fits a laptop's screen with the default four)
+const PANELS = [
+  { key: "slider_height_mm", title: "slide height [mm]", color: "#1f77b4", on: true },
+  { key: "crank_speed_rpm", title: "crank speed [rpm]", color: "#d62728", on: true },
+  { key: "crank_accel_rad_s2", title: "crank accel [rad/s²]", color: "#9467bd", on: false },
+  { key: "crank_jerk_rad_s3", title: "crank jerk [rad/s³]", color: "#8c564b", on: false },
+  { key: "slider_speed_mm_s", title: "slide speed [mm/s]", color: "#2ca02c", on: true },
+  { key: "slider_accel_mm_s2", title: "slide accel [mm/s²]", color: "#ff7f0e", on: true },
+];
+const TRACE_NAMES = { slider_height_mm: "slide height [mm]", crank_speed_rpm: "crank speed [rpm]", crank_accel_rad_s2: "crank acceleration [rad/s²]", crank_jerk_rad_s3: "crank jerk [rad/s³]", slider_speed_mm_s: "slide speed [mm/s]", slider_accel_mm_s2: "slide acceleration [mm/s²]" };
+const OFF_SCALE = 3; // a limit beyond this many times the curve's own extent is written, not drawn to scale
+const LABEL_PX = 6.5; // about a chart label's character width [px], to leave out a label where it would not fit
+
+function buildPanels() {
+  const box = $("#panels");
+  for (const panel of PANELS) {
+    const label = document.createElement("label");
+    label.innerHTML = `<input type="checkbox" data-panel="${panel.key}"${panel.on ? " checked" : ""}> ${panel.title.split(" [")[0]}`;
+    box.appendChild(label);
+  }
+  box.addEventListener("change", () => { if (state.last) drawCharts(); });
+}
+
+function pickedPanels() {
+  return PANELS.filter((p) => document.querySelector(`[data-panel="${p.key}"]`).checked);
+}
+
+function cycleShapes(r, x, axis, width) {
   const at = (name) => { const k = r.key_points.find((p) => p.name === name); return axis === "time" ? k.time_s : k.angle_deg; };
   const rect = (x0, x1, fillcolor) => ({ type: "rect", xref: "x", yref: "paper", x0, x1, y0: 0, y1: 1, fillcolor, opacity: 0.6, line: { width: 0 }, layer: "below" });
   const shapes = [rect(at("opening"), x[x.length - 1], WINDOW_COLOUR), rect(x[0], at("closing"), WINDOW_COLOUR), rect(at("draw_start"), at("draw_end"), DRAW_COLOUR)];
@@ -416,23 +572,32 @@ function cycleShapes(r, x, axis) {
     const kx = axis === "time" ? k.time_s : k.angle_deg;
     shapes.push({ type: "line", xref: "x", yref: "paper", x0: kx, x1: kx, y0: 0, y1: 1, line: { dash: "dot", width: 1, color: "#555" } });
   }
+  // the window's and the draw's names, each inside its own shading, left out where it would not fit
+  const span = x[x.length - 1] - x[0], px = (a, b) => (Math.abs(b - a) / span) * width;
   const window = `robot window θ4 → θ1: ${r.transfer_window_s.toFixed(3)} s (≥ ${r.process.transfer_time_s} s)`;
-  const annotations = [
-    { xref: "x", yref: "paper", x: x[0], y: 1.0, xanchor: "left", yanchor: "bottom", text: window, showarrow: false, font: { size: 11, color: "#1f4e79" } },
-    // the shaded stages named on the chart: the draw (green) beside the robot's window (blue)
-    { xref: "x", yref: "paper", x: (at("draw_start") + at("draw_end")) / 2, y: 1.0, xanchor: "center", yanchor: "bottom", text: "draw θ2 → θ3", showarrow: false, font: { size: 11, color: "#3b6e22" } },
-  ];
+  const before = px(x[0], at("closing")), after = px(at("opening"), x[x.length - 1]);
+  const draw = "draw θ2 → θ3";
+  const annotations = [];
+  const windowText = window.length * LABEL_PX < Math.max(before, after) ? window : `window ${r.transfer_window_s.toFixed(3)} s`;
+  annotations.push(before >= after
+    ? { xref: "x", yref: "paper", x: x[0], y: 1.0, xanchor: "left", yanchor: "bottom", text: windowText, showarrow: false, font: { size: 11, color: "#1f4e79" } }
+    : { xref: "x", yref: "paper", x: x[x.length - 1], y: 1.0, xanchor: "right", yanchor: "bottom", text: windowText, showarrow: false, font: { size: 11, color: "#1f4e79" } });
+  if (draw.length * LABEL_PX < px(at("draw_start"), at("draw_end")) + 20) {
+    annotations.push({ xref: "x", yref: "paper", x: (at("draw_start") + at("draw_end")) / 2, y: 1.0, xanchor: "center", yanchor: "bottom", text: draw, showarrow: false, font: { size: 11, color: "#3b6e22" } });
+  }
   return { shapes, annotations };
 }
 
-// each limit of the case on the chart of the quantity it bounds, dashed where it applies (the server's
-// `limit_lines`, the figures' own), named by its case field in the legend
-const LIMIT_AXES = { slider_height_mm: "y", crank_speed_rpm: "y2", crank_accel_rad_s2: "y3", crank_jerk_rad_s3: "y6", slider_speed_mm_s: "y4", slider_accel_mm_s2: "y5" };
-function limitTraces(lines, x, axis) {
+// each limit of the case on the panel of the quantity it bounds, dashed where it applies (the server's
+// `limit_lines`, the figures' own), named by its case field; a limit far off the curve's scale is written on
+// the panel instead of squashing the curve
+function limitTraces(lines, x, axis, axes) {
   const traces = [];
   for (const line of lines || []) {
+    const yaxis = axes[line.quantity];
+    if (!yaxis) continue; // its panel is not shown
     const style = { dash: "dash", width: 1.2, color: line.colour };
-    const common = { yaxis: LIMIT_AXES[line.quantity], name: line.label, legendgroup: line.field, hoverinfo: "name" };
+    const common = { yaxis, name: line.label, legendgroup: line.field, hoverinfo: "name" };
     if (line.point) {
       const px = axis === "time" ? line.at.time : line.at.angle;
       traces.push({ ...common, x: [px, px], y: [line.upper[0], line.lower ? line.lower[0] : line.upper[0]], mode: "markers", marker: { symbol: "line-ew-open", size: 16, color: style.color, line: { width: 3 } } });
@@ -444,46 +609,75 @@ function limitTraces(lines, x, axis) {
   return traces;
 }
 
+function extent(values) {
+  let lo = Infinity, hi = -Infinity;
+  for (const v of values) if (v != null && Number.isFinite(v)) { if (v < lo) lo = v; if (v > hi) hi = v; }
+  return [lo, hi];
+}
+
+// a panel's range: its curve's, with the limits that lie within OFF_SCALE of its extent; the others named
+function panelRange(values, lines) {
+  let [lo, hi] = extent(values);
+  const size = Math.max(hi - lo, Math.abs(hi), Math.abs(lo), 1e-9);
+  const off = [];
+  for (const line of lines) {
+    const [llo, lhi] = extent([...(line.upper || []), ...(line.lower || [])]);
+    if (!Number.isFinite(llo)) continue;
+    if (Math.max(Math.abs(llo), Math.abs(lhi)) > OFF_SCALE * size) { off.push(line); continue; }
+    lo = Math.min(lo, llo); hi = Math.max(hi, lhi);
+  }
+  if (lo > 0 && lo < 0.25 * hi) lo = 0; // a positive curve near zero: from zero
+  const pad = 0.08 * Math.max(hi - lo, 1e-9);
+  return { range: [lo - pad, hi + pad], off };
+}
+
+function chartHeight() {
+  const chart = $("#motion-chart");
+  const top = chart.getBoundingClientRect().top - $("#result-panel").getBoundingClientRect().top;
+  const room = $("#result-panel").clientHeight - top - 8;
+  return Math.max(260, Math.min(room, 900));
+}
+
 function drawCharts() {
   const ans = state.last;
   const r = ans.result, c = ans.curves, axis = $("#x-axis").value;
   const x = xOf(c);
-  const traces = [
-    { x, y: c.slider_height_mm, name: "slide height [mm]", yaxis: "y", line: { color: "#1f77b4" } },
-    { x, y: c.crank_speed_rpm, name: "crank speed [rpm]", yaxis: "y2", line: { color: "#d62728" } },
-    { x, y: c.crank_accel_rad_s2, name: "crank acceleration [rad/s²]", yaxis: "y3", line: { color: "#9467bd" } },
-    { x, y: c.crank_jerk_rad_s3, name: "crank jerk [rad/s³]", yaxis: "y6", line: { color: "#8c564b" } },
-    { x, y: c.slider_speed_mm_s, name: "slide speed [mm/s]", yaxis: "y4", line: { color: "#2ca02c" } },
-    { x, y: c.slider_accel_mm_s2, name: "slide acceleration [mm/s²]", yaxis: "y5", line: { color: "#ff7f0e" } },
-    ...limitTraces(ans.limit_lines, x, axis),
-  ];
-  const keyX = r.key_points.map((k) => (axis === "time" ? k.time_s : k.angle_deg));
-  const keyIndex = keyX.map((v) => nearest(x, v));
-  traces.push({ x: keyX, y: keyIndex.map((i) => c.slider_height_mm[i]), text: r.key_points.map((k) => KEY_LABELS[k.name]), mode: "markers+text", textposition: "top center", yaxis: "y", name: "key points", marker: { color: "#000", size: 7 }, showlegend: false });
-  if (state.pinned) {
-    const p = state.pinned.curves, px = xOf(p), dash = { dash: "dot", color: "#777", width: 1 };
-    traces.push({ x: px, y: p.crank_speed_rpm, name: "pinned crank speed", yaxis: "y2", line: dash });
-    traces.push({ x: px, y: p.crank_accel_rad_s2, name: "pinned crank acceleration", yaxis: "y3", line: dash });
-    traces.push({ x: px, y: p.slider_accel_mm_s2, name: "pinned slide acceleration", yaxis: "y5", line: dash });
-  }
-  const { shapes, annotations } = cycleShapes(r, x, axis);
-  const round = { nticks: 6, tickformat: "~g" };
-  const layout = {
-    margin: { l: 60, r: 60, t: 24, b: 40 },
-    hovermode: "x unified",
-    legend: { orientation: "h", y: -0.08, yanchor: "top", font: { size: 10 } },
-    xaxis: { title: { text: axis === "time" ? "time from TDC [s]" : "crank angle from TDC [deg]" }, anchor: "y4" },
-    yaxis: { ...round, domain: [0.78, 1.0], title: { text: "height [mm]" } },
-    yaxis2: { ...round, tickmode: "auto", overlaying: "y", side: "right", rangemode: "tozero", showgrid: false, title: { text: "crank [rpm]" } },
-    yaxis3: { ...round, domain: [0.53, 0.73], zeroline: true, title: { text: "crank accel [rad/s²]" } },
-    yaxis6: { ...round, domain: [0.28, 0.48], zeroline: true, title: { text: "crank jerk [rad/s³]" } },
-    yaxis4: { ...round, domain: [0.0, 0.23], title: { text: "slide [mm/s]" } },
-    yaxis5: { ...round, tickmode: "auto", overlaying: "y4", side: "right", showgrid: false, zeroline: false, title: { text: "slide [mm/s²]" } },
-    shapes,
-    annotations,
-  };
-  Plotly.react("motion-chart", traces, layout, { responsive: true, displaylogo: false });
+  const picked = pickedPanels();
   const chart = $("#motion-chart");
+  chart.style.height = chartHeight() + "px";
+  const width = Math.max(200, chart.clientWidth - 62);
+  const layout = {
+    margin: { l: 48, r: 14, t: 20, b: 40 },
+    hovermode: "x unified",
+    showlegend: false,
+    xaxis: { title: { text: axis === "time" ? "time from TDC [s]" : "crank angle from TDC [deg]" }, anchor: `y${picked.length > 1 ? picked.length : ""}` },
+  };
+  const axes = {}, traces = [], gap = 0.04, n = Math.max(picked.length, 1), height = (1 - gap * (n - 1)) / n;
+  const notes = [];
+  picked.forEach((panel, i) => {
+    const name = i === 0 ? "y" : `y${i + 1}`, key = i === 0 ? "yaxis" : `yaxis${i + 1}`;
+    axes[panel.key] = name;
+    const top = 1 - i * (height + gap);
+    const lines = (ans.limit_lines || []).filter((l) => l.quantity === panel.key && !l.point);
+    const { range, off } = panelRange(c[panel.key], lines);
+    if (panel.key === "slider_height_mm") range[1] += 0.18 * (range[1] - range[0]); // room for the key angles' names
+    // the panel's name inside it, top left (an axis title would not fit a short panel's height)
+    layout[key] = { ...ROUND_TICKS, domain: [top - height, top], range, zeroline: true, zerolinecolor: "#888" };
+    notes.push({ xref: "paper", yref: "paper", x: 0, y: top, xanchor: "left", yanchor: "top", showarrow: false, text: panel.title, font: { size: 10, color: panel.color }, bgcolor: "rgba(255,255,255,0.75)" });
+    traces.push({ x, y: c[panel.key], name: TRACE_NAMES[panel.key], yaxis: name, line: { color: panel.color } });
+    if (off.length) notes.push({ xref: "paper", yref: "paper", x: 1, y: top, xanchor: "right", yanchor: "top", showarrow: false, font: { size: 10, color: "#7a4b00" }, text: off.map((l) => `${l.field} ${extent([...(l.upper || [])])[1].toPrecision(4)} off scale`).join("; ") });
+    if (state.pinned) traces.push({ x: xOf(state.pinned.curves), y: state.pinned.curves[panel.key], name: "pinned " + TRACE_NAMES[panel.key], yaxis: name, line: { dash: "dot", color: "#777", width: 1 } });
+  });
+  traces.push(...limitTraces(ans.limit_lines, x, axis, axes));
+  if (axes.slider_height_mm) {
+    const keyX = r.key_points.map((k) => (axis === "time" ? k.time_s : k.angle_deg));
+    const keyIndex = keyX.map((v) => nearest(x, v));
+    traces.push({ x: keyX, y: keyIndex.map((i) => c.slider_height_mm[i]), text: r.key_points.map((k) => KEY_LABELS[k.name]), mode: "markers+text", textposition: "top center", yaxis: axes.slider_height_mm, name: "key points", marker: { color: "#000", size: 7 }, showlegend: false });
+  }
+  const { shapes, annotations } = cycleShapes(r, x, axis, width);
+  layout.shapes = shapes;
+  layout.annotations = [...annotations, ...notes];
+  Plotly.react("motion-chart", traces, layout, { responsive: true, displaylogo: false });
   if (!chart.dataset.follows) { chart.on("plotly_hover", followChart); chart.dataset.follows = "1"; }
   drawDrive(r, c, x, axis);
   drawEnergy(r, c, x, axis);
@@ -639,15 +833,36 @@ function showLoaded(answer) {
   state.pinned = null; // a pinned plan belongs to the case it was pinned on
   state.newCase = true; // until it has a plan, no other case's plan stays on screen
   $("#case-label").textContent = answer.label;
+  forgetHistory();
   buildForm(answer.case);
   solveNow();
 }
 
 async function upload(file) {
+  if (file.size > state.meta.max_case_bytes) { // the server's own line, without a refused request
+    showLoaded({ message: `${file.name}: too large for a case file (more than ${state.meta.max_case_bytes} bytes)` });
+    return;
+  }
   const body = new FormData();
   body.append("file", file);
   const answer = await readJson(fetch("/api/upload", { method: "POST", body }));
   showLoaded(answer);
+  if (answer.case != null) showUploaded(answer.label);
+}
+
+// the case list names the uploaded case (so that picking a listed case again loads it)
+function showUploaded(label) {
+  const select = $("#case-select");
+  let option = select.querySelector("option[data-uploaded]");
+  if (!option) {
+    option = new Option("", "", false, false);
+    option.dataset.uploaded = "1";
+    option.disabled = true;
+    select.add(option, 0);
+  }
+  option.textContent = `uploaded: ${label}`;
+  select.value = "";
+  option.selected = true;
 }
 
 async function download(name, cam) {
@@ -725,7 +940,28 @@ async function start() {
   const select = $("#case-select");
   for (const name of state.meta.cases) select.add(new Option(name, name));
   select.addEventListener("change", () => loadCase(select.value));
-  $("#upload").addEventListener("change", (e) => { if (e.target.files.length) upload(e.target.files[0]); });
+  $("#upload").addEventListener("change", (e) => {
+    const file = e.target.files.length ? e.target.files[0] : null;
+    e.target.value = ""; // the same file chosen again is a new upload
+    if (file) upload(file);
+  });
+  buildPanels();
+  let resizeTimer = null;
+  window.addEventListener("resize", () => { clearTimeout(resizeTimer); resizeTimer = setTimeout(() => { if (state.last) drawCharts(); }, 150); });
+  $("#undo").addEventListener("click", () => moveInHistory(-1));
+  $("#redo").addEventListener("click", () => moveInHistory(+1));
+  document.addEventListener("keydown", (e) => { // Ctrl+Z / Ctrl+Y outside a text box (a box keeps its own undo)
+    if (!(e.ctrlKey || e.metaKey) || e.target.matches("input[type=text], input:not([type])")) return;
+    if (e.key === "z" && !e.shiftKey) { e.preventDefault(); moveInHistory(-1); }
+    else if (e.key === "y" || (e.key === "z" && e.shiftKey)) { e.preventDefault(); moveInHistory(+1); }
+  });
+  if (state.meta.recipes) {
+    listRecipes();
+    $("#recipe-save").addEventListener("click", saveRecipe);
+    $("#recipe-select").addEventListener("change", (e) => openRecipe(e.target.value));
+  } else {
+    document.querySelector("header .recipes").hidden = true;
+  }
   $("#x-axis").addEventListener("change", () => { if (state.last) drawCharts(); });
   $("#crank-angle").addEventListener("input", drawMechanism);
   $("#pin").addEventListener("click", () => { if (state.last) { state.pinned = state.last; render(state.last, state.shownSeq, document.body.dataset.state !== "confirming"); } });
