@@ -451,3 +451,12 @@ def test_thirty_random_edits_uploads_and_downloads_end_on_the_clis_plan(site, tm
         assert {"edit", "undo", "upload", "download", "pick"} <= set(done), done
     finally:
         context.close()
+
+
+def test_serve_refuses_a_recipes_folder_that_is_a_file(tmp_path: Path, capsys) -> None:
+    from planning.cli import main
+
+    file = tmp_path / "recipes"
+    file.write_text("not a folder", encoding="utf-8")
+    assert main(["serve", "--recipes", str(file)]) == 2
+    assert capsys.readouterr().err.strip() == f"pressplan: --recipes {file}: not a folder"
