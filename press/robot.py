@@ -1,0 +1,167 @@
+"""A press-tending robot (an unloader or a loader) on its path: its fastest move and its interference curve.
+
+The first layer of the robots' model (issue 39): pure functions and small dataclasses, no case and no solver.
+
+Conventions
+-----------
+- **Position** ``x`` [mm] along the robot's path, measured from the die centre (``x = 0``, where the tool grips or
+  drops the part) to the robot's waiting point outside the press (``x = L``, the path length).
+- **Time** [s]; a robot's cycle: from its waiting point it moves in (``x`` from ``L`` to 0), dwells at the die
+  centre (grip or release), moves out (``x`` from 0 to ``L``) and waits; once per stroke of the press, periodic
+  with the press's cycle time.
+- **A move** is rest to rest and the fastest the limits allow: ``|v| <= v_max``, ``|a| <= a_max`` and, when
+  given, ``|j| <= j_max``. Its speed never changes sign, so the position is monotone.
+
+  Without a jerk limit it is the trapezoid (the triangle when the top speed is not reached): with
+  ``L >= v_max^2 / a_max``, ``T = L / v_max + v_max / a_max``; else ``T = 2 sqrt(L / a_max)``.
+
+  With a jerk limit it is the double-S (seven-segment) profile of Biagiotti & Melchiorri, *Trajectory Planning
+  for Automatic Machines and Robots* (2008), section 3.4, for ``v0 = v1 = 0``: ``T_j`` the time of a jerk
+  phase, ``T_a`` of the acceleration, ``T_v`` at top speed, ``T = 2 T_a + T_v``:
+  ``T_j = a_max / j_max`` and ``T_a = T_j + v_max / a_max`` where ``v_max j_max >= a_max^2``, else
+  ``T_j = sqrt(v_max / j_max)``, ``T_a = 2 T_j``; ``T_v = L / v_max - T_a``; when ``T_v < 0`` the top speed is
+  not reached: ``T_v = 0`` and, where ``L >= 2 a_max^3 / j_max^2``, ``T_j = a_max / j_max``,
+  ``T_a = T_j / 2 + sqrt((T_j / 2)^2 + L / a_max)``; else ``T_j = (L / (2 j_max))^(1/3)``, ``T_a = 2 T_j``.
+
+  A profile is a list of pieces of constant jerk ``(duration, a_start, j)``: on a piece
+  ``a = a_start + j t``, speed and position follow by exact integration, continuous across pieces (the
+  trapezoid's acceleration steps from one piece to the next; the double-S's is continuous).
+- **The interference curve**: the slide height [mm above BDC] the robot's tool needs when it is at ``x``, a
+  table interpolated linearly, zero beyond its last point (the tool is clear of the die). The clearance at a
+  time is the slide's height then minus what each tool needs then.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class MoveLimits:
+    """A robot's limits along its path: speed [mm/s], acceleration [mm/s^2], jerk [mm/s^3] (None: no limit)."""
+
+    speed_mm_s: float
+    accel_mm_s2: float
+    jerk_mm_s3: float | None = None
+
+
+@dataclass(frozen=True)
+class Move:
+    """A rest-to-rest move over ``length_mm`` as pieces ``(duration [s], a_start [mm/s^2], jerk [mm/s^3])``."""
+
+    length_mm: float
+    pieces: tuple[tuple[float, float, float], ...]
+
+    @property
+    def duration_s(self) -> float:
+        return sum(p[0] for p in self.pieces)
+
+    def state(self, tau_s: np.ndarray | float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(s, v, a)`` at times ``tau_s`` [s] from the move's start: the distance travelled [mm] (0 before
+        the move, ``length_mm`` after it), the speed [mm/s] and the acceleration [mm/s^2]."""
+        tau = np.clip(np.asarray(tau_s, dtype=float), 0.0, self.duration_s)
+        s, v, a = np.zeros_like(tau), np.zeros_like(tau), np.zeros_like(tau)
+        start, s0, v0 = 0.0, 0.0, 0.0
+        for k, (length, a0, jerk) in enumerate(self.pieces):
+            last = k == len(self.pieces) - 1
+            inside = (tau >= start) & ((tau < start + length) | last)
+            t = tau[inside] - start
+            a[inside] = a0 + jerk * t
+            v[inside] = v0 + a0 * t + jerk * t**2 / 2
+            s[inside] = s0 + v0 * t + a0 * t**2 / 2 + jerk * t**3 / 6
+            s0, v0 = (
+                s0 + v0 * length + a0 * length**2 / 2 + jerk * length**3 / 6,
+                v0 + a0 * length + jerk * length**2 / 2,
+            )
+            start += length
+        return s, v, a
+
+
+def fastest_move(length_mm: float, limits: MoveLimits) -> Move:
+    """The fastest rest-to-rest move over ``length_mm`` [mm] within ``limits`` (the module's equations)."""
+    if length_mm <= 0:
+        return Move(0.0, ((0.0, 0.0, 0.0),))
+    v, a = limits.speed_mm_s, limits.accel_mm_s2
+    if limits.jerk_mm_s3 is None:
+        if length_mm >= v * v / a:  # the trapezoid: the top speed reached
+            ramp = v / a
+            return Move(length_mm, ((ramp, a, 0.0), (length_mm / v - ramp, 0.0, 0.0), (ramp, -a, 0.0)))
+        ramp = math.sqrt(length_mm / a)  # the triangle
+        return Move(length_mm, ((ramp, a, 0.0), (ramp, -a, 0.0)))
+    j = limits.jerk_mm_s3
+    t_j, t_a = (a / j, a / j + v / a) if v * j >= a * a else (math.sqrt(v / j), 2 * math.sqrt(v / j))
+    t_v = length_mm / v - t_a
+    if t_v < 0:  # the top speed not reached
+        t_v = 0.0
+        if length_mm >= 2 * a**3 / j**2:
+            t_j = a / j
+            t_a = t_j / 2 + math.sqrt((t_j / 2) ** 2 + length_mm / a)
+        else:
+            t_j = (length_mm / (2 * j)) ** (1 / 3)
+            t_a = 2 * t_j
+    a_top = j * t_j  # the acceleration reached (a_max, or less on a short move)
+    flat = t_a - 2 * t_j
+    pieces = (
+        (t_j, 0.0, j),
+        (flat, a_top, 0.0),
+        (t_j, a_top, -j),
+        (t_v, 0.0, 0.0),
+        (t_j, 0.0, -j),
+        (flat, -a_top, 0.0),
+        (t_j, -a_top, j),
+    )
+    return Move(length_mm, tuple(p for p in pieces if p[0] > 0))
+
+
+@dataclass(frozen=True)
+class InterferenceCurve:
+    """The slide height [mm above BDC] a tool needs at each position [mm from the die centre], linear between
+    the points, zero beyond the last (the tool clear of the die)."""
+
+    positions_mm: tuple[float, ...]
+    needed_height_mm: tuple[float, ...]
+
+    def need(self, x_mm: np.ndarray | float) -> np.ndarray:
+        """The height needed at positions ``x_mm`` [mm]."""
+        x = np.asarray(x_mm, dtype=float)
+        heights = np.interp(x, self.positions_mm, self.needed_height_mm)
+        return np.where(x > self.positions_mm[-1], 0.0, heights)
+
+
+@dataclass(frozen=True)
+class Robot:
+    """A robot on its path: ``path_mm`` from the die centre to its waiting point, its move limits, its dwell at the
+    die centre [s] and its interference curve."""
+
+    name: str
+    path_mm: float
+    limits: MoveLimits
+    dwell_s: float
+    curve: InterferenceCurve
+
+    @property
+    def move(self) -> Move:
+        return fastest_move(self.path_mm, self.limits)
+
+    @property
+    def occupancy_s(self) -> float:
+        """From leaving its waiting point to being back there [s]: in, dwell, out."""
+        return 2 * self.move.duration_s + self.dwell_s
+
+    def position(self, t_s: np.ndarray, start_s: float, period_s: float) -> np.ndarray:
+        """The position [mm] at cycle times ``t_s`` [s] of a robot that leaves its waiting point at ``start_s``
+        [s] each cycle of ``period_s`` [s] (in, dwell, out, then waiting)."""
+        move = self.move
+        tau = np.mod(np.asarray(t_s, dtype=float) - start_s, period_s)
+        inward = self.path_mm - move.state(tau)[0]
+        outward = move.state(tau - move.duration_s - self.dwell_s)[0]
+        out_starts = move.duration_s + self.dwell_s
+        x = np.where(tau < out_starts, inward, outward)
+        return np.where(tau >= self.occupancy_s, self.path_mm, x)
+
+    def needed_height(self, t_s: np.ndarray, start_s: float, period_s: float) -> np.ndarray:
+        """The slide height [mm] the tool needs at cycle times ``t_s`` [s] (:meth:`position`'s schedule)."""
+        return self.curve.need(self.position(t_s, start_s, period_s))
