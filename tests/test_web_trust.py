@@ -168,6 +168,11 @@ def test_d5_a_normal_session_leaves_the_console_empty(page, tmp_path: Path) -> N
     assert page.locator("#load-message").inner_text() == "big.yaml: too large for a case file (more than 256000 bytes)"
     with page.expect_download():
         page.locator('[data-download="result.json"]').click()
+    page.select_option("#cam-target", "csv")  # a cam refused by its proof: an answer, not an HTTP error
+    page.select_option("#cam-interpolation", "linear")
+    page.locator("#cam-count").fill("3")
+    page.locator("#cam-prove").click()
+    page.wait_for_function("document.querySelector('#cam-message').textContent !== ''", timeout=60_000)
     page.wait_for_timeout(300)
     assert page.console == []
 
@@ -177,7 +182,10 @@ def test_d6_the_badge_names_the_plan_shown_and_downloads_wait_for_a_good_value(p
     downloads are disabled; the value fixed: the live plan, confirmed, downloads back."""
     badge = page.locator("#plan-badge")
     assert badge.inner_text() == "live plan: improved-s-curve, free placement, 12.123 strokes/min, confirmed"
+    page.locator("#cam-prove").click()  # a proved cam: downloadable until the form's case has no plan
+    page.wait_for_function("!document.querySelector('#cam-download').disabled", timeout=60_000)
     edit(page, "process.transfer_time_s", "-1")
+    assert page.locator("#cam-download").is_disabled() and page.locator("#cam-proof").inner_text() == ""
     assert badge.inner_text() == (
         "showing the last good plan (improved-s-curve, free placement, 12.123 strokes/min): "
         "the case on the form has none"
@@ -229,6 +237,44 @@ def test_d7_one_screen_at_every_size_with_nothing_overprinted(site, width: int, 
         assert console == []
     finally:
         context.close()
+
+
+def test_the_chart_follows_a_resize_and_six_panels_overprint_nothing(site) -> None:
+    """From 1920x1080 to 1280x720 the chart is drawn anew at its box's size (the plot as tall as its box, all
+    of it on the screen); with all six panels at 1280x720 no text of the chart overprints another."""
+    context, tab, console = open_page(site, 1920, 1080)
+    drawn = "document.querySelector('#motion-chart .main-svg').getBoundingClientRect().height"
+    try:
+        tab.set_viewport_size({"width": 1280, "height": 720})
+        box = "document.querySelector('#motion-chart')"
+        tab.wait_for_function(
+            f"{box}.getBoundingClientRect().bottom <= innerHeight && Math.abs({drawn} - {box}.clientHeight) < 1",
+            timeout=10_000,
+        )
+        chart = tab.locator("#motion-chart").bounding_box()
+        assert chart["y"] + chart["height"] <= 720
+        assert not _overlaps([(name, box) for name, box in tab.evaluate(TEXT_BOXES)])
+        for box in tab.locator("[data-panel]").all():
+            box.check()
+        tab.wait_for_timeout(300)
+        overprinted = _overlaps([(name, box) for name, box in tab.evaluate(TEXT_BOXES)])
+        assert not overprinted, overprinted
+        assert console == []
+    finally:
+        context.close()
+
+
+def test_typing_back_to_the_solved_value_restores_the_status(page) -> None:
+    """Type a key and take it back, then leave the field: nothing to solve, and the status is the plan's
+    again (not "editing…")."""
+    field = page.locator('[data-field="process.draw_speed_rpm"]')
+    field.click()
+    page.keyboard.press("End")
+    page.keyboard.type("5")
+    page.keyboard.press("Backspace")
+    page.keyboard.press("Tab")
+    page.wait_for_timeout(400)  # past the typing pause
+    assert page.locator("#status").inner_text().startswith("improved-s-curve, free placement, verified")
 
 
 def test_d8_one_quantity_per_axis_and_a_far_limit_written_not_drawn(page) -> None:
@@ -367,23 +413,30 @@ def test_a_recipe_is_saved_under_a_name_and_reopened(site, page) -> None:
     wait_rendered(page, before)
     assert form_value(page, "process.transfer_time_s") == "2.5"
     assert page.locator("#case-label").inner_text() == "recipe panel A"
+    pick_case(page, "small-fast-cup.yaml")
+    assert page.locator("#recipe-select").input_value() == ""  # the recipe reopens from its list
 
 
 def test_a_recipe_name_never_leaves_its_folder(tmp_path: Path) -> None:
+    """A name outside the rule (a slash, a dot-dot, a leading dot, too long, none) is refused with the rule,
+    nothing written anywhere; a case that does not read is refused with its line; a refusal is an answer."""
     from planning.web.server import create_app
 
     folder = tmp_path / "recipes"
     folder.mkdir()
     client = create_app(CASES, recipes_dir=folder).test_client()
     data = load_yaml(PUBLISHED.read_text(encoding="utf-8"))
-    for name in ("..", ".hidden", "a/b", "..%2Fescape", "x" * 65, ""):
-        answer = client.post(f"/api/recipe/{name}", json={"case": data})
-        assert answer.status_code in (400, 404, 405), name
+    for name in ("..", ".hidden", "a/b", "../escape", "x" * 65, "", None):
+        answer = client.post("/api/recipes", json={"name": name, "case": data})
+        assert answer.status_code == 200 and answer.get_json()["status"] == Outcome.BAD_INPUT, name
+        assert "letters, digits" in answer.get_json()["message"], name
     assert sorted(p.name for p in tmp_path.rglob("*")) == ["recipes"]  # nothing written anywhere
-    bad = client.post("/api/recipe/ok", json={"case": {**data, "process": {**data["process"], "transfer_time_s": -1}}})
-    assert bad.status_code == 400 and bad.get_json()["field"] == "process.transfer_time_s"
-    assert client.post("/api/recipe/ok", json={"case": data}).get_json()["names"] == ["ok"]
+    bad_case = {**data, "process": {**data["process"], "transfer_time_s": -1}}
+    bad = client.post("/api/recipes", json={"name": "ok", "case": bad_case}).get_json()
+    assert bad["field"] == "process.transfer_time_s" and not (folder / "ok.yaml").exists()
+    assert client.post("/api/recipes", json={"name": "ok", "case": data}).get_json()["names"] == ["ok"]
     assert client.get("/api/recipe/ok").get_json()["case"]["name"] == data["name"]
+    assert client.get("/api/recipe/..%2Fescape").status_code in (400, 404)
     none_here = create_app(CASES).test_client().get("/api/recipes")
     assert none_here.status_code == 400 and "--recipes" in none_here.get_json()["message"]
 

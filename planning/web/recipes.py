@@ -24,8 +24,10 @@ class RecipeError(ValueError):
 
 def recipe_path(folder: Path, name: str) -> Path:
     """The file of recipe ``name`` in ``folder``; :class:`RecipeError` for a name outside the rule."""
-    if not isinstance(name, str) or not RECIPE_NAME.match(name) or ".." in name:
-        raise RecipeError(f"recipe name {str(name)[:80]!r}: use {NAME_RULE}")
+    if not isinstance(name, str) or not name.strip():
+        raise RecipeError(f"recipe: type a name first ({NAME_RULE})")
+    if not RECIPE_NAME.match(name) or ".." in name:
+        raise RecipeError(f"recipe name {name[:80]!r}: use {NAME_RULE}")
     path = folder / f"{name.strip()}.yaml"
     if path.resolve().parent != folder.resolve():  # never outside the folder (a symbolic link included)
         raise RecipeError(f"recipe name {name!r}: outside the recipes' folder")

@@ -322,16 +322,19 @@ def _recipe_routes(app: Flask, shared: _Shared) -> None:
             return jsonify({"status": Outcome.BAD_INPUT, "message": str(exc), "field": exc.field}), 400
         return jsonify({"label": f"recipe {name}", "case": _data(case)})
 
-    @app.post("/api/recipe/<name>")
-    def keep_recipe(name: str) -> Response:
+    @app.post("/api/recipes")
+    def keep_recipe() -> Response:
+        """Save the body's ``case`` as recipe ``name`` (in the body: a name with a slash is refused by its rule,
+        not lost in the route); a refusal is an answer (200) the page shows."""
         body = _body()
+        name = body.get("name")
         try:
             path = recipe_path(folder(), name)
             case = case_from_data(body.get("case"), _label_of(body))
         except RecipeError as exc:
-            return jsonify({"status": Outcome.BAD_INPUT, "message": str(exc), "field": "recipe"}), 400
+            return jsonify({"status": Outcome.BAD_INPUT, "message": str(exc), "field": "recipe"})
         except CaseFileError as exc:  # only a case that reads is kept
-            return jsonify({"status": Outcome.BAD_INPUT, "message": str(exc), "field": exc.field}), 400
+            return jsonify({"status": Outcome.BAD_INPUT, "message": str(exc), "field": exc.field})
         save_recipe(folder(), name, _data(case))
         return jsonify({"saved": path.stem, "names": recipe_names(folder())})
 
@@ -404,7 +407,8 @@ def _cam_response(session: Session, shown: Any, body: dict[str, Any], label: str
     try:
         written = proved(session.cam, shown, options_of(body))
     except (CamRequestError, CamOptionError, PlanningError) as exc:  # the options, or a limit the cam breaks
-        return refused(exc)
+        answer, code = refused(exc)
+        return answer if name is None else (answer, code)  # a proof refused is an answer the page shows
     return proof_answer(written) if name is None else cam_file(written, name)
 
 

@@ -235,7 +235,10 @@ let editTimer = null;
 function onEdit() {
   clearTimeout(editTimer);
   // a change event that changes nothing (the field left after its edit was solved) solves nothing
-  if (state.solvedJson !== undefined && JSON.stringify(caseFromForm()) === state.solvedJson) return;
+  if (state.solvedJson !== undefined && JSON.stringify(caseFromForm()) === state.solvedJson) {
+    if (state.statusLine) setStatus(...state.statusLine); // typed back to the case solved: its status again
+    return;
+  }
   solveNow();
 }
 
@@ -343,6 +346,7 @@ function showBadge(refused) {
   const r = state.last ? state.last.result : null;
   const stale = Boolean(refused);
   document.body.dataset.stale = stale && r ? "1" : "";
+  if (stale && state.camFile) camReset(); // a proved cam belongs to the plan, not to the form's refused case
   for (const b of document.querySelectorAll("#downloads button, #cam-prove")) {
     b.disabled = stale;
     b.title = stale ? "the case on the form has no plan: fix the value marked, then download" : "";
@@ -385,6 +389,7 @@ function showMessage(field, message) {
 }
 
 function setStatus(text, kind) {
+  if (!text.startsWith("editing…")) state.statusLine = [text, kind]; // what an edit that changed nothing restores
   const el = $("#status");
   el.textContent = text;
   el.className = "status " + (kind || "");
@@ -517,7 +522,7 @@ async function listRecipes(selected) {
 
 async function saveRecipe() {
   const name = $("#recipe-name").value.trim();
-  const answer = await readJson(post("/api/recipe/" + encodeURIComponent(name), { label: state.label, case: caseFromForm() }));
+  const answer = await readJson(post("/api/recipes", { name, label: state.label, case: caseFromForm() }));
   if (answer.saved == null) { $("#load-message").textContent = answer.message; return; }
   $("#load-message").textContent = `saved as recipe ${answer.saved}`;
   await listRecipes(answer.saved);
@@ -631,11 +636,12 @@ function panelRange(values, lines) {
   return { range: [lo - pad, hi + pad], off };
 }
 
-function chartHeight() {
-  const chart = $("#motion-chart");
-  const top = chart.getBoundingClientRect().top - $("#result-panel").getBoundingClientRect().top;
-  const room = $("#result-panel").clientHeight - top - 8;
-  return Math.max(260, Math.min(room, 900));
+const PANEL_PX = 80; // the least height of a panel [px]: its ticks and its name legible
+function chartHeight(panels) {
+  const panel = $("#result-panel"), chart = $("#motion-chart");
+  const top = chart.getBoundingClientRect().top - panel.getBoundingClientRect().top + panel.scrollTop;
+  const room = panel.clientHeight - top - 8;
+  return Math.max(260, PANEL_PX * panels + 60, Math.min(room, 900));
 }
 
 function drawCharts() {
@@ -644,9 +650,11 @@ function drawCharts() {
   const x = xOf(c);
   const picked = pickedPanels();
   const chart = $("#motion-chart");
-  chart.style.height = chartHeight() + "px";
+  const chartPx = chartHeight(picked.length);
+  chart.style.height = chartPx + "px";
   const width = Math.max(200, chart.clientWidth - 62);
   const layout = {
+    height: chartPx, // given, so that a redraw takes the box's new size (plotly keeps its first otherwise)
     margin: { l: 48, r: 14, t: 20, b: 40 },
     hovermode: "x unified",
     showlegend: false,
@@ -662,7 +670,8 @@ function drawCharts() {
     const { range, off } = panelRange(c[panel.key], lines);
     if (panel.key === "slider_height_mm") range[1] += 0.18 * (range[1] - range[0]); // room for the key angles' names
     // the panel's name inside it, top left (an axis title would not fit a short panel's height)
-    layout[key] = { ...ROUND_TICKS, domain: [top - height, top], range, zeroline: true, zerolinecolor: "#888" };
+    const panelPx = height * (chartPx - 60);
+    layout[key] = { ...ROUND_TICKS, nticks: Math.max(2, Math.floor(panelPx / 28)), domain: [top - height, top], range, zeroline: true, zerolinecolor: "#888" };
     notes.push({ xref: "paper", yref: "paper", x: 0, y: top, xanchor: "left", yanchor: "top", showarrow: false, text: panel.title, font: { size: 10, color: panel.color }, bgcolor: "rgba(255,255,255,0.75)" });
     traces.push({ x, y: c[panel.key], name: TRACE_NAMES[panel.key], yaxis: name, line: { color: panel.color } });
     if (off.length) notes.push({ xref: "paper", yref: "paper", x: 1, y: top, xanchor: "right", yanchor: "top", showarrow: false, font: { size: 10, color: "#7a4b00" }, text: off.map((l) => `${l.field} ${extent([...(l.upper || [])])[1].toPrecision(4)} off scale`).join("; ") });
@@ -672,7 +681,7 @@ function drawCharts() {
   if (axes.slider_height_mm) {
     const keyX = r.key_points.map((k) => (axis === "time" ? k.time_s : k.angle_deg));
     const keyIndex = keyX.map((v) => nearest(x, v));
-    traces.push({ x: keyX, y: keyIndex.map((i) => c.slider_height_mm[i]), text: r.key_points.map((k) => KEY_LABELS[k.name]), mode: "markers+text", textposition: "top center", yaxis: axes.slider_height_mm, name: "key points", marker: { color: "#000", size: 7 }, showlegend: false });
+    traces.push({ x: keyX, y: keyIndex.map((i) => c.slider_height_mm[i]), text: r.key_points.map((k) => KEY_LABELS[k.name]), mode: "markers+text", textposition: "top center", cliponaxis: false, yaxis: axes.slider_height_mm, name: "key points", marker: { color: "#000", size: 7 }, showlegend: false });
   }
   const { shapes, annotations } = cycleShapes(r, x, axis, width);
   layout.shapes = shapes;
@@ -939,7 +948,7 @@ async function start() {
   }
   const select = $("#case-select");
   for (const name of state.meta.cases) select.add(new Option(name, name));
-  select.addEventListener("change", () => loadCase(select.value));
+  select.addEventListener("change", () => { $("#recipe-select").value = ""; loadCase(select.value); }); // a recipe reopens from its list
   $("#upload").addEventListener("change", (e) => {
     const file = e.target.files.length ? e.target.files[0] : null;
     e.target.value = ""; // the same file chosen again is a new upload
