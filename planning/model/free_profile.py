@@ -36,6 +36,41 @@ def free_segments(durations, jerks, layout: Layout = PHASES) -> list[Segment]:  
     return [Segment(name, T, j, 0.0) for name, T, j in zip(names, durations, jerks, strict=True)]
 
 
+def closed_jerks(
+    durations: tuple[float, ...], jerks: tuple[float, ...], w2: float, ends: tuple[float, ...], layout: Layout
+) -> tuple[float, ...]:
+    """The jerks [rad/s^3] nearest ``jerks`` (least squares) with which the profile from theta3 (speed ``w2``,
+    no acceleration) meets its ends exactly: each phase's end angle ``ends`` [rad] (theta4, theta1 + 2 pi,
+    theta2 + 2 pi, counted on from theta3's), and the speed ``w2`` with no acceleration at the last.
+
+    The NLP joins its shooting nodes to IPOPT's constraint tolerance, so the profile propagated through the
+    segments' closed forms gathers their defects at its end (1e-9 rad/s of speed over 104 segments: more than
+    round-off, which the verification's closure allows). The ends are linear in the jerks when the durations
+    stay: a jerk ``j_k`` over ``T_k`` followed by ``S`` seconds adds ``j_k T_k`` of acceleration,
+    ``j_k (T_k^2 / 2 + T_k S)`` of speed and ``j_k (T_k^3 / 6 + T_k^2 S / 2 + T_k S^2 / 2)`` of angle; the
+    least-norm correction of those five rows is one linear solve, and moves the jerks by as little as the
+    defects are (a relative 1e-9)."""
+    T, j = np.asarray(durations, dtype=float), np.asarray(jerks, dtype=float)
+    cut = np.cumsum([n for _, n in layout])  # the phases' last segments (+1)
+    rows, targets, values = [], [], []
+    for end, (index, target) in enumerate(zip(cut, ends, strict=True)):
+        after = np.concatenate([np.cumsum(T[:index][::-1])[::-1][1:], [0.0]])  # from each segment's end to this
+        gain = np.zeros_like(T)
+        gain[:index] = T[:index] ** 3 / 6 + T[:index] ** 2 * after / 2 + T[:index] * after**2 / 2
+        rows.append(gain)
+        targets.append(target)
+        values.append(w2 * float(np.sum(T[:index])) + float(gain @ j))  # the angle past theta3 there
+        if end == len(cut) - 1:
+            speed = np.zeros_like(T)
+            speed[:index] = T[:index] ** 2 / 2 + T[:index] * after
+            rows += [speed, np.where(np.arange(T.size) < index, T, 0.0)]
+            targets += [w2, 0.0]
+            values += [w2 + float(speed @ j), float(T[:index] @ j[:index])]
+    A, residual = np.array(rows), np.array(values) - np.array(targets)
+    correction = A.T @ np.linalg.solve(A @ A.T, residual)
+    return tuple((j - correction).tolist())
+
+
 @dataclass(frozen=True)
 class FreeProfileParameters:
     """A solved free profile (inside units): ``durations`` [s] and ``jerks`` [rad/s^3] of the segments from

@@ -10,7 +10,7 @@ import numpy as np
 
 from planning.model.case import Placement
 from planning.model.cycle import CycleParameters, cycle_segments
-from planning.model.free_profile import FreeProfileParameters, Layout
+from planning.model.free_profile import FreeProfileParameters, Layout, closed_jerks
 from planning.model.laws import DEFAULT_LAW
 from planning.model.profile import Profile, Segment, advance_segment, knot_states, split_segment
 from planning.tolerances import KNOT_TIME_S, TINY
@@ -132,6 +132,9 @@ def plan_of(
         for phase, n in layout:
             durations += [values[f"{phase}_step"]] * n
             jerks += [values[f"{phase}_jerk_{k}"] for k in range(n)]
+        # the phases' ends met exactly: the shooting's defects gathered at the end taken out (closed_jerks)
+        ends = (th4 - th3, th1 + 2 * math.pi - th3, th2 + 2 * math.pi - th3)
+        jerks = closed_jerks(tuple(durations), tuple(jerks), values["draw_speed"], ends, layout)
         params = FreeProfileParameters(tuple(durations), tuple(jerks), values["draw_speed"], th2, th3, layout=layout)
         segs = [seg for seg in params.segments() if seg.duration > 0]
         draw = Segment("draw:constant", params.draw_time, 0.0, 0.0)
