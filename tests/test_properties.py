@@ -27,7 +27,7 @@ RANDOM_SET = 100  # presses of each kind (draw speed given, or left to the plann
 VERIFIED_SHARE = 0.9  # of them at least this share end in a verified plan
 OFFSET_SET = 40  # offset crank-sliders: the first half in the normal run, the second in the slow tier
 RANDOM_PARTS = 4  # each set in parts of 25 presses (tests the workers share)
-QUICK_PARTS = 2  # of them in the normal run; the others in the slow tier (CI runs both)
+QUICK_PARTS = 1  # of them in the normal run; the others in the slow tier (CI runs both)
 UPPER_BOUND_SET = 4  # verified presses of each part checked against the certified upper bound (32 in all)
 UPPER_BOUND_LAWS_SET = 30  # random presses whose every law and bracket motion the slow run checks against it
 SLOW_CASES = 2000
@@ -230,6 +230,7 @@ RELAXATIONS = {  # each makes the set of feasible motions larger (or keeps it)
 }
 
 
+@pytest.mark.slow  # hypothesis draws presses until six solve: 10 s
 @settings(PROFILE, max_examples=RELAXATION_EXAMPLES)
 @given(data=CASES, relax=st.sampled_from(sorted(RELAXATIONS)))
 def test_relaxing_any_limit_never_turns_a_solved_case_into_exit_3(data, relax):
@@ -246,6 +247,7 @@ def test_relaxing_any_limit_never_turns_a_solved_case_into_exit_3(data, relax):
     solve(case_from_data(relaxed))  # raises PlanningError (a failed test) when the looser case gets exit 3
 
 
+@pytest.mark.slow  # 12 presses under four laws: 7 s
 @settings(PROFILE, max_examples=12)
 @given(data=CASES, law=st.sampled_from(["seven-segment", "quintic", "logistic", "cycloidal"]))
 def test_random_press_under_every_law_ends_verified_or_clean(data, law):
