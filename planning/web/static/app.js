@@ -636,6 +636,19 @@ function panelRange(values, lines) {
   return { range: [lo - pad, hi + pad], off };
 }
 
+// a short panel's ticks: the curve's own extremes (two digits) and zero, where auto ticks would leave only zero
+// or crowd; a tall one's: plotly's, about one per 40 px
+function panelTicks(values, range, panelPx) {
+  if (panelPx >= 140) return { nticks: Math.floor(panelPx / 40) };
+  const [lo, hi] = extent(values);
+  const ticks = range[0] <= 0 && range[1] >= 0 ? [0] : [];
+  const apart = 0.25 * (range[1] - range[0]); // a tick this close to another would print over it
+  for (const v of [Number(lo.toPrecision(2)), Number(hi.toPrecision(2))]) {
+    if (v >= range[0] && v <= range[1] && ticks.every((t) => Math.abs(t - v) >= apart)) ticks.push(v);
+  }
+  return { tickmode: "array", tickvals: ticks.sort((a, b) => a - b) };
+}
+
 const PANEL_PX = 80; // the least height of a panel [px]: its ticks and its name legible
 function chartHeight(panels) {
   const panel = $("#result-panel"), chart = $("#motion-chart");
@@ -671,7 +684,7 @@ function drawCharts() {
     if (panel.key === "slider_height_mm") range[1] += 0.18 * (range[1] - range[0]); // room for the key angles' names
     // the panel's name inside it, top left (an axis title would not fit a short panel's height)
     const panelPx = height * (chartPx - 60);
-    layout[key] = { ...ROUND_TICKS, nticks: Math.max(2, Math.floor(panelPx / 28)), domain: [top - height, top], range, zeroline: true, zerolinecolor: "#888" };
+    layout[key] = { ...ROUND_TICKS, ...panelTicks(c[panel.key], range, panelPx), domain: [top - height, top], range, zeroline: true, zerolinecolor: "#888" };
     notes.push({ xref: "paper", yref: "paper", x: 0, y: top, xanchor: "left", yanchor: "top", showarrow: false, text: panel.title, font: { size: 10, color: panel.color }, bgcolor: "rgba(255,255,255,0.75)" });
     traces.push({ x, y: c[panel.key], name: TRACE_NAMES[panel.key], yaxis: name, line: { color: panel.color } });
     if (off.length) notes.push({ xref: "paper", yref: "paper", x: 1, y: top, xanchor: "right", yanchor: "top", showarrow: false, font: { size: 10, color: "#7a4b00" }, text: off.map((l) => `${l.field} ${extent([...(l.upper || [])])[1].toPrecision(4)} off scale`).join("; ") });
