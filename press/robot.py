@@ -155,6 +155,9 @@ class Robot:
         """The position [mm] at cycle times ``t_s`` [s] of a robot that leaves its waiting point at ``start_s``
         [s] each cycle of ``period_s`` [s] (in, dwell, out, then waiting)."""
         move = self.move
+        if self.occupancy_s > period_s:
+            took = f"in, dwell and out take {self.occupancy_s:g} s"
+            raise ValueError(f"{self.name}: {took}, longer than the cycle {period_s:g} s")
         tau = np.mod(np.asarray(t_s, dtype=float) - start_s, period_s)
         inward = self.path_mm - move.state(tau)[0]
         outward = move.state(tau - move.duration_s - self.dwell_s)[0]

@@ -128,3 +128,13 @@ def test_the_optimal_laws_profile_meets_its_ends_exactly() -> None:
     cut = np.cumsum([n for _, n in PHASES])
     assert np.allclose(states[cut, 0] - theta3, ends, atol=1e-12, rtol=0)
     assert abs(states[-1, 1] - w2) < 1e-12 and abs(states[-1, 2]) < 1e-12
+
+
+def test_closed_jerks_on_a_degenerate_layout_gives_an_answer() -> None:
+    """One segment per phase (five end rows, three jerks): the least-squares jerks, no exception (the plan's
+    verification then decides)."""
+    from planning.model.free_profile import closed_jerks
+
+    layout = (("return", 1), ("transfer", 1), ("feed", 1))
+    jerks = closed_jerks((0.5, 0.5, 0.5), (1.0, -2.0, 1.0), 1.0, (1.0, 2.0, 3.0), layout)
+    assert len(jerks) == 3 and all(np.isfinite(jerks))

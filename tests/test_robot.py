@@ -88,3 +88,9 @@ def test_a_robots_cycle_moves_in_dwells_moves_out_and_waits_periodically() -> No
     dense = np.linspace(0, period, 5001)
     positions = robot.position(dense, start, period)
     assert positions.min() == pytest.approx(0.0, abs=1e-9) and positions.max() == pytest.approx(1200.0)
+
+
+def test_a_robot_longer_than_the_cycle_is_refused() -> None:
+    robot = Robot("loader", 1000.0, MoveLimits(1000.0, 5000.0), 0.5, InterferenceCurve((0.0, 500.0), (600.0, 0.0)))
+    with pytest.raises(ValueError, match="longer than the cycle"):
+        robot.position(np.array([0.0]), 0.0, robot.occupancy_s - 0.1)

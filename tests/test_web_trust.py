@@ -189,6 +189,9 @@ def test_d6_the_badge_names_the_plan_shown_and_downloads_wait_for_a_good_value(p
     page.wait_for_function("!document.querySelector('#cam-download').disabled", timeout=60_000)
     edit(page, "process.transfer_time_s", "-1")
     assert page.locator("#cam-download").is_disabled() and page.locator("#cam-proof").inner_text() == ""
+    page.locator("#pin").click()  # pinning the plan on screen changes nothing of that
+    assert badge.inner_text().startswith("showing the last good plan")
+    assert page.locator('[data-download="result.json"]').is_disabled()
     assert badge.inner_text() == (
         "showing the last good plan (improved-s-curve, free placement, 12.123 strokes/min): "
         "the case on the form has none"
@@ -330,6 +333,20 @@ def test_d9_server_details() -> None:
     )
 
 
+def test_a_post_without_length_or_chunks_is_answered_at_once() -> None:
+    """A body with neither a Content-Length nor chunks is no body: a 400 at once, not a thread waiting for the
+    client to close."""
+    import socket
+    from urllib.parse import urlparse
+
+    with running_server(None) as url:
+        where = urlparse(url)
+        with socket.create_connection((where.hostname, where.port), timeout=10) as conn:
+            conn.sendall(b"POST /api/bound HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n\r\n")
+            answer = conn.recv(4096).decode()
+    assert answer.startswith("HTTP/1.1 400"), answer[:80]
+
+
 def chunked_post(size: int) -> tuple[int, str]:
     """POST a JSON body of about ``size`` bytes chunked (no Content-Length) to a running server; its
     status code and the answer's status."""
@@ -393,9 +410,28 @@ def test_undo_and_redo_walk_the_edits(page) -> None:
     page.locator("#redo").click()
     wait_rendered(page, before)
     assert form_value(page, "process.transfer_time_s") == "2.5" and page.locator("#spm").inner_text() == spm_25
+    page.locator("#spm").click()  # outside a text box the keys undo and redo, on any layout or Caps Lock
+    before = rendered(page)
+    page.keyboard.press("Control+Shift+KeyZ")
+    wait_rendered(page, before)
+    assert form_value(page, "process.transfer_time_s") == "3"
+    before = rendered(page)
+    page.keyboard.press("Control+KeyZ")
+    wait_rendered(page, before)
+    assert form_value(page, "process.transfer_time_s") == "2.5"
 
 
 def test_a_decimal_comma_is_a_decimal_point(page) -> None:
+    """"2,5" is 2.5; "1,200" (a thousands separator or a decimal comma?) is left to the server, which refuses it
+    beside the field; "0,125" is 0.125 (no thousands separator writes a leading zero)."""
+    assert page.evaluate("[numberOf('1,200'), numberOf('0,125'), numberOf('-,5'), numberOf('1,5e3')]") == [
+        "1,200",
+        0.125,
+        -0.5,
+        1500,
+    ]
+    edit(page, "process.transfer_time_s", "1,200")
+    assert page.locator('.msg[data-for="process.transfer_time_s"]').inner_text() != ""
     edit(page, "process.transfer_time_s", "2,5")
     assert page.evaluate("caseFromForm().process.transfer_time_s") == 2.5
     assert page.evaluate("document.body.dataset.state") == "ready"
@@ -429,7 +465,7 @@ def test_a_recipe_name_never_leaves_its_folder(tmp_path: Path) -> None:
     folder.mkdir()
     client = create_app(CASES, recipes_dir=folder).test_client()
     data = load_yaml(PUBLISHED.read_text(encoding="utf-8"))
-    for name in ("..", ".hidden", "a/b", "../escape", "x" * 65, "", None):
+    for name in ("..", ".hidden", "a/b", "../escape", "x" * 65, "", None, "ok\n", "trailing "):
         answer = client.post("/api/recipes", json={"name": name, "case": data})
         assert answer.status_code == 200 and answer.get_json()["status"] == Outcome.BAD_INPUT, name
         assert "letters, digits" in answer.get_json()["message"], name
@@ -438,6 +474,13 @@ def test_a_recipe_name_never_leaves_its_folder(tmp_path: Path) -> None:
     bad = client.post("/api/recipes", json={"name": "ok", "case": bad_case}).get_json()
     assert bad["field"] == "process.transfer_time_s" and not (folder / "ok.yaml").exists()
     assert client.post("/api/recipes", json={"name": "ok", "case": data}).get_json()["names"] == ["ok"]
+    assert (folder / "ok.yaml").stat().st_mode & 0o777 == 0o644  # readable as any case file
+    text = json.dumps({"name": "ok", "case": {**data, "name": "forged"}})
+    forged = client.post("/api/recipes", data=text, content_type="text/plain")  # another site's form sends this
+    assert forged.status_code == 400 and "application/json" in forged.get_json()["message"]
+    foreign = client.post("/api/recipes", json={"name": "ok", "case": data}, headers={"Origin": "https://evil.example"})
+    assert foreign.status_code == 403
+    assert load_yaml((folder / "ok.yaml").read_text(encoding="utf-8"))["name"] == data["name"]
     assert client.get("/api/recipe/ok").get_json()["case"]["name"] == data["name"]
     assert client.get("/api/recipe/..%2Fescape").status_code in (400, 404)
     none_here = create_app(CASES).test_client().get("/api/recipes")

@@ -48,7 +48,7 @@ def closed_jerks(
     round-off, which the verification's closure allows). The ends are linear in the jerks when the durations
     stay: a jerk ``j_k`` over ``T_k`` followed by ``S`` seconds adds ``j_k T_k`` of acceleration,
     ``j_k (T_k^2 / 2 + T_k S)`` of speed and ``j_k (T_k^3 / 6 + T_k^2 S / 2 + T_k S^2 / 2)`` of angle; the
-    least-norm correction of those five rows is one linear solve, and moves the jerks by as little as the
+    least-norm correction of those five rows is one linear least-squares solve, and moves the jerks by as little as the
     defects are (a relative 1e-9)."""
     T, j = np.asarray(durations, dtype=float), np.asarray(jerks, dtype=float)
     cut = np.cumsum([n for _, n in layout])  # the phases' last segments (+1)
@@ -67,7 +67,7 @@ def closed_jerks(
             targets += [w2, 0.0]
             values += [w2 + float(speed @ j), float(T[:index] @ j[:index])]
     A, residual = np.array(rows), np.array(values) - np.array(targets)
-    correction = A.T @ np.linalg.solve(A @ A.T, residual)
+    correction = np.linalg.lstsq(A, residual, rcond=None)[0]  # the least-norm one (least squares if degenerate)
     return tuple((j - correction).tolist())
 
 

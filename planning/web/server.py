@@ -33,6 +33,7 @@ from collections import OrderedDict
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+from urllib.parse import urlsplit
 
 import numpy as np
 import yaml
@@ -214,9 +215,12 @@ def _guard(app: Flask, allowed_hosts: tuple[str, ...]) -> None:
         """Only the names of this machine and the address it binds: a page on another site that rebinds
         its own name to 127.0.0.1 (DNS rebinding) reaches nothing."""
         host = _hostname(request.host or "").lower()  # host names are case-insensitive
-        if everyone or host in allowed:
+        origin = request.headers.get("Origin")  # a request another site's page sends names that site
+        sender = _hostname(urlsplit(origin).netloc).lower() if origin and origin != "null" else None
+        if everyone or (host in allowed and (sender is None or sender in allowed)):
             return None
-        return jsonify({"status": Outcome.BAD_INPUT, "message": f"host {host!r} is not served here"}), 403
+        name = host if host not in allowed else sender
+        return jsonify({"status": Outcome.BAD_INPUT, "message": f"host {name!r} is not served here"}), 403
 
     @app.errorhandler(BadRequest)
     def bad_request(exc: BadRequest) -> Response:
@@ -335,7 +339,11 @@ def _recipe_routes(app: Flask, shared: _Shared) -> None:
             return jsonify({"status": Outcome.BAD_INPUT, "message": str(exc), "field": "recipe"})
         except CaseFileError as exc:  # only a case that reads is kept
             return jsonify({"status": Outcome.BAD_INPUT, "message": str(exc), "field": exc.field})
-        save_recipe(folder(), name, _data(case))
+        try:
+            save_recipe(folder(), name, _data(case))
+        except OSError as exc:  # the folder read-only, full, or the name taken by a folder
+            message = f"recipe {name}: cannot be written to the recipes' folder ({exc.strerror or exc})"
+            return jsonify({"status": Outcome.ERROR, "message": message, "field": "recipe"})
         return jsonify({"saved": path.stem, "names": recipe_names(folder())})
 
 
@@ -463,12 +471,15 @@ def _body() -> dict[str, Any]:
     """The request's JSON object; :class:`BadRequest` when it is not one (malformed, nested deeper than
     :data:`MAX_JSON_DEPTH`, another type). The depth is counted before parsing, so no input reaches the
     parser's recursion limit."""
-    if request.content_length is None:  # chunked: at most one byte past the limit, then refused (the
-        # request's own stream stops at the limit without a word: the server's decoded input is read)
+    if request.mimetype != "application/json":  # the page's; another site's form (text/plain) is not read
+        raise BadRequest("the request's body is not JSON (Content-Type: application/json)")
+    if request.content_length is None and request.environ.get("wsgi.input_terminated"):
+        # chunked: at most one byte past the limit, then refused (the request's own stream stops at the limit
+        # without a word: the server's decoded input is read)
         raw = request.environ["wsgi.input"].read(MAX_REQUEST_BYTES + 1)
         if len(raw) > MAX_REQUEST_BYTES:
             raise RequestEntityTooLarge()
-    else:
+    else:  # a length given (or none and no chunks: no body)
         raw = request.get_data(cache=True)
     if _depth(raw) > MAX_JSON_DEPTH:
         raise BadRequest(f"the request nests deeper than {MAX_JSON_DEPTH} levels")
@@ -619,8 +630,10 @@ def utilisation(verification: Any, case: Case) -> list[dict[str, Any]]:
         if check.id not in order or check.kind not in ("max", "min"):
             continue
         value, limit = abs(check.value), abs(check.limit)
-        share = value / limit if check.kind == "max" else (limit / value if value else math.inf)
-        if limit == 0 or not math.isfinite(share):
+        if limit == 0 or (check.kind == "min" and value == 0):
+            continue
+        share = value / limit if check.kind == "max" else limit / value
+        if not math.isfinite(share):
             continue
         field = field_of_check(check.id)
         rows.append({"id": check.id, "name": check.name, "field": field, "pct": 100 * share, "binds": check.binds})

@@ -219,6 +219,7 @@ function formValue(input) {
 // a number as typed, or the text itself (the server then says what is wrong with it); a decimal comma, as
 // many locales write it, is a decimal point ("1,8" is 1.8; a comma with a point as well is left to the server)
 function numberOf(text) {
+  if (/^[-+]?[1-9]\d{0,2},\d{3}$/.test(text)) return text; // "1,200": a thousands separator or a decimal comma? the server refuses it
   const typed = /^[-+]?\d*,\d+([eE][-+]?\d+)?$/.test(text) ? text.replace(",", ".") : text;
   const number = Number(typed);
   return Number.isFinite(number) && /^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$/.test(typed) ? number : text;
@@ -420,9 +421,7 @@ function render(answer, seq, confirmed) {
       `RMS ${(r.drive.rms_motor_torque_Nm / 1e3).toFixed(2)} kN m (${r.drive.rms_torque_use_pct.toFixed(1)} % of rated), ` +
       `peak power ${r.drive.peak_motor_power_kW.toFixed(0)} kW, ${r.drive.energy_drawn_kJ.toFixed(1)} kJ drawn per stroke`
     : "";
-  $("#pin-line").textContent = state.pinned
-    ? `pinned ${state.pinned.result.spm.toFixed(3)} SPM: difference ${(r.spm - state.pinned.result.spm >= 0 ? "+" : "")}${(r.spm - state.pinned.result.spm).toFixed(3)} SPM`
-    : "";
+  showPin();
   const body = $("#key-points tbody");
   body.innerHTML = "";
   for (const k of r.key_points) {
@@ -454,6 +453,14 @@ function render(answer, seq, confirmed) {
   if (!confirmed || window.firstRenderedSeq !== seq) { window.firstRenderedAt = performance.now(); window.firstRenderedSeq = seq; }
   window.renderedAt = performance.now();
   document.body.dataset.rendered = String(seq);
+}
+
+// the pinned plan's SPM beside the one on screen (a pin changes nothing else: the badge and status stay)
+function showPin() {
+  const r = state.last.result, p = state.pinned;
+  $("#pin-line").textContent = p
+    ? `pinned ${p.result.spm.toFixed(3)} SPM: difference ${(r.spm - p.result.spm >= 0 ? "+" : "")}${(r.spm - p.result.spm).toFixed(3)} SPM`
+    : "";
 }
 
 // each limit's use by the plan as a bar, in the case's order of limits; the binding ones marked
@@ -530,9 +537,11 @@ async function saveRecipe() {
 
 async function openRecipe(name) {
   if (!name) return;
+  const mine = ++loads;
   const answer = await readJson(fetch("/api/recipe/" + encodeURIComponent(name)));
+  if (mine !== loads) return;
   showLoaded(answer);
-  if (answer.case != null) { $("#recipe-name").value = name; $("#case-select").value = ""; }
+  if (answer.case != null) { $("#recipe-name").value = name; $("#case-select").selectedIndex = -1; }
 }
 
 function xOf(curves) {
@@ -841,9 +850,11 @@ function followChart(event) {  // the drawing follows the crank angle under the 
 }
 
 // ---- cases, uploads, downloads ----------------------------------------------------------------------
+let loads = 0; // the case loaded last is the one shown, whatever order the answers come in
 async function loadCase(name) {
+  const mine = ++loads;
   const answer = await readJson(fetch("/api/case/" + encodeURIComponent(name)));
-  showLoaded(answer);
+  if (mine === loads) showLoaded(answer);
 }
 
 function showLoaded(answer) {
@@ -867,7 +878,9 @@ async function upload(file) {
   }
   const body = new FormData();
   body.append("file", file);
+  const mine = ++loads;
   const answer = await readJson(fetch("/api/upload", { method: "POST", body }));
+  if (mine !== loads) return; // another case picked or opened since
   showLoaded(answer);
   if (answer.case != null) showUploaded(answer.label);
 }
@@ -929,7 +942,9 @@ function camInterpolations() { // the interpolations the target takes
 async function camProve() {
   camReset();
   $("#cam-proof").textContent = "proving…";
+  const asked = state.shownSeq;
   const answer = await readJson(post("/api/cam", { session: SESSION, label: state.label, case: caseFromForm(), cam: camOptions() }));
+  if (asked !== state.shownSeq) return; // another plan on screen since: its cam is not this one
   $("#cam-proof").textContent = "";
   if (answer.status !== OUTCOME.VERIFIED) { $("#cam-message").textContent = answer.message; return; }
   const speed = answer.highest_speed_pct.toFixed(2);
@@ -974,8 +989,8 @@ async function start() {
   $("#redo").addEventListener("click", () => moveInHistory(+1));
   document.addEventListener("keydown", (e) => { // Ctrl+Z / Ctrl+Y outside a text box (a box keeps its own undo)
     if (!(e.ctrlKey || e.metaKey) || e.target.matches("input[type=text], input:not([type])")) return;
-    if (e.key === "z" && !e.shiftKey) { e.preventDefault(); moveInHistory(-1); }
-    else if (e.key === "y" || (e.key === "z" && e.shiftKey)) { e.preventDefault(); moveInHistory(+1); }
+    if (e.code === "KeyZ" && !e.shiftKey) { e.preventDefault(); moveInHistory(-1); } // the key's place: any layout, Caps Lock
+    else if (e.code === "KeyY" || (e.code === "KeyZ" && e.shiftKey)) { e.preventDefault(); moveInHistory(+1); }
   });
   if (state.meta.recipes) {
     listRecipes();
@@ -986,8 +1001,8 @@ async function start() {
   }
   $("#x-axis").addEventListener("change", () => { if (state.last) drawCharts(); });
   $("#crank-angle").addEventListener("input", drawMechanism);
-  $("#pin").addEventListener("click", () => { if (state.last) { state.pinned = state.last; render(state.last, state.shownSeq, document.body.dataset.state !== "confirming"); } });
-  $("#unpin").addEventListener("click", () => { state.pinned = null; if (state.last) render(state.last, state.shownSeq, document.body.dataset.state !== "confirming"); });
+  $("#pin").addEventListener("click", () => { if (state.last) { state.pinned = state.last; showPin(); drawCharts(); } });
+  $("#unpin").addEventListener("click", () => { state.pinned = null; if (state.last) { showPin(); drawCharts(); } });
   $("#download-case").addEventListener("click", () => download("case.yaml"));
   for (const kind of ["focusin", "mouseover"]) $("#case-form").addEventListener(kind, showHelp);
   for (const target of Object.keys(state.meta.cam.targets)) $("#cam-target").add(new Option(target, target));
