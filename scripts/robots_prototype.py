@@ -29,7 +29,6 @@ sys.path.insert(0, str(ROOT))
 import planning.solver.halves_nlp as H  # noqa: E402
 from planning.model.case_file import read_case  # noqa: E402
 from planning.model.laws import get_law  # noqa: E402
-from planning.model.limits.base import Extremes, Transcription  # noqa: E402
 from planning.solver.ipopt import NLPSolver  # noqa: E402
 from planning.solver.nlp import CYCLE_OPTIONS, CycleNLP, Rows, add_limit_rows, sample_states  # noqa: E402
 from planning.solver.optimize import solve  # noqa: E402
@@ -81,20 +80,7 @@ def build(unloader: Robot, loader: Robot):  # noqa: ANN201 - the patched _build
         states, times, draw_count = H._sampled(c, law, False)
         samples, torque, lift = sample_states(formula, layout, c.q, c.p_case, states, times, draw_count)
         p = c.params
-        nlp = Transcription(
-            **samples,
-            period=p.period,
-            window_time=c.v["closing_time"] - c.v["opening_time"],
-            speeds=Extremes(ca.vertcat(p.feed_peak_speed, p.return_peak_speed, p.transfer_speed, p.draw_speed)),
-            accelerations=Extremes(ca.vertcat(*p.peak_accelerations())),
-            jerks=Extremes(ca.vertcat(*p.peak_jerks())),
-            lowest_speeds=None,
-            crossings=[(omd, c.q["die_down_slope"]), (omu, c.q["die_up_slope"])],
-            exit_speeds=exit_speeds,
-            zone=False,
-            rate=False,
-            speed_unit=c.unit["draw_speed"],
-        )
+        nlp = H._transcription(c, samples, (omd, omu), exit_speeds, False, False)
         refinable = add_limit_rows(rows, nlp, layout)
         # the robots' rows
         n = len(variables)

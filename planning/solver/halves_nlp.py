@@ -356,6 +356,30 @@ def _objective(
     return objective
 
 
+def _transcription(
+    c: _Cycle, samples: dict, crossings: tuple[ca.SX, ca.SX], exit_speeds: list, zone: bool, rate: bool
+) -> Transcription:
+    """What the limits' rows read of this NLP (``planning.model.limits.base.Transcription``): the samples'
+    states, the period, the robot's window, the extremes of the halves, the die crossings' speeds."""
+    p = c.params
+    omd, omu = crossings
+    return Transcription(
+        **samples,
+        period=p.period,
+        window_time=c.v["closing_time"] - c.v["opening_time"],
+        # the halves are monotone in speed: its extremes are the speeds they join
+        speeds=Extremes(ca.vertcat(p.feed_peak_speed, p.return_peak_speed, p.transfer_speed, p.draw_speed)),
+        accelerations=Extremes(ca.vertcat(*p.peak_accelerations())),
+        jerks=Extremes(ca.vertcat(*p.peak_jerks())),
+        lowest_speeds=None,  # the variable bounds of w1, w2 (the halves are monotone)
+        crossings=[(omd, c.q["die_down_slope"]), (omu, c.q["die_up_slope"])],
+        exit_speeds=exit_speeds,
+        zone=zone,
+        rate=rate,
+        speed_unit=c.unit["draw_speed"],
+    )
+
+
 def _build(
     law_name: str,
     formula: Formula,
@@ -380,22 +404,7 @@ def _build(
     exit_speeds = _exit_rows(rows, c, len(variables) - EXIT_SAMPLES) if die_exit else []
     states, times, draw_count = _sampled(c, law, drive)
     samples, torque, lift = sample_states(formula, layout, c.q, c.p_case, states, times, draw_count)
-    p = c.params
-    nlp = Transcription(
-        **samples,
-        period=p.period,
-        window_time=c.v["closing_time"] - c.v["opening_time"],
-        # the halves are monotone in speed: its extremes are the speeds they join
-        speeds=Extremes(ca.vertcat(p.feed_peak_speed, p.return_peak_speed, p.transfer_speed, p.draw_speed)),
-        accelerations=Extremes(ca.vertcat(*p.peak_accelerations())),
-        jerks=Extremes(ca.vertcat(*p.peak_jerks())),
-        lowest_speeds=None,  # the variable bounds of w1, w2 (the halves are monotone)
-        crossings=[(omd, c.q["die_down_slope"]), (omu, c.q["die_up_slope"])],
-        exit_speeds=exit_speeds,
-        zone=zone,
-        rate=rate,
-        speed_unit=c.unit["draw_speed"],
-    )
+    nlp = _transcription(c, samples, (omd, omu), exit_speeds, zone, rate)
     refinable = add_limit_rows(rows, nlp, layout)
     objective = _objective(rows, c, torque, states, times, (rate, peak, losses))
     problem = {"x": c.x, "p": ca.vertcat(c.p_case, c.p_scale), "f": objective, "g": ca.vertcat(*rows.g)}

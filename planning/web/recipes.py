@@ -41,11 +41,10 @@ def recipe_names(folder: Path) -> list[str]:
     return sorted(p.stem for p in folder.glob("*.yaml") if p.is_file() and RECIPE_NAME.fullmatch(p.stem))
 
 
-def save_recipe(folder: Path, name: str, data: dict) -> Path:
-    """Write ``data`` (a case already validated) as recipe ``name``, replacing one of that name."""
-    path = recipe_path(folder, name)
+def save_recipe(path: Path, data: dict) -> None:
+    """Write ``data`` (a case already validated) to ``path`` (:func:`recipe_path`'s), replacing a recipe there."""
     text = yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
-    handle, temporary = tempfile.mkstemp(dir=folder, prefix=".recipe-", suffix=".tmp")
+    handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=".recipe-", suffix=".tmp")
     try:
         with os.fdopen(handle, "w", encoding="utf-8") as out:
             out.write(text)
@@ -54,4 +53,3 @@ def save_recipe(folder: Path, name: str, data: dict) -> Path:
     except BaseException:
         Path(temporary).unlink(missing_ok=True)
         raise
-    return path

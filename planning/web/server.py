@@ -340,7 +340,7 @@ def _recipe_routes(app: Flask, shared: _Shared) -> None:
         except CaseFileError as exc:  # only a case that reads is kept
             return jsonify({"status": Outcome.BAD_INPUT, "message": str(exc), "field": exc.field})
         try:
-            save_recipe(folder(), name, _data(case))
+            save_recipe(path, _data(case))
         except OSError as exc:  # the folder read-only, full, or the name taken by a folder
             message = f"recipe {name}: cannot be written to the recipes' folder ({exc.strerror or exc})"
             return jsonify({"status": Outcome.ERROR, "message": message, "field": "recipe"})
