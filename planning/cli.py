@@ -55,6 +55,11 @@ def _case_commands(sub) -> None:  # noqa: ANN001 - argparse's sub-parsers
     n.add_argument("file", help="the case file to write (YAML; not over an existing file)")
     n.add_argument("--mechanism", choices=MECHANISMS, default="crank-slider", help="the press (default crank-slider)")
     n.add_argument("--drive", action="store_true", help="with a drive: section (motor, masses, forming force)")
+    n.add_argument(
+        "--robots",
+        action="store_true",
+        help="with an unloader and a loader on their interference curves instead of one safety height",
+    )
     c = sub.add_parser("check", help="key points and process checks of a case (no solve)")
     _case_argument(c)
     c.add_argument("--json", action="store_true", help="print JSON instead of the table")
@@ -624,7 +629,8 @@ def _bound(case, args) -> int:
         f"{case.name}: time-optimal bound {bound.spm:.3f} strokes/min, cycle {bound.cycle_time_s:.4f} s "
         f"({bound.points} intervals{_more_than_asked(bound.points, args.points)}; peak crank speed "
         f"{data['peak_crank_speed_rpm']:.2f} rpm, draw {bound.draw_speed_rpm:.3f} rpm, "
-        f"idle time in the robot's window {bound.window_slack_s:.3f} s"
+        + (f"idle time for the robots {bound.window_slack_s:.3f} s" if case.robots else "")
+        + (f"idle time in the robot's window {bound.window_slack_s:.3f} s" if case.robots is None else "")
         + (f"; crank jerk <= {bound.crank_jerk_limit_rad_s3:g} rad/s^3)" if bound.crank_jerk_limit_rad_s3 else ")")
     )
     if upper is not None:
@@ -698,10 +704,10 @@ def _new(args) -> int:
     if path.suffix.lower() not in (".yaml", ".yml"):
         raise CommandError(f"{path}: a case file ends in .yaml")
     try:
-        write_new_case(path, args.mechanism, args.drive)
+        write_new_case(path, args.mechanism, args.drive, args.robots)
     except FileExistsError:
         raise CommandError(f"{path}: exists already (choose another name; nothing was written)") from None
-    kind = f"a {args.mechanism} case{' with a drive' if args.drive else ''}"
+    kind = f"a {args.mechanism} case{' with a drive' if args.drive else ''}{' with robots' if args.robots else ''}"
     print(f"{path}: {kind}, commented field by field, to edit. Next: pressplan check {path}")
     return EXIT_OK
 

@@ -255,7 +255,7 @@ def repair(
                 same = np.allclose(plan.key_angles, case.key_angles, atol=SAME_ANGLE_RAD)
                 # the robot's window first: the verification's own check, without its dense grid (a faster
                 # neighbour in a sweep of the transfer time fails it, and only it)
-                short = plan.transfer_window() < case.process.transfer_time_s - TIME_TOL_S
+                short = case.robots is None and plan.transfer_window() < case.process.transfer_time_s - TIME_TOL_S
                 if same and not short:
                     evaluation = evaluate(plan, case)  # handed over with the plan: not evaluated again
                     if evaluation.verification.passed:

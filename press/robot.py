@@ -154,11 +154,16 @@ class Robot:
     def position(self, t_s: np.ndarray, start_s: float, period_s: float) -> np.ndarray:
         """The position [mm] at cycle times ``t_s`` [s] of a robot that leaves its waiting point at ``start_s``
         [s] each cycle of ``period_s`` [s] (in, dwell, out, then waiting)."""
-        move = self.move
         if self.occupancy_s > period_s:
             took = f"in, dwell and out take {self.occupancy_s:g} s"
             raise ValueError(f"{self.name}: {took}, longer than the cycle {period_s:g} s")
-        tau = np.mod(np.asarray(t_s, dtype=float) - start_s, period_s)
+        return self.position_since_start(np.mod(np.asarray(t_s, dtype=float) - start_s, period_s))
+
+    def position_since_start(self, tau_s: np.ndarray) -> np.ndarray:
+        """The position [mm] at times ``tau_s`` [s] from leaving its waiting point (at it again after its
+        occupancy)."""
+        move = self.move
+        tau = np.asarray(tau_s, dtype=float)
         inward = self.path_mm - move.state(tau)[0]
         outward = move.state(tau - move.duration_s - self.dwell_s)[0]
         out_starts = move.duration_s + self.dwell_s
@@ -168,3 +173,67 @@ class Robot:
     def needed_height(self, t_s: np.ndarray, start_s: float, period_s: float) -> np.ndarray:
         """The slide height [mm] the tool needs at cycle times ``t_s`` [s] (:meth:`position`'s schedule)."""
         return self.curve.need(self.position(t_s, start_s, period_s))
+
+
+def crossing_offsets(robot: Robot) -> np.ndarray:
+    """The times [s from the robot's start] at which its tool passes its interference curve's points, in and
+    out (sorted): the curve's kinks and its last step, where a sampled clearance must look exactly."""
+    move, out = robot.move, []
+    for x in robot.curve.positions_mm:
+        if not 0.0 < x < robot.path_mm:
+            continue
+        for travelled, since in ((robot.path_mm - x, 0.0), (x, move.duration_s + robot.dwell_s)):
+            lo, hi = 0.0, move.duration_s
+            for _ in range(BISECTIONS):  # the distance travelled is monotone in time
+                mid = 0.5 * (lo + hi)
+                lo, hi = (mid, hi) if float(move.state(mid)[0][()]) < travelled else (lo, mid)
+            out.append(since + hi)
+    return np.sort(np.array(out, dtype=float))
+
+
+def clear_position_mm(curve: InterferenceCurve) -> float:
+    """The position [mm] from which on the tool needs nothing: clear of the die (the point after the last that
+    needs height, or the last point, beyond which the curve is zero)."""
+    heights = np.asarray(curve.needed_height_mm)
+    needing = np.flatnonzero(heights > 0)
+    if needing.size == 0:
+        return 0.0
+    k = int(needing[-1])
+    return float(curve.positions_mm[min(k + 1, len(heights) - 1)])
+
+
+def time_to_clear_s(robot: Robot) -> float:
+    """The time [s] from the start of the robot's move out until its tool is clear of the die
+    (:func:`clear_position_mm`; the whole move where the tool is clear only at its waiting point)."""
+    move, target = robot.move, min(clear_position_mm(robot.curve), robot.path_mm)
+    lo, hi = 0.0, move.duration_s
+    for _ in range(BISECTIONS):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if float(move.state(mid)[0][()]) < target else (lo, mid)
+    return hi
+
+
+BISECTIONS = 60  # halvings of a move's duration: below round-off of any move under a day
+
+
+def sample_offsets(robot: Robot, count: int) -> np.ndarray:
+    """``count`` times [s from the robot's start] over its occupancy: the curve's crossings
+    (:func:`crossing_offsets`) and evenly spaced times between, sorted (a fixed number, so that an NLP's rows
+    keep their shape)."""
+    crossings = crossing_offsets(robot)
+    even = np.linspace(0.0, robot.occupancy_s, max(count - crossings.size, 2))
+    return np.sort(np.concatenate([even, crossings]))[:count]
+
+
+def time_needing(
+    robot: Robot, level_mm: float, within_s: tuple[float, float] | None = None, grid: int = 20_001
+) -> float:
+    """A lower bound on the time [s] in one occupancy (or its part ``within_s``: from, to [s from the start])
+    during which the tool needs at least ``level_mm``: ``grid`` even times, a step counted where the need
+    reaches the level at both its ends (never more than the true time; the upper bounds' robot rows rest on
+    it)."""
+    lo, hi = within_s if within_s is not None else (0.0, robot.occupancy_s)
+    tau = np.linspace(lo, hi, grid)
+    need = robot.curve.need(robot.position_since_start(tau))
+    both = (need[:-1] >= level_mm) & (need[1:] >= level_mm)
+    return float(np.sum(np.diff(tau)[both]))

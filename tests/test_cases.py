@@ -21,5 +21,11 @@ def test_case_solves_and_verifies(path):
     assert free.plan.spm >= published.plan.spm - 1e-9
     tab = trajectory(free, case)
     assert abs(tab["slider_accel_mm_s2"]).max() <= case.limits.slider_accel_mm_s2 * (1 + 1e-6)
-    assert free.plan.transfer_window() >= case.process.transfer_time_s - 1e-6
+    if case.robots is None:
+        assert free.plan.transfer_window() >= case.process.transfer_time_s - 1e-6
+    else:  # the robots' clearance at every sample, from their own positions
+        t = tab["time_s"]
+        for robot in case.robots_on_path:
+            need = robot.needed_height(t, free.plan.robot_starts_s[robot.name], free.plan.period)
+            assert (tab["slider_height_mm"] - need)[need > 0].min() >= -1e-6 * need.max()
     assert upper_bound(case, 180, 2).spm >= free.plan.spm  # certified: no verified motion above it

@@ -45,6 +45,8 @@ def legend_overlaps(fig: Figure) -> list[str]:
 def limits_of(case) -> list[str]:  # noqa: ANN001 - a Case
     """Every limit the case sets, by its dotted field."""
     fields = [f"limits.{k}" for k, v in case.limits.model_dump().items() if v is not None]
+    if case.robots is not None:  # each robot's tool: the height it needs, on the slide's panel
+        return [*(f"robots.{robot.name}" for robot in case.robots_on_path), *fields]
     return ["process.safety_height_mm", *fields]
 
 

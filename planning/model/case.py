@@ -20,6 +20,7 @@ from pydantic import BaseModel, ConfigDict, Field, create_model
 from planning.model.errors import CaseError, show_value
 from planning.model.laws import DEFAULT_LAW, LAWS, LawName
 from planning.model.limits import LIMITS, Draw
+from planning.model.limits.robots import span_s
 from planning.model.units import (
     RPM,
     Angle,
@@ -44,6 +45,7 @@ from press.crank_slider import CrankSlider
 from press.dynamics import DriveModel, LinkMass
 from press.linkage import KnuckleJoint, LinkageError, LinkDrive
 from press.mechanism import Mechanism
+from press.robot import InterferenceCurve, MoveLimits, Robot
 
 Placement = Literal["free", "published"]  # where theta1 / theta4 may fall (the paper's Fig. 6, or anywhere)
 Objective = Literal["max-spm", "min-rms-torque", "min-energy", "min-grid-peak"]  # what the planner optimises
@@ -214,14 +216,21 @@ class KeyPointsModel(_Model):
 
 
 class ProcessModel(_Model):
-    """``safety_height_mm`` [mm above BDC], ``transfer_time_s`` [s], ``draw_speed_rpm`` [rpm] or None."""
+    """``safety_height_mm`` [mm above BDC], ``transfer_time_s`` [s] (both required without robots, refused with
+    them), ``draw_speed_rpm`` [rpm] or None."""
 
-    safety_height_mm: Annotated[float, Field(gt=0, le=40_000)] = Field(
+    safety_height_mm: Annotated[float, Field(gt=0, le=40_000)] | None = Field(
+        None,
         title="safety height [mm above BDC]",
-        description="The transfer robot's height: the slide stays at or above it from θ4 through TDC to θ1.",
+        description=(
+            "The transfer robot's height: the slide stays at or above it from θ4 through TDC to θ1 (required "
+            "without a robots: section, which replaces it)."
+        ),
     )
-    transfer_time_s: Seconds = Field(
-        title="transfer time [s]", description="The least time the robot needs from θ4 to θ1."
+    transfer_time_s: Seconds | None = Field(
+        None,
+        title="transfer time [s]",
+        description="The least time the robot needs from θ4 to θ1 (required without a robots: section).",
     )
     draw_speed_rpm: CrankSpeed | None = Field(
         None,
@@ -465,6 +474,55 @@ class PublishedModel(_Model):
     solution: PublishedSolution | None = None
 
 
+
+MAX_CURVE_POINTS = 16  # points of an interference curve (its crossings are rows of the NLP: a fixed share)
+CurvePoint = Annotated[list[float], Field(min_length=2, max_length=2)]  # [position mm, needed height mm]
+CurveTable = Annotated[list[CurvePoint], Field(min_length=1, max_length=MAX_CURVE_POINTS)]
+PathSpeed = Annotated[float, Field(ge=1.0, le=1e5)]  # [mm/s] a robot's speed along its path
+PathAccel = Annotated[float, Field(ge=1.0, le=1e7)]  # [mm/s^2]
+PathJerk = Annotated[float, Field(ge=1.0, le=1e10)]  # [mm/s^3]
+RobotOrder = Literal["overlapping", "in-turns"]  # how the loader follows the unloader
+
+
+class RobotModel(_Model):
+    """A press-tending robot on its path (``press.robot``): from the die centre (0) to its waiting point
+    (``path_mm``), its limits along the path, its dwell at the die centre and its interference curve."""
+
+    path_mm: Length = Field(
+        title="path [mm]", description="From the die centre, where the tool grips or drops, to the waiting point."
+    )
+    speed_mm_s: PathSpeed = Field(title="speed [mm/s]", description="The robot's top speed along its path.")
+    accel_mm_s2: PathAccel = Field(title="acceleration [mm/s²]", description="Its acceleration limit along the path.")
+    jerk_mm_s3: PathJerk | None = Field(
+        None, title="jerk [mm/s³]", description="Its jerk limit along the path; empty: none (trapezoid moves)."
+    )
+    dwell_s: Annotated[float, Field(ge=0, le=1e4)] = Field(
+        0.0, title="dwell at the die [s]", description="The time the tool stands at the die centre to grip or drop."
+    )
+    interference_mm: CurveTable = Field(
+        title="interference curve [mm, mm]",
+        description=(
+            "Rows of the tool's position (mm from the die centre) and the slide height it needs there (mm above "
+            "BDC), linear between rows, zero beyond the last (the tool clear of the die)."
+        ),
+    )
+
+
+class RobotsModel(_Model):
+    """The robots that tend the press (``planning.model.limits.robots``): an ``unloader`` (takes the part out)
+    and a ``loader`` (brings the blank in), either may be left out; ``order``: ``overlapping`` (the loader
+    reaches the die centre once the unloader's tool is clear of the die) or ``in-turns`` (the loader leaves its
+    waiting point once the unloader is back at its own)."""
+
+    order: RobotOrder = Field(
+        "overlapping",
+        title="order",
+        description="overlapping: the loader comes in while the unloader goes out; in-turns: one after the other.",
+    )
+    unloader: RobotModel | None = None
+    loader: RobotModel | None = None
+
+
 class Case(_Model):
     """A whole case file."""
 
@@ -473,9 +531,10 @@ class Case(_Model):
     source: Annotated[str, Field(max_length=2000)] = ""
     press: PressModel
     key_points: KeyPointsModel
-    process: ProcessModel
+    process: ProcessModel = ProcessModel()
     limits: LimitsModel
     drive: DriveSection | None = None
+    robots: RobotsModel | None = None
     planner: PlannerModel = PlannerModel()
     published: PublishedModel | None = None
 
@@ -497,6 +556,30 @@ class Case(_Model):
         """theta1..theta4 [rad]."""
         k = self.key_points
         return np.radians([k.closing_deg, k.draw_start_deg, k.draw_end_deg, k.opening_deg])
+
+    @property
+    def transfer_time_s(self) -> float:
+        """The time [s] the transfer needs between the draws: ``process.transfer_time_s``, or with robots the
+        least time from the first leaving its waiting point to the last back (``limits.robots.span_s``): what
+        the starts and the storage's smoothing scale with."""
+        if self.robots is None:
+            return self.process.transfer_time_s
+        return span_s(self)
+
+    @property
+    def robots_on_path(self) -> tuple[Robot, ...]:
+        """The case's robots (``press.robot.Robot``), the unloader first; empty without a ``robots:`` section."""
+        if self.robots is None:
+            return ()
+        out = []
+        for name in ROBOT_NAMES:
+            r = getattr(self.robots, name)
+            if r is not None:
+                limits = MoveLimits(r.speed_mm_s, r.accel_mm_s2, r.jerk_mm_s3)
+                table = r.interference_mm
+                curve = InterferenceCurve(tuple(float(p) for p, _ in table), tuple(float(h) for _, h in table))
+                out.append(Robot(name, r.path_mm, limits, r.dwell_s, curve))
+        return tuple(out)
 
     @property
     def drive_model(self) -> DriveModel | None:
@@ -549,6 +632,7 @@ class Case(_Model):
         return case
 
 
+ROBOT_NAMES = ("unloader", "loader")  # the robots a case may have, in the order they move
 KEY_POINT_NAMES = ("closing", "draw_start", "draw_end", "opening")
 KEY_POINT_FIELDS = ("closing_deg", "draw_start_deg", "draw_end_deg", "opening_deg")
 
@@ -566,6 +650,7 @@ def cross_checks(case: Case) -> None:
                 f"must be greater than key_points.{KEY_POINT_FIELDS[i - 1]} = {angles[i - 1]:g} deg (cycle order)",
                 angles[i],
             )
+    _transfer_checks(case)
     for limit in LIMITS:
         limit.validate(case)
     fixed = case.planner.law_parameter
@@ -697,6 +782,52 @@ def _drive_mass_checks(case: Case) -> None:
     for name in d.links or {}:
         if name not in names:
             raise CaseError(f"drive.links.{name}", f"a {kind} press's links are {', '.join(names)}", name)
+
+
+def _transfer_checks(case: Case) -> None:
+    """The old model's two fields without robots, none with them; a robot's interference curve a table of
+    positions along its path (increasing, within it) and heights within the stroke, clear at its waiting
+    point."""
+    process = case.process
+    if case.robots is None:
+        for key in ("safety_height_mm", "transfer_time_s"):
+            if getattr(process, key) is None:
+                raise CaseError(f"process.{key}", "is required (or a robots: section, which replaces it)", None, False)
+        return
+    for key in ("safety_height_mm", "transfer_time_s"):
+        if getattr(process, key) is not None:
+            reason = "is the one-height model: the robots: section replaces it; leave it out"
+            raise CaseError(f"process.{key}", reason, getattr(process, key))
+    if case.robots.unloader is None and case.robots.loader is None:
+        raise CaseError("robots", "names no robot: give an unloader:, a loader: or both", None, False)
+    stroke = case.machine.stroke
+    for name in ROBOT_NAMES:
+        robot = getattr(case.robots, name)
+        if robot is not None:
+            _curve_checks(f"robots.{name}", robot, stroke)
+
+
+def _curve_checks(where: str, robot: RobotModel, stroke: float) -> None:
+    """One robot's interference curve (:func:`_transfer_checks`)."""
+    field = f"{where}.interference_mm"
+    positions = [p for p, _ in robot.interference_mm]
+    for k, (x, need) in enumerate(robot.interference_mm):
+        if not 0 <= x <= robot.path_mm:
+            raise CaseError(f"{field}.{k}", f"position must lie on the path 0 ... {robot.path_mm:g} mm", x)
+        if need < 0:
+            raise CaseError(f"{field}.{k}", "height must be at least 0 mm above BDC", need)
+        if need > stroke:
+            reason = f"needs the slide {need:g} mm above BDC, above the stroke {stroke:g} mm: it can never pass"
+            raise CaseError(f"{field}.{k}", reason, need)
+    if any(b <= a for a, b in zip(positions, positions[1:], strict=False)):
+        raise CaseError(field, "positions must increase from row to row", positions)
+    last_x, last_need = robot.interference_mm[-1]
+    if last_x >= robot.path_mm and last_need > 0:
+        reason = (
+            f"the tool needs {last_need:g} mm at its waiting point ({where}.path_mm = {robot.path_mm:g}): it must "
+            "be clear of the die there (end the curve before the path's end, or at 0 mm)"
+        )
+        raise CaseError(field, reason, last_need)
 
 
 def _law_checks(case: Case) -> None:

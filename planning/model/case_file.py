@@ -166,6 +166,8 @@ def case_from_data(data: Any, label: str = "<case>") -> Case:
         raise CaseFileError(f"{label}: the file is empty")
     if not isinstance(data, dict):
         raise CaseFileError(f"{label}: expected a mapping of case fields at the top level (got {type(data).__name__})")
+    if "process" in data and data["process"] is None:  # every process field optional: a section of comments
+        data = {**data, "process": {}}
     try:
         case = Case.model_validate(data)
     except ValidationError as exc:

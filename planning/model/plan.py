@@ -48,6 +48,8 @@ class Plan:
     motion_law: str = DEFAULT_LAW
     structure: dict[str, str] = field(default_factory=dict)
     nlp_values: dict[str, float] = field(default_factory=dict, repr=False)  # the NLP variables (warm starts)
+    robot_starts_s: dict[str, float] = field(default_factory=dict)  # [s from TDC] each robot leaves its waiting point
+    robot_time_scale: float = 1.0  # the robots run their cams this many times as fast as planned (a cam's speed)
 
     @property
     def period(self) -> float:
@@ -142,7 +144,12 @@ def plan_of(
     plan = Plan(params, profile, (th1, th2, th3, th4), placement, info, motion_law=params.motion_law)
     t = plan.key_times()
     structure = {"closing": plan.segment_at(float(t[0])), "opening": plan.segment_at(float(t[3]))}
-    return replace(plan, structure=structure, nlp_values=dict(values))
+    robots = {  # the NLP's starts count from theta3
+        robot.name: float(np.mod(values[f"{robot.name}_start"] + t[2], plan.period))
+        for robot in case.robots_on_path
+        if f"{robot.name}_start" in values
+    }
+    return replace(plan, structure=structure, nlp_values=dict(values), robot_starts_s=robots)
 
 
 def params_from_numbers(values: dict[str, float], theta2: float, theta3: float, law: str) -> CycleParameters:

@@ -3,7 +3,8 @@ figures (``planning.reports.plots``) and the web page's charts.
 
 A :class:`LimitLine` bounds one trajectory column (``quantity``) with ``upper`` (and ``lower`` for a
 two-sided limit) given per sample, NaN where the limit does not apply: the safety height only in the
-robot's window, the die speed only where the slide is at or below the die height. The draw-start speed
+robot's window, the die speed only where the slide is at or below the die height, a robot's tool's need only
+where its tool is over the die. The draw-start speed
 holds at theta2 alone: a ``point`` line, one sample there. Labels name the case field and the value.
 """
 
@@ -25,6 +26,8 @@ COLOURS = {  # by case field, the figures' and the page's; the curve a limit bou
     "limits.slider_speed_mm_s": "#2e8b57",
     "limits.draw_start_speed_mm_s": "#006400",
     "limits.slider_accel_mm_s2": "#cc5500",
+    "robots.unloader": "#d62728",  # matplotlib's tab:red and tab:green, as the interference figure's
+    "robots.loader": "#2ca02c",
 }
 
 
@@ -114,4 +117,9 @@ def limit_lines(result: dict[str, Any], columns: dict[str, np.ndarray], axis: st
                 point=True,
             )
         )
+    for robot in (result.get("robots") or {}).get("robots", ()):  # each tool's need where it needs any
+        need = np.asarray(columns[f"{robot['name']}_needed_height_mm"], dtype=float)
+        label = f"robots.{robot['name']}: the height its tool needs"
+        upper = np.where(need > 0, need, np.nan)
+        lines.append(LimitLine(f"robots.{robot['name']}", label, "slider_height_mm", x, upper))
     return lines

@@ -184,14 +184,72 @@ TITLES = {
 }
 
 
-def new_case_text(name: str, path: str, mechanism: str = "crank-slider", drive: bool = False) -> str:
+def new_case_text(
+    name: str, path: str, mechanism: str = "crank-slider", drive: bool = False, robots: bool = False
+) -> str:
     """The text of a first case for ``mechanism`` (one of :data:`MECHANISMS`), with a drive section when
-    ``drive``; ``name`` is the case's name, ``path`` where it is written (for the commands in its head)."""
+    ``drive``, with an unloader and a loader on their interference curves instead of the safety height and
+    the transfer time when ``robots``; ``name`` is the case's name, ``path`` where it is written (for the
+    commands in its head)."""
     text = _HEAD.format(name=name, path=path, title=TITLES[mechanism]) + _PRESS[mechanism]
     if drive:  # the forming force the motor works against, in the process section
         force = "  # the forming force against the slide's height above BDC [mm, kN]\n" + _FORCE[mechanism] + "\n"
         text = text.replace("limits:\n", force + "limits:\n", 1)
-    return text + _PLANNER + (_DRIVE[mechanism] if drive else "")
+    tail = ""
+    if robots:
+        text, tail = _with_robots(text)
+    return text + tail + _PLANNER + (_DRIVE[mechanism] if drive else "")
+
+
+def _with_robots(text: str) -> tuple[str, str]:
+    """The template without its safety height and transfer time, and the robots' section that replaces them:
+    two robots whose moves, one after the other with their tools needing the safety height, take the transfer
+    time (a move of 0.45 f s, a dwell of 0.1 f s, f half the transfer time; the path and the curve's positions
+    scale with f^2 at the same acceleration)."""
+    lines, safety, transfer = [], 700.0, 2.0
+    for line in text.splitlines(keepends=True):
+        key = line.strip().split(":")[0]
+        if key in ("safety_height_mm", "transfer_time_s"):
+            value = float(line.split(":")[1].split("#")[0])
+            safety, transfer = (value, transfer) if key == "safety_height_mm" else (safety, value)
+            continue
+        lines.append(line)
+    f = transfer / 2
+    robot = _robot_text(
+        path=1000 * f * f, speed=4000 * f, dwell=0.1 * f, over=600 * f * f, clear=750 * f * f, need=safety
+    )
+    section = _ROBOTS_HEAD + "  unloader:                          # takes the drawn part out\n" + robot
+    section += "  loader:                            # brings the next blank in\n" + robot
+    return "".join(lines), section
+
+
+_ROBOTS_HEAD = """\
+robots:                              # the robots on their interference curves (docs/robots.md); they replace
+                                     # process.safety_height_mm and process.transfer_time_s
+  order: overlapping                 # overlapping: the loader comes in while the unloader goes out; in-turns
+"""
+_ROBOT = (  # (field line, comment): the comments aligned as the other sections'
+    ("    path_mm: {path:g}", "from the die centre (0) to its waiting point outside the press"),
+    ("    speed_mm_s: {speed:g}", "along its path, at most"),
+    ("    accel_mm_s2: 20000", "along its path, at most"),
+    ("    # jerk_mm_s3: 400000", "optional: its jerk limit (smooth double-S moves instead of trapezoids)"),
+    ("    dwell_s: {dwell:g}", "standing at the die centre to grip or drop"),
+    ("    interference_mm:", "[position from the die centre mm, slide height its tool needs mm above BDC]"),
+    ("      - [0, {need:g}]", "over the die ..."),
+    ("      - [{over:g}, {need:g}]", ""),
+    ("      - [{clear:g}, 0]", "... clear of it from here out (zero beyond the last row)"),
+)
+COMMENT_COLUMN = 37  # where a template's comments start
+
+
+def _robot_text(**values: float) -> str:
+    """One robot's lines of the template (:data:`_ROBOT`) with ``values``."""
+    lines = []
+    for field, comment in _ROBOT:
+        text = field.format(**values)
+        lines.append(text.ljust(COMMENT_COLUMN - 1) + (f" # {comment}" if comment else "") + "\n")
+    return "".join(line.rstrip() + "\n" for line in lines)
+
 
 
 def drive_template(mechanism: str) -> dict:
@@ -204,9 +262,20 @@ def drive_template(mechanism: str) -> dict:
     return {"drive": drive, "forming_force_kN": force}
 
 
-def write_new_case(path: Path, mechanism: str = "crank-slider", drive: bool = False) -> None:
+def robots_template(mechanism: str) -> dict:
+    """The robots' section :func:`new_case_text` writes for ``mechanism`` and the one-height model's fields it
+    replaces (the page's "add robots" and "remove the robots")."""
+    import yaml
+
+    text, section = _with_robots(_PRESS[mechanism])
+    process = yaml.safe_load(_PRESS[mechanism])["process"]
+    one_height = {key: process[key] for key in ("safety_height_mm", "transfer_time_s")}
+    return {"robots": yaml.safe_load(section)["robots"], "one_height": one_height}
+
+
+def write_new_case(path: Path, mechanism: str = "crank-slider", drive: bool = False, robots: bool = False) -> None:
     """Write :func:`new_case_text` to ``path`` (named after the file); never over an existing file
     (``FileExistsError``)."""
-    text = new_case_text(path.stem, str(path), mechanism, drive)
+    text = new_case_text(path.stem, str(path), mechanism, drive, robots)
     with path.open("x", encoding="utf-8") as f:
         f.write(text)

@@ -49,12 +49,13 @@ def read_table(path: Path) -> dict[str, np.ndarray]:
 
 
 def _decorate(ax, result: dict[str, Any], axis: str, x: np.ndarray, label: bool) -> None:
-    """The robot's window shaded (its achieved time written once), the draw shaded, the key points as
-    dotted lines."""
+    """The robot's window shaded (its achieved time written once; none with robots on their interference
+    curves), the draw shaded, the key points as dotted lines."""
     window = result.get("transfer_window_s")
     required = result.get("process", {}).get("transfer_time_s")
     text = f"robot window θ4 → θ1: {window:.3f} s" + (f" (≥ {required:g} s)" if required is not None else "")
-    for i, (a, b) in enumerate(robot_windows(result, axis, x)):
+    windows = [] if result.get("robots") else robot_windows(result, axis, x)  # robots: their curves, no window
+    for i, (a, b) in enumerate(windows):
         ax.axvspan(a, b, color=WINDOW_COLOUR, alpha=0.7, lw=0, zorder=0, label=text if label and i == 0 else None)
     keys = {k["name"]: k for k in result["key_points"]}
     at = "time_s" if axis == "time" else "angle_deg"
@@ -241,7 +242,46 @@ def plot_files(
         out[f"energy.{fmt}"] = energy_figure(result, traj)
     if "capacity" in result:
         out[f"capacity.{fmt}"] = capacity_figure(result, traj)
+    if "robots" in result:
+        out[f"interference.{fmt}"] = interference_figure(result, traj)
     return out
+
+
+ROBOT_COLOURS = {"unloader": "#d62728", "loader": "#2ca02c"}  # matplotlib's tab:red and tab:green
+
+
+def interference_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
+    """The robots on their interference curves over one cycle: the slide's height and the height each tool
+    needs (where it needs any), the least clearance marked; below, each tool's position on its path, the time
+    it spends over the die shaded."""
+    fig = Figure(figsize=(12, 6.4), layout="constrained")
+    FigureCanvasAgg(fig)
+    heights, paths = fig.subplots(2, 1, sharex=True, height_ratios=(3, 2))
+    t = traj["time_s"]
+    heights.plot(t, traj["slider_height_mm"], color="#1f77b4", lw=1.8, label="slide height")
+    for r in result["robots"]["robots"]:
+        name, colour = r["name"], ROBOT_COLOURS.get(r["name"], "k")
+        need = np.asarray(traj[f"{name}_needed_height_mm"], dtype=float)
+        heights.plot(t, np.where(need > 0, need, np.nan), color=colour, lw=1.4, label=f"height the {name}'s tool needs")
+        if r["least_clearance_mm"] is not None:
+            at = r["least_clearance_time_s"]
+            label = f"{name}: least clearance {round(r['least_clearance_mm'], 2) + 0.0:.2f} mm"  # no "-0.00"
+            heights.plot([at], [r["needed_there_mm"]], "v", color=colour, ms=7, label=label)
+        position = traj[f"{name}_position_mm"]
+        paths.plot(t, position, color=colour, lw=1.4, label=f"{name} on its path")
+        paths.fill_between(t, 0, position, where=need > 0, color=colour, alpha=0.15, lw=0)
+    heights.set_ylabel("height above BDC [mm]")
+    heights.set_ylim(bottom=0)
+    heights.legend(loc="upper center", fontsize=8)  # the draw's part: the tools are out, the slide low
+    heights.set_title(f"robots on their interference curves ({result['robots']['order']})", fontsize=9, loc="left")
+    paths.set_ylabel("position from the die centre [mm]")
+    paths.set_xlabel("time from TDC [s]")
+    paths.set_ylim(bottom=0)
+    paths.legend(loc="center", fontsize=8, title="shaded: the tool over the die", title_fontsize=8)
+    for ax in (heights, paths):
+        ax.grid(alpha=0.3)
+        ax.set_xlim(t[0], t[-1])
+    return fig
 
 
 def capacity_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:

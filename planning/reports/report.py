@@ -20,6 +20,7 @@ from planning.model.limits.slider_accel import SliderAccelLimit
 from planning.model.outcome import Outcome
 from planning.model.profile import MAX_STEP_S, Profile
 from planning.model.units import rounded_down
+from planning.reports.robots import robot_columns, robot_lines, robot_values, robots_block
 from planning.reports.source_solution import paper_solution
 from planning.reports.stages import stage_table
 from planning.solver.solution import ENERGY, GRID_PEAK, Solution
@@ -56,9 +57,10 @@ def sample_profile(profile: Profile, machine: Mechanism, max_step: float = MAX_S
 
 def trajectory_columns(case: Case) -> tuple[str, ...]:
     """The columns of ``trajectory.csv`` for ``case``."""
-    if case.drive is None:
-        return TRAJECTORY_COLUMNS
-    return TRAJECTORY_COLUMNS + DRIVE_COLUMNS + (POWER_COLUMNS if case.electrical else ())
+    columns = TRAJECTORY_COLUMNS
+    if case.drive is not None:
+        columns += DRIVE_COLUMNS + (POWER_COLUMNS if case.electrical else ())
+    return columns + robot_columns(case)
 
 
 def trajectory(solution: Solution, case: Case, most: int = MAX_ROWS) -> dict[str, np.ndarray]:
@@ -80,6 +82,7 @@ def columns_at(evaluation: Evaluation, case: Case, rows: np.ndarray) -> dict[str
             c = evaluation.power_columns
             columns += [c["copper_loss_W"] / 1e3, c["bus_power_W"] / 1e3, c["grid_power_W"] / 1e3]
             columns.append(c["storage_energy_J"] / 1e3)
+    columns += robot_values(d, case)
     return {name: np.asarray(column)[rows] for name, column in zip(trajectory_columns(case), columns, strict=True)}
 
 
@@ -171,6 +174,7 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
         **({"drive": drive_block(solution, case)} if case.drive is not None else {}),
         **({"capacity": capacity_block(case)} if case.press.capacity is not None else {}),
         **({"power": solution.drive.power.as_dict()} if solution.drive and solution.drive.power else {}),
+        **({"robots": robots_block(solution, case)} if case.robots is not None else {}),
         **objective_block(solution, case),
         "verification": {
             "passed": ver.passed,
@@ -262,7 +266,8 @@ def objective_block(solution: Solution, case: Case) -> dict[str, Any]:
 def summary_text(result: dict[str, Any]) -> str:
     """The console summary of a result dictionary."""
     r = result
-    lines = _plan_lines(r) + _key_point_lines(r) + _stage_lines(r) + _drive_lines(r) + _objective_lines(r)
+    lines = _plan_lines(r) + _key_point_lines(r) + _stage_lines(r) + robot_lines(r) + _drive_lines(r)
+    lines += _objective_lines(r)
     lines.append("")
     lines.append("  binding: " + (", ".join(r["binding_constraints"]) or "none"))
     v = r["verification"]
@@ -293,7 +298,8 @@ def _plan_lines(r: dict[str, Any]) -> list[str]:
         if hd
         else f"  free profile: {r['segment_count']} segments of constant jerk (no halves), "
         f"|jerk| <= {r['limits']['crank_jerk_rad_s3']:g} rad/s^3",
-        f"  robot window theta4 -> theta1: {r['transfer_window_s']:.4f} s; "
+        f"  {'theta4 -> theta1' if r.get('robots') else 'robot window theta4 -> theta1'}: "
+        f"{r['transfer_window_s']:.4f} s; "
         f"max |slider accel| {r['max_abs_slider_accel_mm_s2']:.1f} mm/s^2",
     ]
 

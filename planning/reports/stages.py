@@ -110,12 +110,10 @@ def _peaks_in(spans: tuple[tuple[float, float], ...], run: dict[str, Any], perio
 
 def _binding(evaluation: Evaluation) -> list[tuple[str, Any]]:
     """The checks that bind, with their case fields, in the verification's order; a field once (its first
-    check); the storage schedule's bounds apart (``planning.solver.verify.SCHEDULE_CHECKS``)."""
-    from planning.solver.verify import SCHEDULE_CHECKS, field_of_check
+    check); the storage schedule's bounds and the robots' own moves apart (``Verification.binding``)."""
+    from planning.solver.verify import field_of_check
 
     out: dict[str, Any] = {}
-    for check in evaluation.verification.checks:
-        if not check.binds or check.id in SCHEDULE_CHECKS:
-            continue
+    for check in evaluation.verification.binding():
         out.setdefault(field_of_check(check.id) or check.name, check)
     return list(out.items())

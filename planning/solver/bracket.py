@@ -8,7 +8,8 @@ the two sides in turn: the verified motion on a layout of more segments (:data:`
 first layout's), the upper bound on a grid of more intervals (:data:`UPPER_MESHES`), until the gap is under
 the tolerance or the refinements run out, or stall (a side that closed less than :data:`STALL_SHARE` of the
 gap is refined no further: the gap is then the relaxation's, e.g. limits it leaves out, or the motion's).
-The gap reached is reported, not hidden.
+The gap reached is reported, not hidden. With robots the verified side is not refined (their rows tie every
+segment of the free profile together: a finer layout's NLP grows with the square of its segments).
 
 A case without a crank-jerk limit allows any jerk: the verified motion is planned under an allowance of
 :data:`JERK_ALLOWANCE` times the press's characteristic jerk (speed scale over time scale squared), which
@@ -112,7 +113,9 @@ def bracket(case: Case, tolerance_pct: float = BRACKET_TOL_PCT) -> Bracket:
     verified = _checked(fastest, solve_optimal(planned))
     upper = upper_bound(fastest, UPPER_MESHES[0], 1)
     rounds = [BracketRound(verified.plan.spm, upper.spm, gap_pct(verified.plan.spm, upper.spm))]
-    layouts = [finer(PHASES, f) for f in LAYOUT_FACTORS]
+    # with robots the verified motion stays on the first layout: their rows tie every segment of the profile
+    # (the slide's height at a robot's time sums them all), so a finer layout's NLP grows with its square
+    layouts = [finer(PHASES, f) for f in LAYOUT_FACTORS] if case.robots is None else []
     meshes = list(UPPER_MESHES[1:])
     turn = 0
     while rounds[-1].gap_pct > tolerance_pct and (layouts or meshes):

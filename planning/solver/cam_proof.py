@@ -92,7 +92,8 @@ class CamProof:
 def run(cam: Cam, plan: Plan, case: Case, speed: float = 1.0, cycle_s: float = CONTROLLER_CYCLE_S) -> Evaluation:
     """The dense verification of ``cam`` run at ``speed`` times the plan's master speed."""
     profile = realised_profile(cam, plan.period / speed, cycle_s)
-    return evaluate(replace(plan, profile=profile), case, cam=True)
+    # the robots follow their cams on the same master: at ``speed`` they run that many times as fast
+    return evaluate(replace(plan, profile=profile, robot_time_scale=speed), case, cam=True)
 
 
 def prove(cam: Cam, plan: Plan, case: Case, speed: float = 1.0, cycle_s: float = CONTROLLER_CYCLE_S) -> CamProof:

@@ -30,6 +30,7 @@ from planning.model.free_profile import PHASES, Layout
 from planning.model.limits.base import Extremes, Transcription
 from planning.model.plan import Plan, SolverInfo, plan_of
 from planning.model.profile import advance
+from planning.solver.halves_nlp import ROBOT_VARIABLES
 from planning.solver.ipopt import NLPSolver
 from planning.solver.nlp import (
     CYCLE_OPTIONS,
@@ -58,8 +59,9 @@ WARM_OPTIONS = {"ipopt.mu_init": IPOPT_FREE_WARM_MU_INIT}
 
 
 @cache
-def variables_of(phases: Layout = PHASES) -> tuple[tuple[str, str], ...]:
-    """The NLP's variables and the kind of scale of each, for the phases' ``layout``."""
+def variables_of(phases: Layout = PHASES, robots: bool = False) -> tuple[tuple[str, str], ...]:
+    """The NLP's variables and the kind of scale of each, for the phases' ``layout``; with ``robots`` their
+    starts last (``planning.solver.halves_nlp.ROBOT_VARIABLES``)."""
     # the die-height crossings outside the draw: going up in the return (time from theta3), going down in
     # the feed (time from theta1)
     out: list[tuple[str, str]] = [("draw_speed", "speed"), ("die_up_time", "time"), ("die_down_time", "time")]
@@ -71,16 +73,16 @@ def variables_of(phases: Layout = PHASES) -> tuple[tuple[str, str], ...]:
             out += [
                 (f"{phase}_{name}_{k}", kind) for name, kind in zip(STATES, ("angle", "speed", "accel"), strict=True)
             ]
-    return tuple(out)
+    return tuple(out) + (ROBOT_VARIABLES if robots else ())
 
 
 VARIABLES = variables_of(PHASES)
 
 
 @cache
-def index_of(phases: Layout = PHASES) -> dict[str, int]:
-    """Each variable's position for the phases' ``layout``."""
-    return {name: i for i, (name, _) in enumerate(variables_of(phases))}
+def index_of(phases: Layout = PHASES, robots: bool = False) -> dict[str, int]:
+    """Each variable's position for the phases' ``layout`` (with the robots' starts)."""
+    return {name: i for i, (name, _) in enumerate(variables_of(phases, robots))}
 
 
 def variable_scales(case: Case, phases: Layout = PHASES) -> np.ndarray:
@@ -96,7 +98,7 @@ def variable_scales(case: Case, phases: Layout = PHASES) -> np.ndarray:
         "jerk": case.limits.crank_jerk_rad_s3,
         "time": t_star,
     }
-    return np.array([unit[kind] for _, kind in variables_of(phases)])
+    return np.array([unit[kind] for _, kind in variables_of(phases, case.robots is not None)])
 
 
 def variable_bounds(
@@ -111,7 +113,7 @@ def variable_bounds(
     the draw speed within its bounds, a die crossing's time fixed where it lies in the draw."""
     J = case.limits.crank_jerk_rad_s3
     longest = time_limit(case)
-    variables, index = variables_of(phases), index_of(phases)
+    variables, index = variables_of(phases, case.robots is not None), index_of(phases, case.robots is not None)
     lo, hi = np.full(len(variables), -np.inf), np.full(len(variables), np.inf)
     for name, kind in variables:
         i = index[name]
@@ -122,6 +124,8 @@ def variable_bounds(
             lo[i], hi[i] = 0.0, longest / dict(phases)[phase]
         elif kind == "speed":
             lo[i], hi[i] = 0.0, TOP_SPEED
+        elif name.endswith("_start"):  # a robot's start: within a period either side of theta3
+            lo[i], hi[i] = -longest, longest
     lo[index["draw_speed"]], hi[index["draw_speed"]] = w2_lo, w2_hi
     for k in ("die_down", "die_up"):
         i = index[f"{k}_time"]
@@ -147,7 +151,7 @@ def _shooting(phases: Layout, physical: ca.MX, v: dict, unit: dict, q: dict, ind
     ends = {"return": q["theta4"], "transfer": q["theta1"] + 2 * np.pi, "feed": q["theta2"] + 2 * np.pi}
     start = (q["theta3"], v["draw_speed"], ca.MX(0.0))
     t0 = ca.MX(0.0)
-    shooting, boundary, samples, times, knot_accels = [], [], [], [], []
+    shooting, boundary, samples, times, knot_accels, pieces = [], [], [], [], [], []
     crossings = {}
     for phase, n in phases:
         h = v[f"{phase}_step"]
@@ -161,6 +165,7 @@ def _shooting(phases: Layout, physical: ca.MX, v: dict, unit: dict, q: dict, ind
             when = v["die_up_time" if phase == "return" else "die_down_time"]
             tau = ca.fmin(ca.fmax(when - h * ca.DM(np.arange(n)), 0), h)
             crossings[phase] = (clipped_advance(tau, start[0], start[1], om0, al0, jerk, 0.0), when, n * h)
+        pieces.append((t0, h, n, start, om0, al0, jerk))
         th1, om1, al1, _ = advance(th0, om0, al0, jerk, 0.0, h)
         shooting.append(
             ca.vertcat(th1 - nxt[0], (om1 - nxt[1]) / unit["draw_speed"], (al1 - nxt[2]) / unit[f"{phase}_accel_1"])
@@ -185,6 +190,7 @@ def _shooting(phases: Layout, physical: ca.MX, v: dict, unit: dict, q: dict, ind
         "crossings": crossings,
         "end": start,
         "t_end": t0,
+        "pieces": pieces,
     }
 
 
@@ -223,6 +229,33 @@ def _all_samples(s: dict[str, Any], q: dict, w2: ca.MX, drive: bool) -> tuple[tu
     return states, t_all, count, om
 
 
+def _robot_terms(
+    shot: dict[str, Any], period: ca.MX, w2: ca.MX, physical: ca.MX, robots: bool, layout: ParameterLayout, q: dict
+) -> dict:
+    """The robots' part of the transcription (``halves_nlp._robot_terms``'s, for the shooting): the slide's height
+    at any time, each phase's segments in closed form from its start state (clip), then the draw, at the time
+    within the period."""
+    if not robots:
+        return {}
+    geometry = layout.geometry(q)
+
+    def height_at(times: list) -> ca.MX:
+        t = ca.vertcat(*times)
+        t = t - period * ca.floor(t / period)  # within the period (h(theta(t)) is periodic: a smooth wrap)
+        ones = ca.DM.ones(1, len(times))
+        theta = shot["pieces"][0][3][0] + w2 * ca.fmin(ca.fmax(t - shot["t_end"], 0), period - shot["t_end"])
+        for t0, h, n, _, om0, al0, jerk in shot["pieces"]:  # a phase's segments at once: times x segments
+            knots = t0 + h * ca.DM(np.arange(n))
+            tau = ca.fmin(ca.fmax(ca.repmat(t, 1, n) - (knots @ ones).T, 0), h)
+            swept = tau * (ones.T @ om0.T) + tau**2 * (ones.T @ al0.T) / 2 + tau**3 * (ones.T @ jerk.T) / 6
+            theta = theta + ca.sum2(swept)
+        return layout.formula.jets(theta, geometry)[0]
+
+    first = physical.shape[0] - len(ROBOT_VARIABLES)
+    starts = {name.removesuffix("_start"): physical[first + k] for k, (name, _) in enumerate(ROBOT_VARIABLES)}
+    return {"height_at": height_at, "robot_starts": starts, "draw_start_time": shot["t_end"]}
+
+
 def _build(
     formula: Formula, limit_ids: tuple[str, ...], drive: bool, links: tuple[str, ...] = (), phases: Layout = PHASES
 ) -> CycleNLP:
@@ -230,7 +263,8 @@ def _build(
     # Hessian of this graph in a fraction of the time a scalar SX graph of the same problem takes, and
     # evaluates them about as fast
     layout = ParameterLayout(formula, limit_ids, drive, False, links if drive else ())
-    variables, index = variables_of(phases), index_of(phases)
+    robots = "robots" in limit_ids
+    variables, index = variables_of(phases, robots), index_of(phases, robots)
     x = ca.MX.sym("x", len(variables))
     p_case = ca.MX.sym("p", layout.size)
     p_scale = ca.MX.sym("scale", len(variables))
@@ -245,9 +279,11 @@ def _build(
     states, t_all, count, speeds = _all_samples(shot, q, w2, drive)
     draw_time = (q["theta3"] - q["theta2"]) / w2
     samples, _, lift = sample_states(formula, layout, q, p_case, states, t_all, count)
+    period = shot["t_end"] + draw_time
     nlp = Transcription(
         **samples,
-        period=shot["t_end"] + draw_time,
+        **_robot_terms(shot, period, w2, physical, robots, layout, q),
+        period=period,
         window_time=phases[1][1] * v["transfer_step"],
         speeds=Extremes(speeds, signed=False, sampled=True),
         accelerations=Extremes(ca.vertcat(*shot["knot_accels"]), signed=True),
@@ -274,7 +310,19 @@ def _build(
         partial(variable_bounds, phases=phases),
         partial(make_plan, phases=phases),
         refinable=refinable,
+        complete=partial(complete_robots, phases) if robots else None,
     )
+
+
+def complete_robots(phases: Layout, values: dict[str, float]) -> dict[str, float]:
+    """``values`` with the robots' starts where a start lacks them: the unloader at theta4, the loader
+    halfway to theta1 (the transfer phase's ends)."""
+    if "unloader_start" in values:
+        return values
+    steps = dict(phases)
+    t4 = values["return_step"] * steps["return"]
+    t1 = t4 + values["transfer_step"] * steps["transfer"]
+    return {**values, "unloader_start": t4, "loader_start": 0.5 * (t4 + t1)}
 
 
 def _interleave(columns: list) -> ca.MX:

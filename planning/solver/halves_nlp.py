@@ -39,8 +39,10 @@ the die zone at every sample (a plan at a target rate may peak in speed there) a
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cache, partial
+from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -91,6 +93,8 @@ VARIABLE_INDEX = {name: i for i, (name, _) in enumerate(VARIABLES)}
 PEAK_VARIABLE = ("bus_peak", "power")
 # the denser variant adds the times at which the crank passes the die exit's angles (from theta3) [s]
 EXIT_VARIABLES = tuple((f"die_exit_time_{k}", "time") for k in range(EXIT_SAMPLES))
+# with robots (``planning.model.limits.robots``) each robot's start [s from theta3], after every other variable
+ROBOT_VARIABLES = (("unloader_start", "time"), ("loader_start", "time"))
 SAMPLES_CONSTANT = 20  # samples on the constant-speed transfer dwell
 MIN_HALF_S = 4e-3  # [s] lower bound on the duration of a half (1 ms per improved-S-curve sub-segment)
 TOP_SPEED = 1e3  # [rad/s] upper bound of the crank speeds (far above any press)
@@ -219,6 +223,17 @@ class _Cycle:
     states: list
     starts: list
     n_before: int
+    names: tuple[str, ...] = ()  # the variables' names, in order
+    layout: ParameterLayout | None = None
+
+    @property
+    def geometry(self) -> list:
+        """The mechanism's geometry parameters' symbols."""
+        return self.layout.geometry(self.q)
+
+    @property
+    def formula(self) -> Formula:
+        return self.layout.formula
 
     @property
     def before(self) -> tuple[list, list, list[Segment]]:
@@ -243,7 +258,8 @@ def _cycle(law_name: str, layout: ParameterLayout, variables: tuple) -> _Cycle:
     starts = [0.0]
     for seg in segs[:-1]:
         starts.append(starts[-1] + seg.duration)
-    return _Cycle(x, p_case, p_scale, v, unit, q, params, segs, states, starts, len(segs) - 1)
+    names = tuple(name for name, _ in variables)
+    return _Cycle(x, p_case, p_scale, v, unit, q, params, segs, states, starts, len(segs) - 1, names, layout)
 
 
 def _shape_rows(rows: Rows, c: _Cycle, law) -> None:  # noqa: ANN001 - a Law
@@ -349,7 +365,8 @@ def _objective(
         objective = q["weight_period"] * params.period + q["weight_heat"] * heat + q["weight_energy"] * energy
         objective -= q["weight_dwell"] * params.transfer_dwell
     if peak:  # the least grid peak: bus power <= bus_peak at every sample, bus_peak weighed (weight_peak)
-        bus_peak, power_unit = c.x[-1] * c.p_scale[-1], c.p_scale[-1]
+        k = len(VARIABLES)  # the peak variable follows the cycle's
+        bus_peak, power_unit = c.x[k] * c.p_scale[k], c.p_scale[k]
         bus = bus_power_samples(q, torque)
         rows.add("bus power under its peak", (bus - bus_peak) / power_unit, -np.inf, 0.0, "planner.objective")
         objective += q["weight_peak"] * bus_peak
@@ -360,10 +377,12 @@ def _transcription(
     c: _Cycle, samples: dict, crossings: tuple[ca.SX, ca.SX], exit_speeds: list, zone: bool, rate: bool
 ) -> Transcription:
     """What the limits' rows read of this NLP (``planning.model.limits.base.Transcription``): the samples'
-    states, the period, the robot's window, the extremes of the halves, the die crossings' speeds."""
+    states, the period, the robot's window, the extremes of the halves, the die crossings' speeds; with robots
+    the slide's height at any time and their starts (:func:`_robot_terms`)."""
     p = c.params
     omd, omu = crossings
     return Transcription(
+        **_robot_terms(c),
         **samples,
         period=p.period,
         window_time=c.v["closing_time"] - c.v["opening_time"],
@@ -378,6 +397,49 @@ def _transcription(
         rate=rate,
         speed_unit=c.unit["draw_speed"],
     )
+
+
+def _robot_terms(c: _Cycle) -> dict:
+    """The robots' part of the transcription where the NLP has their starts (the last variables): the slide's
+    height at any time (the closed-form angle over every segment, the draw last, at the time within the period:
+    ``h(theta(t))`` is periodic, so the wrap is smooth), their starts, theta2's time."""
+    names = [name for name, _ in ROBOT_VARIABLES]
+    first = len(c.names) - len(names)
+    if tuple(c.names[first:]) != tuple(names):
+        return {}
+    period = c.params.period
+    geometry = c.geometry
+
+    def height_at(times: list) -> ca.SX:
+        wrapped = [t - period * ca.floor(t / period) for t in times]
+        theta = ca.vertcat(*[_angle_at(t, c.starts, c.states[:-1], c.segs)[0] for t in wrapped])
+        return c.formula.jets(theta, geometry)[0]
+
+    starts = {name.removesuffix("_start"): c.x[first + k] * c.p_scale[first + k] for k, name in enumerate(names)}
+    return {"height_at": height_at, "robot_starts": starts, "draw_start_time": c.starts[c.n_before]}
+
+
+def robot_scales(scales: Callable[[Case], np.ndarray], case: Case) -> np.ndarray:
+    """``scales(case)`` and the robots' starts' (the other times' scale)."""
+    base = scales(case)
+    return np.append(base, [base[VARIABLE_INDEX["closing_time"]]] * len(ROBOT_VARIABLES))
+
+
+def robot_bounds(bounds: Callable[..., tuple], case: Case, *args: Any) -> tuple[np.ndarray, np.ndarray]:
+    """``bounds(case, ...)`` and the robots' starts': within a period either side of theta3."""
+    lo, hi = bounds(case, *args)
+    top = time_limit(case)
+    return np.append(lo, [-top] * len(ROBOT_VARIABLES)), np.append(hi, [top] * len(ROBOT_VARIABLES))
+
+
+def complete_robots(complete: Callable | None, case_robots: bool, values: dict[str, float]) -> dict[str, float]:
+    """``values`` (``complete`` applied first) with the robots' starts where a start lacks them: around TDC,
+    the unloader's way in and dwell before the middle of theta4 -> theta1, the loader's way in after it."""
+    values = dict(values if complete is None else complete(values))
+    if "unloader_start" not in values:
+        values["unloader_start"] = values["opening_time"]
+        values["loader_start"] = 0.5 * (values["opening_time"] + values["closing_time"])
+    return values
 
 
 def _build(
@@ -396,12 +458,14 @@ def _build(
     die_exit = zone and not rate  # the denser variant: the die exit held at its angles (smooth rows)
     zone = rate  # the rate NLP: every sample in the die zone held (its crank speed may peak there)
     layout = ParameterLayout(formula, limit_ids, drive, rate, links if drive else (), die_exit)
+    robots = "robots" in limit_ids
     variables = VARIABLES + ((PEAK_VARIABLE,) if peak else ()) + (EXIT_VARIABLES if die_exit else ())
+    variables += ROBOT_VARIABLES if robots else ()
     c = _cycle(law_name, layout, variables)
     rows = Rows()
     _shape_rows(rows, c, law)
     published_rows, (omd, omu) = _key_point_rows(rows, c)
-    exit_speeds = _exit_rows(rows, c, len(variables) - EXIT_SAMPLES) if die_exit else []
+    exit_speeds = _exit_rows(rows, c, len(VARIABLES) + int(peak)) if die_exit else []
     states, times, draw_count = _sampled(c, law, drive)
     samples, torque, lift = sample_states(formula, layout, c.q, c.p_case, states, times, draw_count)
     nlp = _transcription(c, samples, (omd, omu), exit_speeds, zone, rate)
@@ -415,6 +479,10 @@ def _build(
     scales = peak_variable_scales if peak else exit_variable_scales if die_exit else variable_scales
     bounds = peak_variable_bounds if peak else exit_variable_bounds if die_exit else variable_bounds
     denser = None if zone or die_exit else partial(halves_nlp, law_name, formula, limit_ids, drive, rate, True, links)
+    complete = complete_exit if die_exit else None
+    if robots:
+        scales, bounds = partial(robot_scales, scales), partial(robot_bounds, bounds)
+        complete = partial(complete_robots, complete, True)
     return CycleNLP(
         program,
         *rows.bounds(),
@@ -427,7 +495,7 @@ def _build(
         published_rows,
         refinable,
         denser,
-        complete_exit if die_exit else None,
+        complete,
     )
 
 

@@ -38,7 +38,7 @@ FINE_JERK_SHARE = 0.5  # a plan using less than this share of the jerk limit is 
 def seed_values(seed: Plan, phases: Layout = PHASES) -> dict[str, float]:
     """A plan of another law (or an optimal plan on another layout) as the optimal NLP's values on the
     phases' ``layout``: its profile sampled on each phase's uniform grid between the key points, the jerk of
-    each segment from the change of acceleration across it."""
+    each segment from the change of acceleration across it; the robots' starts as they were."""
     prof, period = seed.profile, seed.period
     t1, t2, t3, t4 = (float(t) for t in seed.key_times())
     spans = {"return": (t3, t4), "transfer": (t4, t1 + period), "feed": (t1 + period, t2 + period)}
@@ -60,6 +60,9 @@ def seed_values(seed: Plan, phases: Layout = PHASES) -> dict[str, float]:
         for k in range(1, n + 1):
             values |= {f"{phase}_angle_{k}": float(th[k]), f"{phase}_speed_{k}": float(om[k])}
             values[f"{phase}_accel_{k}"] = float(al[k])
+    for name in ("unloader_start", "loader_start"):  # the robots' starts count from theta3 in both NLPs
+        if name in seed.nlp_values:
+            values[name] = seed.nlp_values[name]
     return values
 
 

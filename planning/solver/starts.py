@@ -71,7 +71,7 @@ def transfer_speeds(case: Case) -> tuple[float, float]:
     the minimum) and the minimum crank speed."""
     th1, _, _, th4 = case.key_angles
     w_min = case.limits.min_crank_speed_rpm * RPM
-    return max((th1 + 2 * math.pi - th4) / case.process.transfer_time_s, 1.5 * w_min), w_min
+    return max((th1 + 2 * math.pi - th4) / case.transfer_time_s, 1.5 * w_min), w_min
 
 
 def published_starts(case: Case, w2: float, neighbour: Plan | None) -> list[dict[str, float]]:
@@ -94,7 +94,7 @@ def constant_speed(case: Case, w2: float, inside: float) -> dict[str, float]:
     into the halves, as :func:`guess` places them."""
     th1, th2, th3, th4 = case.key_angles
     w_transfer, w_min = transfer_speeds(case)
-    w_window = (th1 + 2 * math.pi - th4) / case.process.transfer_time_s
+    w_window = (th1 + 2 * math.pi - th4) / case.transfer_time_s
     w_accel = math.sqrt(case.limits.slider_accel_mm_s2 / case.machine.peak_curvature)
     w = max(min(w2, w_window, w_accel, top_crank_speed(case) or math.inf), w_min)
     share = inside / sc.SUBSEGMENTS  # theta4 this share before the return's end, theta1 after the feed's start

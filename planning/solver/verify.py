@@ -59,6 +59,8 @@ class CheckId(str, enum.Enum):
 
 SCHEDULE_CHECKS = frozenset({CheckId.STORAGE_EMPTY, CheckId.STORAGE_FULL})  # the storage schedule's own bounds:
 # at them the storage is used to the full, which binds no limit of the plan (not in the binding list)
+BY_CONSTRUCTION = frozenset({"robots_path"})  # a robot's speed and acceleration: its moves are the fastest its
+# limits allow, at them by construction, which binds no limit of the plan (not in the binding list)
 CYCLE_FIELDS = {CheckId.KEY_ANGLES: "key_points"}  # the case field behind a cycle check, where one is
 
 
@@ -83,8 +85,9 @@ class Verification:
         return [c for c in self.checks if not c.passed]
 
     def binding(self) -> list[Check]:
-        """The checks at their limits (:attr:`Check.binds`), the storage schedule's bounds apart."""
-        return [c for c in self.checks if c.binds and c.id not in SCHEDULE_CHECKS]
+        """The checks at their limits (:attr:`Check.binds`), the storage schedule's bounds and the robots' own
+        moves apart."""
+        return [c for c in self.checks if c.binds and c.id not in SCHEDULE_CHECKS | BY_CONSTRUCTION]
 
     def check(self, check_id: str) -> Check | None:
         """The check with id ``check_id`` (a limit's id or a :class:`CheckId`), None when the plan has none."""

@@ -40,11 +40,11 @@ import yaml
 from flask import Flask, Response, jsonify, request, send_file
 from werkzeug.exceptions import HTTPException, RequestEntityTooLarge
 
-from planning.model.case import OBJECTIVES, Case
+from planning.model.case import OBJECTIVES, ROBOT_NAMES, Case, RobotOrder
 from planning.model.case_file import MAX_BYTES, CaseFileError, case_from_data, load_yaml, read_case, too_large_words
 from planning.model.laws import LAWS
 from planning.model.outcome import Outcome
-from planning.reports.new_case import MECHANISMS, drive_template
+from planning.reports.new_case import MECHANISMS, drive_template, robots_template
 from planning.reports.outputs import downloads
 from planning.reports.outputs._cam import CamOptionError
 from planning.solver.outcomes import PlanningError
@@ -260,6 +260,7 @@ def _page_routes(app: Flask, shared: _Shared) -> None:
                 "placements": ["free", "published"],
                 "fields": field_specs(),
                 "drive_templates": {kind: drive_template(kind) for kind in MECHANISMS},
+                "robot_templates": {kind: robots_template(kind) for kind in MECHANISMS},
                 "outcomes": {outcome.name: outcome.value for outcome in Outcome},
                 "downloads": [{"name": o.name, "title": o.title} for o in downloads()],
                 "cam": cam_meta(),
@@ -558,8 +559,12 @@ def field_specs() -> list[dict[str, Any]]:
         {"name": "planner.motion_law", "kind": "choice", "choices": list(LAWS)},
         {"name": "planner.placement", "kind": "choice", "choices": ["free", "published"]},
         {"name": "planner.objective", "kind": "choice", "choices": list(OBJECTIVES)},
-        {"name": "process.forming_force_kN", "kind": "table", "optional": True},
+        {"name": "process.forming_force_kN", "kind": "table", "optional": True, "columns": ["height mm", "force kN"]},
+        {"name": "robots.order", "kind": "choice", "choices": list(RobotOrder.__args__)},
     ]
+    for robot in ROBOT_NAMES:
+        name, columns = f"robots.{robot}.interference_mm", ["position mm", "height mm"]
+        specs.append({"name": name, "kind": "table", "optional": False, "columns": columns})
     for spec in specs:
         model, leaf = _model_at(spec["name"])
         info = model.model_fields[leaf]

@@ -164,7 +164,9 @@ class Transcription:
     the crank speed may peak while the slide is below the die height (rows at every sample there).
     ``rate``: the NLP of a target rate. ``speed_unit`` [rad/s] and ``length_unit`` [mm]: scales of rows.
     ``motor_torque`` [N m], ``motor_speed`` [rad/s] and ``crank_torque`` [N m] at the samples in a drive
-    NLP, else None. ``param(name)``: a case parameter's symbol.
+    NLP, else None. ``param(name)``: a case parameter's symbol. With robots (``planning.model.limits.robots``):
+    ``height_at(times)`` the slide's height [mm] at any times [s from theta3] (periodic), ``robot_starts`` their
+    start variables, ``draw_start_time`` [s from theta3] when the next draw starts.
     """
 
     theta: Any
@@ -191,6 +193,9 @@ class Transcription:
     motor_speed: Any = None
     crank_torque: Any = None
     exit_speeds: list[tuple[Any, Any]] = field(default_factory=list)
+    height_at: Callable[[list], Any] | None = None  # the slide's height [mm] at NLP times [s from theta3], any
+    robot_starts: dict[str, Any] = field(default_factory=dict)  # each robot's start [s from theta3] (variables)
+    draw_start_time: Any = None  # [s from theta3] the next draw's start, theta2 (the end of the cycle outside it)
 
     def outside_draw(self, values: Any) -> Any:
         """The entries of a sample vector before the draw's."""

@@ -161,7 +161,7 @@ def _storage_counts(case: Any) -> bool:
     s = d.storage
     if s is None:
         return False
-    smoothing = EXCESS_SMOOTHING * d.grid.peak_power_kW * 1e3 / 2 * case.process.transfer_time_s  # [J]
+    smoothing = EXCESS_SMOOTHING * d.grid.peak_power_kW * 1e3 / 2 * case.transfer_time_s  # [J]
     return s.efficiency * s.usable_energy_kJ * 1e3 > smoothing
 
 

@@ -35,6 +35,9 @@ class TransferTimeLimit(Limit):
     order = 10
     parameters = ("transfer_time",)
 
+    def applies(self, case: Any) -> bool:
+        return case.robots is None  # the robots' interference curves replace the window (``robots``)
+
     def parameter_values(self, case: Any) -> dict[str, float]:
         return {"transfer_time": case.process.transfer_time_s}
 
@@ -81,7 +84,12 @@ class SafetyHeightLimit(Limit):
     field = "process.safety_height_mm"
     order = 11
 
+    def applies(self, case: Any) -> bool:
+        return case.robots is None
+
     def validate(self, case: Any) -> None:
+        if not self.applies(case):
+            return
         m = case.machine
         safety = case.process.safety_height_mm
         if safety > m.stroke:

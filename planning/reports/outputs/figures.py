@@ -1,6 +1,7 @@
 """The figures: ``motion_vs_time`` and ``motion_vs_angle`` (the slide and the crank, every limit where it
 applies), ``drive`` (with a drive: the torque-speed plane, torque and power), ``energy`` (with the drive's
-electrical side) and ``capacity`` (with ``press.capacity``: the tonnage curve, the crank torque); drawn from
+electrical side), ``capacity`` (with ``press.capacity``: the tonnage curve, the crank torque) and ``interference``
+(with robots: the slide against each tool's needed height, their paths); drawn from
 ``result.json``'s data and the trajectory (``pressplan plot`` redraws them from those files)."""
 
 from __future__ import annotations
@@ -48,7 +49,7 @@ def redraw(folder: Path, plot_format: str = "png") -> dict[str, Writer]:
 OUTPUT = Output(
     "motion_vs_time.*",
     "the figures",
-    ("motion_vs_time.*", "motion_vs_angle.*", "drive.*", "energy.*", "capacity.*"),
+    ("motion_vs_time.*", "motion_vs_angle.*", "drive.*", "energy.*", "capacity.*", "interference.*"),
     _writers,
     order=90,
     figure=True,

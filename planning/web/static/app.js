@@ -2,10 +2,12 @@
 "use strict";
 
 const SESSION = (crypto.randomUUID ? crypto.randomUUID() : String(Math.random()).slice(2)) ;
-const SECTIONS = ["press", "press.link_drive", "press.knuckle_joint", "key_points", "process", "limits", "drive", "drive.motor", "planner"];
+const SECTIONS = ["press", "press.link_drive", "press.knuckle_joint", "key_points", "process", "robots", "robots.unloader", "robots.loader", "limits", "drive", "drive.motor", "planner"];
+// with robots the one-height model's two fields are left out (the robots replace them; the case refuses both)
+const ONE_HEIGHT_KEYS = ["process.safety_height_mm", "process.transfer_time_s"];
 // the press section's own keys belong to the crank-slider; a linkage's dimensions are in its subsection
 const CRANK_SLIDER_KEYS = ["press.crank_radius_mm", "press.rod_length_mm", "press.offset_mm", "drive.rod_mass_kg", "drive.rod_cg_from_crank_pin_mm"];
-const SECTION_TITLES = { press: "press", "press.link_drive": "link drive", "press.knuckle_joint": "knuckle joint", key_points: "key angles", process: "process", limits: "limits", drive: "drive", "drive.motor": "motor (all motors together)", planner: "planner" };
+const SECTION_TITLES = { robots: "robots", "robots.unloader": "unloader (takes the part out)", "robots.loader": "loader (brings the blank in)", press: "press", "press.link_drive": "link drive", "press.knuckle_joint": "knuckle joint", key_points: "key angles", process: "process", limits: "limits", drive: "drive", "drive.motor": "motor (all motors together)", planner: "planner" };
 const WINDOW_COLOUR = "#d9ecff", DRAW_COLOUR = "#e2f0d9"; // the robot's window, the draw
 const KEY_LABELS = { closing: "θ1", draw_start: "θ2", draw_end: "θ3", opening: "θ4" };
 const TYPING_REST_MS = 120; // a pause this long in typing solves (a fast typist's keys come closer)
@@ -35,14 +37,16 @@ function buildForm(data) {
   const form = $("#case-form");
   form.innerHTML = "";
   const specs = state.meta.fields;
-  const hasDrive = data.drive != null;
+  const hasDrive = data.drive != null, hasRobots = data.robots != null;
   const crankSlider = (getPath(data, "press.mechanism") || "crank-slider") === "crank-slider";
   for (const section of SECTIONS) {
     if (section === "drive" && !hasDrive) { form.appendChild(addDriveBox()); continue; }
+    if (section === "robots" && !hasRobots) { form.appendChild(addRobotsBox()); continue; }
     if (section.startsWith("drive") && !hasDrive) continue;
     if (section.includes(".") && !section.startsWith("drive") && getPath(data, section) == null) continue;
     const fields = specs.filter((f) => f.name.startsWith(section + ".") && !f.name.slice(section.length + 1).includes("."))
-      .filter((f) => crankSlider || !CRANK_SLIDER_KEYS.includes(f.name));
+      .filter((f) => crankSlider || !CRANK_SLIDER_KEYS.includes(f.name))
+      .filter((f) => !hasRobots || !ONE_HEIGHT_KEYS.includes(f.name));
     if (!fields.length) continue;
     const fs = document.createElement("fieldset");
     fs.dataset.section = section;
@@ -50,6 +54,9 @@ function buildForm(data) {
     for (const spec of fields) fs.appendChild(spec.kind === "table" ? forceTable(spec, getPath(data, spec.name)) : fieldRow(spec, getPath(data, spec.name)));
     if (section === "drive") {
       fs.appendChild(button({ id: "remove-drive" }, "remove the drive", "plan the motion alone (no motor limits, no torque or energy)", removeDrive));
+    }
+    if (section === "robots") {
+      fs.appendChild(button({ id: "remove-robots" }, "remove the robots", "back to one safety height and one transfer time (the template press's)", removeRobots));
     }
     form.appendChild(fs);
   }
@@ -98,7 +105,41 @@ function removeDrive() {
   solveNow();
 }
 
-// the forming force as rows of (height above BDC [mm], force [kN]), rows added and removed in place
+// robots added in the page: an unloader and a loader of `pressplan new --robots`'s template press of this
+// mechanism (their tools needing the safety height over the die), to be replaced by the line's own figures
+function addRobotsBox() {
+  const fs = document.createElement("fieldset");
+  fs.dataset.section = "robots";
+  fs.innerHTML = `<legend>robots</legend><p class="help-text">One safety height and one transfer time. Robots on their ` +
+    `interference curves plan the unloader and the loader with the slide: they go in while it is still rising.</p>`;
+  fs.appendChild(button({ id: "add-robots" }, "add robots", "an unloader and a loader of a template press of this mechanism (pressplan new --robots): enter your robots' figures", addRobots));
+  return fs;
+}
+
+function addRobots() {
+  const data = caseFromForm();
+  const kind = getPath(data, "press.mechanism") || "crank-slider";
+  data.robots = structuredClone(state.meta.robot_templates[kind].robots);
+  for (const key of ONE_HEIGHT_KEYS) setPath(data, key, undefined);
+  state.data = data;
+  buildForm(data);
+  setStatus("robots added: the template press's; enter your robots' figures", "busy");
+  solveNow();
+}
+
+function removeRobots() {
+  const data = caseFromForm();
+  const kind = getPath(data, "press.mechanism") || "crank-slider";
+  delete data.robots;
+  const oneHeight = state.meta.robot_templates[kind].one_height;
+  for (const [key, value] of Object.entries(oneHeight)) setPath(data, "process." + key, value);
+  state.data = data;
+  buildForm(data);
+  solveNow();
+}
+
+// a table of number pairs (the forming force's height and force, an interference curve's position and
+// height), rows added and removed in place
 function forceTable(spec, value) {
   const row = document.createElement("div");
   row.className = "field table-field";
@@ -109,7 +150,8 @@ function forceTable(spec, value) {
   table.id = id;
   table.dataset.field = spec.name;
   table.dataset.kind = "table";
-  table.innerHTML = "<thead><tr><th>height mm</th><th>force kN</th><th></th></tr></thead><tbody></tbody>";
+  const [first, second] = spec.columns || ["height mm", "force kN"];
+  table.innerHTML = `<thead><tr><th>${first}</th><th>${second}</th><th></th></tr></thead><tbody></tbody>`;
   const body = table.querySelector("tbody");
   const addRow = (pair) => {
     const tr = document.createElement("tr");
@@ -581,7 +623,8 @@ function pickedPanels() {
 function cycleShapes(r, x, axis, width) {
   const at = (name) => { const k = r.key_points.find((p) => p.name === name); return axis === "time" ? k.time_s : k.angle_deg; };
   const rect = (x0, x1, fillcolor) => ({ type: "rect", xref: "x", yref: "paper", x0, x1, y0: 0, y1: 1, fillcolor, opacity: 0.6, line: { width: 0 }, layer: "below" });
-  const shapes = [rect(at("opening"), x[x.length - 1], WINDOW_COLOUR), rect(x[0], at("closing"), WINDOW_COLOUR), rect(at("draw_start"), at("draw_end"), DRAW_COLOUR)];
+  const robots = r.robots != null; // the robots' interference curves replace the one robot's window
+  const shapes = robots ? [rect(at("draw_start"), at("draw_end"), DRAW_COLOUR)] : [rect(at("opening"), x[x.length - 1], WINDOW_COLOUR), rect(x[0], at("closing"), WINDOW_COLOUR), rect(at("draw_start"), at("draw_end"), DRAW_COLOUR)];
   for (const k of r.key_points) {
     const kx = axis === "time" ? k.time_s : k.angle_deg;
     shapes.push({ type: "line", xref: "x", yref: "paper", x0: kx, x1: kx, y0: 0, y1: 1, line: { dash: "dot", width: 1, color: "#555" } });
@@ -593,7 +636,7 @@ function cycleShapes(r, x, axis, width) {
   const draw = "draw θ2 → θ3";
   const annotations = [];
   const windowText = window.length * LABEL_PX < Math.max(before, after) ? window : `window ${r.transfer_window_s.toFixed(3)} s`;
-  annotations.push(before >= after
+  if (!robots) annotations.push(before >= after
     ? { xref: "x", yref: "paper", x: x[0], y: 1.0, xanchor: "left", yanchor: "bottom", text: windowText, showarrow: false, font: { size: 11, color: "#1f4e79" } }
     : { xref: "x", yref: "paper", x: x[x.length - 1], y: 1.0, xanchor: "right", yanchor: "bottom", text: windowText, showarrow: false, font: { size: 11, color: "#1f4e79" } });
   if (draw.length * LABEL_PX < px(at("draw_start"), at("draw_end")) + 20) {
@@ -700,6 +743,7 @@ function drawCharts() {
     if (state.pinned) traces.push({ x: xOf(state.pinned.curves), y: state.pinned.curves[panel.key], name: "pinned " + TRACE_NAMES[panel.key], yaxis: name, line: { dash: "dot", color: "#777", width: 1 } });
   });
   traces.push(...limitTraces(ans.limit_lines, x, axis, axes));
+  if (axes.slider_height_mm && r.robots) traces.push(...robotTraces(r, c, x, axes.slider_height_mm));
   if (axes.slider_height_mm) {
     const keyX = r.key_points.map((k) => (axis === "time" ? k.time_s : k.angle_deg));
     const keyIndex = keyX.map((v) => nearest(x, v));
@@ -712,6 +756,18 @@ function drawCharts() {
   if (!chart.dataset.follows) { chart.on("plotly_hover", followChart); chart.dataset.follows = "1"; }
   drawDrive(r, c, x, axis);
   drawEnergy(r, c, x, axis);
+}
+
+// each robot's tool: the slide height it needs where it is over the die, on the slide height's panel (the
+// interference chart of `pressplan solve`, interference.png, draws the same)
+const ROBOT_COLOURS = { unloader: "#d62728", loader: "#2ca02c" };
+function robotTraces(r, c, x, yaxis) {
+  return r.robots.robots.map((robot) => {
+    const need = c[`${robot.name}_needed_height_mm`] || [];
+    const least = robot.least_clearance_mm;
+    const words = least != null ? `, least clearance ${least.toFixed(2)} mm` : "";
+    return { x, y: need.map((v) => (v > 0 ? v : null)), yaxis, name: `height the ${robot.name}'s tool needs [mm]${words}`, line: { color: ROBOT_COLOURS[robot.name] || "#000", width: 1.5 }, connectgaps: false };
+  });
 }
 
 function nearest(xs, v) {

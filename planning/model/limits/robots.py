@@ -1,0 +1,375 @@
+"""The robots on their interference curves (``robots:``): at every instant the slide is at least as high as
+each robot's tool needs it where the tool is (``press.robot``: its fastest moves, its curve).
+
+The model (docs/robots.md): each robot leaves its waiting point at its start ``s`` [s], moves in to the die
+centre (its fastest move, ``T_in``), dwells ``T_d`` and moves out (``T_in`` again), once per cycle of period
+``P``; the planner decides ``s``. With ``n(t)`` the height its tool needs at time ``t`` (its curve at its
+position) and ``h(t)`` the slide's height, the clearance ``c(t) = h(t) - n(t) >= 0`` at every ``t``. The unloader
+grips after the draw ends (theta3) and the loader has dropped the blank before the next draw starts (theta2);
+the loader reaches the die centre once the unloader's tool, moving out, is clear of the die (``overlapping``),
+or leaves its waiting point once the unloader is back at its own (``in-turns``). Each occupancy (in, dwell,
+out) fits in one period.
+
+In an NLP (a transcription that offers ``height_at`` and the robots' start variables) the clearance is held
+at :data:`ROBOT_SAMPLES` times of each occupancy, the curve's crossings among them (where its kinks and its
+step are), each need scaled by ``robots_need_factor`` (1 at first; raised by the search when the dense check
+finds the clearance lost between the samples). The dense verification checks it at every sample of the plan
+and at the crossings' exact times, and each robot's speed and acceleration by differences of its position.
+
+In the time-optimal bound and the certified upper bound (over crank angle, no time of a robot) the robots
+enter by what every schedule must give them: for each height ``H`` a tool needs, the slide spends at least as
+long at or above ``H`` as the robots need it there (both robots' times added where they cannot overlap),
+and the period is at least each occupancy. Necessary conditions only: the bounds stay bounds.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from planning.model.limits.base import (
+    BoundMesh,
+    Check,
+    Dense,
+    Impossible,
+    Limit,
+    Peak,
+    Row,
+    Transcription,
+    sample_vector,
+    total,
+)
+from planning.model.units import RPM
+from planning.tolerances import LIMIT_REL_TOL, REFINE_MARGIN, SAME_HEIGHT_MM, TIME_TOL_S
+from press.robot import Robot, crossing_offsets, sample_offsets, time_needing, time_to_clear_s
+
+ROBOT_SAMPLES = 48  # times of each robot's occupancy at which an NLP holds its clearance
+ROBOTS = ("unloader", "loader")  # the case's robots (``planning.model.case.ROBOT_NAMES``), in their order
+PER_ROBOT = ("occupancy", "in", "dwell", "present")  # [s, s, s, 1|0]
+
+
+def _robot_parameters() -> tuple[str, ...]:
+    names = []
+    for r in ROBOTS:
+        names += [f"robot_{r}_{part}" for part in PER_ROBOT]
+        names += [f"robot_{r}_{kind}_{k}" for k in range(ROBOT_SAMPLES) for kind in ("offset", "need")]
+    return (
+        *names,
+        "robots_order_lead",
+        "robots_order_clear",
+        "robots_in_turns",
+        "robots_order_active",
+        "robots_need_factor",
+    )
+
+
+def robots_by_name(case: Any) -> dict[str, Robot]:
+    """The case's robots by name."""
+    return {robot.name: robot for robot in case.robots_on_path}
+
+
+def order_terms(case: Any) -> tuple[float, float]:
+    """``(lead, clear)`` [s]: the loader's start plus ``lead`` is at least the unloader's plus ``clear``
+    (overlapping: the loader reaches the die centre once the unloader's tool, moving out, is clear of the die;
+    in turns: the loader leaves its waiting point once the unloader is back at its own)."""
+    robots = robots_by_name(case)
+    unloader, loader = robots.get("unloader"), robots.get("loader")
+    if unloader is None or loader is None:
+        return 0.0, 0.0
+    if case.robots.order == "in-turns":
+        return 0.0, unloader.occupancy_s
+    return loader.move.duration_s, unloader.move.duration_s + unloader.dwell_s + time_to_clear_s(unloader)
+
+
+def span_s(case: Any) -> float:
+    """The least time [s] from the first robot leaving its waiting point to the last one back there: the
+    robots' share of a cycle (in turns: the occupancies added; overlapping: the unloader in, at the die and
+    clear of it, then the loader at the die and out, or the longer occupancy)."""
+    robots = robots_by_name(case)
+    if len(robots) == 1:
+        return next(iter(robots.values())).occupancy_s
+    u, ld = robots["unloader"], robots["loader"]
+    if case.robots.order == "in-turns":
+        return u.occupancy_s + ld.occupancy_s
+    lead, clear = order_terms(case)
+    return max(u.occupancy_s, ld.occupancy_s, clear - lead + ld.occupancy_s)
+
+
+class RobotsLimit(Limit):
+    """The slide above what each robot's tool needs, at every instant (module docstring)."""
+
+    id = "robots"
+    name = "slide above the robots' interference curves"
+    unit = "mm"
+    field = "robots"
+    order = 12
+    parameters = _robot_parameters()
+    refined = "robots_need_factor"
+    refine_upward = True
+
+    def applies(self, case: Any) -> bool:
+        return case.robots is not None
+
+    def parameter_values(self, case: Any) -> dict[str, float]:
+        robots = robots_by_name(case)
+        values: dict[str, float] = {}
+        for r in ROBOTS:
+            robot = robots.get(r)
+            if robot is None:
+                values |= {f"robot_{r}_{part}": 0.0 for part in PER_ROBOT}
+                offsets = needs = np.zeros(ROBOT_SAMPLES)
+            else:
+                values |= {
+                    f"robot_{r}_occupancy": robot.occupancy_s,
+                    f"robot_{r}_in": robot.move.duration_s,
+                    f"robot_{r}_dwell": robot.dwell_s,
+                    f"robot_{r}_present": 1.0,
+                }
+                offsets = sample_offsets(robot, ROBOT_SAMPLES)
+                needs = robot.curve.need(robot.position_since_start(offsets))
+            values |= {f"robot_{r}_offset_{k}": float(v) for k, v in enumerate(offsets)}
+            values |= {f"robot_{r}_need_{k}": float(v) for k, v in enumerate(needs)}
+        lead, clear = order_terms(case)
+        both = float(len(robots) == 2)
+        turns = float(case.robots.order == "in-turns")
+        return values | {
+            "robots_order_lead": lead,
+            "robots_order_clear": clear,
+            "robots_in_turns": turns,
+            "robots_order_active": both,
+            "robots_need_factor": 1.0,
+        }
+
+    def at_draw_speed(self, draw: Any, speed: float) -> list[Check]:
+        """The robots in and out within the longest cycle the minimum crank speed allows (:func:`span_s`)."""
+        case = draw.case
+        longest = 2 * np.pi / (case.limits.min_crank_speed_rpm * RPM)
+        name = f"robots in and out ({case.robots.order}) within the longest cycle (limits.min_crank_speed_rpm)"
+        return [Check.of(self.id, name, span_s(case), longest, "s", "max", TIME_TOL_S)]
+
+    def precheck(self, case: Any, given: float | None, lowest: float) -> Impossible | None:
+        """The robots' span (:func:`span_s`) within the longest cycle the minimum crank speed allows."""
+        longest = 2 * np.pi / (case.limits.min_crank_speed_rpm * RPM)
+        span = span_s(case)
+        if span <= longest:
+            return None
+        robots = robots_by_name(case)
+        name = max(robots, key=lambda r: robots[r].occupancy_s)
+        reason = (
+            f"robots.{name}.speed_mm_s: the robots need {span:.3f} s in and out (robots.order = "
+            f"{case.robots.order}), longer than any cycle at limits.min_crank_speed_rpm = "
+            f"{case.limits.min_crank_speed_rpm:g} ({longest:.3f} s); robots.{name} is the slower"
+        )
+        return Impossible(reason, f"robots.{name}.speed_mm_s", span, longest)
+
+    def rows(self, nlp: Transcription) -> list[Row]:
+        if nlp.height_at is None:
+            raise ValueError("this transcription cannot state the robots' rows (no height_at)")
+        p, out = nlp.param, []
+        for r in ROBOTS:
+            start, present = nlp.robot_starts[r], p(f"robot_{r}_present")
+            offsets = [p(f"robot_{r}_offset_{k}") for k in range(ROBOT_SAMPLES)]
+            needs = [p(f"robot_{r}_need_{k}") for k in range(ROBOT_SAMPLES)]
+            height = nlp.height_at([start + tau for tau in offsets])
+            clearance = (height - sample_vector(needs) * p("robots_need_factor")) / nlp.length_unit
+            out.append(Row(f"{r}: slide above its tool", clearance, 0.0, np.inf, sampled=True))
+            # the unloader grips, the loader has dropped, after theta3 and before theta2 (time 0 is theta3)
+            at_die = start + p(f"robot_{r}_in") + (p(f"robot_{r}_dwell") if r == "loader" else 0.0)
+            frame = sample_vector([present * at_die, present * (nlp.draw_start_time - at_die)])
+            out.append(Row(f"{r}: at the die between the draws", frame, 0.0, np.inf))
+            within = present * (nlp.period - p(f"robot_{r}_occupancy"))
+            out.append(Row(f"{r}: in and out within the cycle", within, 0.0, np.inf))
+        s_u, s_l = nlp.robot_starts["unloader"], nlp.robot_starts["loader"]
+        both, turns = p("robots_order_active"), p("robots_in_turns")
+        first = s_l + p("robots_order_lead") - s_u - p("robots_order_clear")
+        wrap = s_u + nlp.period - s_l - p("robot_loader_occupancy")  # in turns: back before the next unloader
+        out.append(
+            Row("the loader after the unloader", sample_vector([both * first, both * turns * wrap]), 0.0, np.inf)
+        )
+        return out
+
+    def check(self, dense: Dense) -> list[Check]:
+        case, plan = dense.case, dense.plan
+        out = []
+        missing = [robot.name for robot in case.robots_on_path if robot.name not in plan.robot_starts_s]
+        if missing:  # a plan made without these robots (a neighbour's, another case's): no schedule to check
+            name = f"{', '.join(missing)}: scheduled in the plan"
+            return [Check.of("robots_order", name, float("nan"), 0.0, "s", "min", TIME_TOL_S)]
+        for robot in case.robots_on_path:
+            schedule = robot_schedule(dense, robot)
+            need = schedule.tightest_need_mm
+            c = Check.of(
+                self.id,
+                f"{robot.name}: slide height where its tool is closest",
+                need + schedule.least_clearance_mm,
+                need,
+                self.unit,
+                "min",
+                LIMIT_REL_TOL * max(need, 1.0),
+            )
+            if np.isfinite(schedule.least_clearance_mm):  # where: the tightest time
+                at = schedule.least_at_s
+                angle = float(np.degrees(plan.profile.at_time(np.array([at]))[0][0])) % 360.0
+                c = replace(c, peak=Peak(at, angle, ((at, at),)))
+            if not c.passed:  # the search raises the needs at the NLP's samples by the worst shortfall
+                factor = (1 / max(schedule.least_ratio, 0.5)) * (1 + REFINE_MARGIN) / (1 - REFINE_MARGIN)
+                c = replace(c, refine_by=("robots_need_factor", factor, np.inf))
+            out.append(c)
+            out += _path_checks(robot, plan.robot_time_scale)
+        out += _order_checks(case, plan, dense)
+        return out
+
+    def bound_rows(self, mesh: BoundMesh) -> list[tuple[Any, Any, Any]]:
+        """For each height a tool needs: the intervals that reach it take at least the robots' time there;
+        the period at least each occupancy (module docstring)."""
+        case = mesh.case
+        robots = robots_by_name(case)
+        top = np.maximum(mesh.h[:-1], mesh.h[1:])  # an interval's highest slide position (h monotone on it)
+        rows = [(total(mesh.tau), max(r.occupancy_s for r in robots.values()), np.inf)]
+        for level in _levels(robots):
+            above = np.flatnonzero(top >= level).tolist()
+            need = _time_needing(case, robots, level)
+            if need > 0 and above:  # (a level no node reaches: refused by the case's checks, above the stroke)
+                rows.append((total(mesh.tau[above]), need, np.inf))
+        return rows
+
+    def relaxed_rows(self, mesh: Any) -> list[tuple[Any, Any, Any]]:
+        """The same necessary conditions over the certified mesh (h monotone on each interval)."""
+        return self.bound_rows(mesh)
+
+
+def _levels(robots: dict[str, Robot]) -> list[float]:
+    """The heights the robots' curves name (each a level the bounds hold)."""
+    return sorted({float(h) for robot in robots.values() for h in robot.curve.needed_height_mm if h > 0})
+
+
+def _time_needing(case: Any, robots: dict[str, Robot], level: float) -> float:
+    """A lower bound on the time [s] per cycle the slide must be at or above ``level`` [mm] for the robots:
+    each robot's own; in turns both added; overlapping, the unloader's way in and dwell and the loader's
+    dwell and way out added (those never overlap: the loader is at the die only once the unloader is clear)."""
+    own = [time_needing(r, level) for r in robots.values()]
+    if len(robots) < 2:
+        return max(own)
+    u, ld = robots["unloader"], robots["loader"]
+    if case.robots.order == "in-turns":
+        return sum(own)
+    first = time_needing(u, level, (0.0, u.move.duration_s + u.dwell_s + time_to_clear_s(u)))
+    last = time_needing(ld, level, (ld.move.duration_s, ld.occupancy_s))
+    return max(*own, first + last)
+
+
+@dataclass(frozen=True)
+class RobotSchedule:
+    """One robot's moves in a plan, from its dense re-simulation: ``start_s`` [s from TDC] it leaves its
+    waiting point; ``events_s``: it leaves, reaches the die centre, leaves it, is back [s from TDC, within the
+    period]; ``least_clearance_mm`` at ``least_at_s`` [s from TDC] (the slide's height minus what the tool
+    needs, at every dense sample and at the curve's crossings); ``least_ratio`` (the slide's height over the
+    need where the tool needs height; 1 where it never does); ``over_die_s`` [s per cycle] the tool needs
+    height (inside the die space); ``tightest_need_mm`` what the tool needs where the clearance is least."""
+
+    name: str
+    start_s: float
+    events_s: tuple[float, float, float, float]
+    least_clearance_mm: float
+    least_at_s: float
+    least_ratio: float
+    over_die_s: float
+    tightest_need_mm: float
+
+
+def robot_schedule(dense: Dense, robot: Robot) -> RobotSchedule:
+    """The :class:`RobotSchedule` of ``robot`` in the plan of ``dense`` (its moves as planned, run
+    ``plan.robot_time_scale`` times as fast: the robot's cam on a master run at that speed)."""
+    plan, case = dense.plan, dense.case
+    k = plan.robot_time_scale
+    period = plan.period
+    start = plan.robot_starts_s[robot.name]  # [s of the planned schedule, period k * period]
+    exact = np.mod(start + crossing_offsets(robot), k * period) / k
+    theta = plan.profile.at_time(exact)[0]
+    t = np.concatenate([dense.t, exact])
+    h = np.concatenate([dense.h, case.machine.height(np.asarray(theta))])
+    need = robot.needed_height(k * t, start, k * period)
+    needing = need > 0  # where the tool is over the die (elsewhere the slide is free, down to BDC)
+    clearance = np.where(needing, h - need, np.inf)
+    i = int(np.argmin(clearance))
+    ratio = float(np.min(h[needing] / need[needing])) if np.any(needing) else 1.0
+    move = robot.move.duration_s
+    events = np.mod(start + np.array([0.0, move, move + robot.dwell_s, robot.occupancy_s]), k * period) / k
+    over = time_needing(robot, SAME_HEIGHT_MM) / k
+    return RobotSchedule(
+        robot.name, start / k, tuple(events.tolist()), float(clearance[i]), float(t[i]), ratio, over, float(need[i])
+    )
+
+
+PATH_GRID = 4001  # times over an occupancy at which a robot's speed and acceleration are differenced
+
+
+def _path_checks(robot: Robot, scale: float) -> list[Check]:
+    """The robot's speed and acceleration along its path run ``scale`` times as fast as planned, by central
+    differences of its position on :data:`PATH_GRID` times (exact for its pieces up to cubic; between pieces a
+    mean of the two)."""
+    t = np.linspace(0.0, robot.occupancy_s, PATH_GRID)
+    x = robot.position_since_start(t)
+    dt = t[1] - t[0]
+    speed = scale * np.max(np.abs(np.diff(x))) / dt
+    accel = scale**2 * np.max(np.abs(np.diff(x, 2))) / dt**2
+    limits = robot.limits
+    return [
+        Check.of(
+            "robots_path",
+            f"{robot.name}: speed along its path",
+            speed,
+            limits.speed_mm_s,
+            "mm/s",
+            "max",
+            LIMIT_REL_TOL * limits.speed_mm_s,
+        ),
+        Check.of(
+            "robots_path",
+            f"{robot.name}: acceleration along its path",
+            accel,
+            limits.accel_mm_s2,
+            "mm/s^2",
+            "max",
+            LIMIT_REL_TOL * limits.accel_mm_s2,
+        ),
+    ]
+
+
+def _order_checks(case: Any, plan: Any, dense: Dense) -> list[Check]:
+    """Each robot at the die between the draws, within the period; the loader after the unloader (in the
+    order the case says). Times from theta3, within the period."""
+    period = plan.period
+    t3 = float(dense.key_times[2])
+    free = float(np.mod(dense.key_times[1] - t3, period))  # theta3 -> theta2: the time outside the draw
+
+    def since_draw(time_s: float) -> float:
+        rel = float(np.mod(time_s - t3, period))
+        return rel - period if rel > period - TIME_TOL_S else rel
+
+    robots = robots_by_name(case)
+    k = plan.robot_time_scale
+    out, at_die = [], {}
+    for name, robot in robots.items():
+        start = plan.robot_starts_s[name] / k
+        event = start + (robot.move.duration_s + (robot.dwell_s if name == "loader" else 0.0)) / k
+        at_die[name] = since_draw(event)
+        what = "grips after theta3" if name == "unloader" else "has dropped the blank"
+        margin = min(at_die[name], free - at_die[name])
+        out.append(Check.of("robots_order", f"{name}: {what}, before theta2", margin, 0.0, "s", "min", TIME_TOL_S))
+        occupancy = robot.occupancy_s / k
+        name_within = f"{name}: in and out within the cycle"
+        out.append(Check.of("robots_order", name_within, occupancy, period, "s", "max", TIME_TOL_S))
+    if len(robots) == 2:
+        u, ld = robots["unloader"], robots["loader"]
+        grip, dropped = at_die["unloader"], at_die["loader"]
+        if case.robots.order == "in-turns":
+            gap = (dropped - (ld.dwell_s + ld.move.duration_s) / k) - (grip + (u.dwell_s + u.move.duration_s) / k)
+            name = "the loader leaves after the unloader is back"
+        else:
+            gap = (dropped - ld.dwell_s / k) - (grip + (u.dwell_s + time_to_clear_s(u)) / k)
+            name = "the loader reaches the die once the unloader is clear of it"
+        out.append(Check.of("robots_order", name, gap, 0.0, "s", "min", TIME_TOL_S))
+    return out

@@ -1,0 +1,321 @@
+"""The robots on their interference curves (``robots:``; docs/robots.md): the new model contains the old one,
+the verification can fail, the bounds stay above every verified plan, the outputs carry the robots, and bad
+input is refused naming its field."""
+
+from __future__ import annotations
+
+import copy
+import csv
+import json
+import math
+import subprocess
+import sys
+from dataclasses import replace
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from planning.model.case_file import CaseFileError, case_from_data, read_case
+from planning.solver.bound import time_optimal_bound
+from planning.solver.optimize import solve
+from planning.solver.upper_bound import upper_bound
+from planning.solver.verify import evaluate
+
+ROOT = Path(__file__).resolve().parents[1]
+ROBOTS_CASE = ROOT / "cases" / "wang2023-side-panel-robots.yaml"
+PUBLISHED = ROOT / "cases" / "wang2023-side-panel.yaml"
+
+
+def robots_data() -> dict:
+    return yaml.safe_load(ROBOTS_CASE.read_text(encoding="utf-8"))
+
+
+@cache
+def shipped():  # noqa: ANN201 - a Solution
+    return solve(read_case(ROBOTS_CASE))
+
+
+def at_the_safety_height_in_turns() -> dict:
+    """The shipped case's robots in turns, each tool needing the slide where the paper's is at theta1 and
+    theta4 wherever it is not at its waiting point: the one-height model's transfer."""
+    data = robots_data()
+    base = read_case(PUBLISHED)
+    height = float(base.machine.height(math.radians(base.key_points.closing_deg)))
+    data["robots"]["order"] = "in-turns"
+    for name in ("unloader", "loader"):
+        path = data["robots"][name]["path_mm"]
+        data["robots"][name]["interference_mm"] = [[0.0, height], [path - 1e-3, height]]
+    return data
+
+
+def test_the_new_model_contains_the_old_one() -> None:
+    """Flat at the safety height and in turns, the robots' plan is the one-height model's within 0.1 %."""
+    old = solve(read_case(PUBLISHED))
+    new = solve(case_from_data(at_the_safety_height_in_turns()))
+    assert old.verification.passed and new.verification.passed
+    assert abs(new.plan.spm / old.plan.spm - 1) < 1e-3, (old.plan.spm, new.plan.spm)
+
+
+def test_the_shipped_case_gains_when_the_robots_overlap_the_slide() -> None:
+    """Each robot takes 1.0 s in and out (2 s in turns: the paper's transfer time); overlapping the slide's
+    motion, only over the die, the press makes at least 20 % more strokes than the one-height model's 12.12."""
+    case = read_case(ROBOTS_CASE)
+    for robot in case.robots_on_path:
+        assert robot.occupancy_s == pytest.approx(1.0, abs=1e-12)
+    solution = shipped()
+    assert solution.verification.passed
+    old = solve(read_case(PUBLISHED))
+    assert solution.plan.spm > 1.2 * old.plan.spm, (solution.plan.spm, old.plan.spm)
+    binding = {c.name for c in solution.verification.binding()}
+    assert any("unloader" in name for name in binding) and any("loader:" in name for name in binding)
+
+
+@pytest.mark.parametrize("degrees", [3.0, 6.0])
+def test_the_verification_fails_a_robot_moved_a_few_degrees(degrees: float) -> None:
+    """The unloader started a few degrees of the master earlier comes in under the rising slide; the loader
+    started later goes out under the falling slide: both fail on the clearance, by more than 1 mm."""
+    solution = shipped()
+    plan, case = solution.plan, read_case(ROBOTS_CASE)
+    for name, sign in (("unloader", -1.0), ("loader", 1.0)):
+        starts = dict(plan.robot_starts_s)
+        starts[name] += sign * degrees / 360.0 * plan.period
+        moved = evaluate(replace(plan, robot_starts_s=starts), case, least_energy=False)
+        failed = [c for c in moved.verification.failures() if c.id == "robots"]
+        assert failed and name in failed[0].name, (name, [c.name for c in moved.verification.failures()])
+        assert failed[0].value < failed[0].limit - 1.0  # the slide lower than the tool needs by more than 1 mm
+
+
+def test_the_clearance_holds_on_an_independent_dense_grid() -> None:
+    """The slide's height from the plan's profile against each tool's need from the robot's own position, on a
+    0.1 ms grid (ten times the verification's): never below, by more than the verification's tolerance."""
+    solution = shipped()
+    plan, case = solution.plan, read_case(ROBOTS_CASE)
+    t = np.arange(0.0, plan.period, 1e-4)
+    h = case.machine.height(plan.profile.at_time(t)[0])
+    for robot in case.robots_on_path:
+        need = robot.needed_height(t, plan.robot_starts_s[robot.name], plan.period)
+        over = need > 0
+        assert np.any(over)
+        assert np.min(h[over] - need[over]) > -1e-6 * np.max(need)
+
+
+def test_the_bounds_stay_above_the_plan() -> None:
+    case = read_case(ROBOTS_CASE)
+    plan = shipped().plan
+    assert time_optimal_bound(case).spm >= plan.spm
+    assert upper_bound(case).spm >= plan.spm
+
+
+def test_the_outputs_carry_the_robots(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    run = subprocess.run(
+        [sys.executable, "-m", "planning.cli", "solve", str(ROBOTS_CASE), "--out", str(out), "--cam-points", "720"],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
+    assert run.returncode == 0, run.stderr
+    assert "least clearance" in run.stdout
+    result = json.loads((out / "result.json").read_text())
+    block = result["robots"]
+    assert block["order"] == "overlapping"
+    assert [r["name"] for r in block["robots"]] == ["unloader", "loader"]
+    for r in block["robots"]:
+        assert set(r["events"]) == {
+            "leaves_waiting_point",
+            "at_die_centre",
+            "leaves_die_centre",
+            "back_at_waiting_point",
+        }
+        assert abs(r["least_clearance_mm"]) < 1e-3  # both bind
+        assert 0 < r["over_die_s"] < r["occupancy_s"]
+    with (out / "trajectory.csv").open() as f:
+        rows = list(csv.DictReader(row for row in f if not row.startswith("#")))
+    for name in ("unloader", "loader"):
+        x = np.array([float(r[f"{name}_position_mm"]) for r in rows])
+        need = np.array([float(r[f"{name}_needed_height_mm"]) for r in rows])
+        clearance = np.array([float(r[f"{name}_clearance_mm"]) for r in rows])
+        h = np.array([float(r["slider_height_mm"]) for r in rows])
+        assert x.min() == pytest.approx(0.0, abs=1e-9) and x.max() == pytest.approx(1000.0)
+        np.testing.assert_allclose(clearance, h - need, atol=1e-9)
+        assert clearance[need > 0].min() > -1e-3
+    lines = [line for line in (out / "robot_cams.csv").read_text().splitlines() if not line.startswith("#")]
+    header = lines[0].split(",")
+    cams = np.array([[float(v) for v in line.split(",")] for line in lines[1:]])
+    assert cams.shape == (720, len(header))
+    master = cams[:, 0]
+    position = cams[:, header.index("unloader_position_mm")]
+    slope = cams[:, header.index("unloader_dposition_dmaster")]
+    # the cam's slope is its position's derivative against the master (central differences, 0.5 deg apart)
+    central = (np.roll(position, -1) - np.roll(position, 1)) / (2 * (master[1] - master[0]))
+    moving = np.abs(slope) > 1.0
+    np.testing.assert_allclose(central[moving][5:-5], slope[moving][5:-5], rtol=0.05, atol=2.0)
+    assert (out / "interference.png").stat().st_size > 10_000
+
+
+def _refused(data: dict) -> str:
+    with pytest.raises(CaseFileError) as info:
+        case_from_data(data, "robots.yaml")
+    return str(info.value)
+
+
+def test_bad_robots_are_refused_naming_the_field() -> None:
+    data = robots_data()
+    high = copy.deepcopy(data)
+    high["robots"]["unloader"]["interference_mm"][0][1] = 1300.0
+    assert "robots.unloader.interference_mm.0" in _refused(high) and "stroke" in _refused(high)
+    waiting = copy.deepcopy(data)
+    waiting["robots"]["loader"]["interference_mm"] = [[0, 700], [1000, 700]]
+    assert "robots.loader.interference_mm" in _refused(waiting) and "waiting point" in _refused(waiting)
+    old = copy.deepcopy(data)
+    old["process"]["safety_height_mm"] = 700
+    assert "process.safety_height_mm" in _refused(old)
+    none = copy.deepcopy(data)
+    none["robots"] = {"order": "in-turns"}
+    assert "robots" in _refused(none)
+    backwards = copy.deepcopy(data)
+    backwards["robots"]["unloader"]["interference_mm"] = [[600, 700], [0, 700], [750, 0]]
+    assert "positions must increase" in _refused(backwards)
+    plain = yaml.safe_load(PUBLISHED.read_text())
+    del plain["process"]["transfer_time_s"]
+    assert "process.transfer_time_s" in _refused(plain)
+
+
+def test_check_refuses_robots_too_slow_for_any_cycle() -> None:
+    run = subprocess.run(
+        [sys.executable, "-m", "planning.cli", "solve", str(ROBOTS_CASE), "--no-plots", "--out", "/dev/null/x"]
+        + ["--set", "robots.unloader.speed_mm_s=10"],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
+    assert run.returncode in (2, 3) and "Traceback" not in run.stderr
+    check = subprocess.run(
+        [sys.executable, "-m", "planning.cli", "check", str(ROBOTS_CASE), "--set", "robots.unloader.speed_mm_s=10"],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
+    assert check.returncode == 3
+    assert "FAIL  robots in and out" in check.stdout
+
+
+def _random_robots(rng: np.random.Generator) -> dict:
+    """A robot case on the published press or one of the shipped others: random robots (speeds, paths, dwell,
+    curves, jerk or not, one robot or two, either order)."""
+    data = robots_data()
+    base = yaml.safe_load(
+        (
+            ROOT
+            / "cases"
+            / rng.choice(["wang2023-side-panel.yaml", "offset-crank-side-panel.yaml", "link-drive-side-panel.yaml"])
+        ).read_text()
+    )
+    for key in ("press", "key_points", "limits"):
+        data[key] = base[key]
+    data["process"] = {k: v for k, v in base["process"].items() if k not in ("safety_height_mm", "transfer_time_s")}
+    stroke = (
+        read_case(PUBLISHED).machine.stroke
+        if base["press"].get("mechanism", "crank-slider") == "crank-slider"
+        else None
+    )
+    data["robots"]["order"] = str(rng.choice(["overlapping", "in-turns"]))
+    for name in ("unloader", "loader"):
+        path = float(rng.uniform(400, 1500))
+        over, clear = sorted(rng.uniform(0.2, 0.9, 2) * path)
+        need = float(rng.uniform(300, 700 if stroke is None else 0.8 * stroke))
+        robot = {
+            "path_mm": path,
+            "speed_mm_s": float(rng.uniform(1500, 5000)),
+            "accel_mm_s2": float(rng.uniform(5000, 30000)),
+            "dwell_s": float(rng.uniform(0.0, 0.3)),
+            "interference_mm": [[0.0, need], [float(over), need], [float(clear) + 1.0, 0.0]],
+        }
+        if rng.random() < 0.3:
+            robot["jerk_mm_s3"] = float(rng.uniform(1e5, 1e6))
+        data["robots"][name] = robot
+    if rng.random() < 0.2:
+        del data["robots"]["loader"]
+    return data
+
+
+@pytest.mark.slow
+def test_the_bounds_stay_above_every_verified_plan_on_20_random_robot_cases() -> None:
+    from planning.solver.outcomes import PlanningError
+    from planning.tolerances import CROSSED_PCT
+
+    rng = np.random.default_rng(39)
+    planned = 0
+    for trial in range(20):
+        data = _random_robots(rng)
+        try:
+            case = case_from_data(data, f"random-{trial}")
+        except CaseFileError:
+            continue  # e.g. a need above a smaller press's stroke
+        upper = upper_bound(case).spm
+        try:
+            solution = solve(case)
+        except PlanningError:
+            continue
+        assert solution.verification.passed
+        planned += 1
+        assert solution.plan.spm <= upper * (1 + CROSSED_PCT / 100), (trial, solution.plan.spm, upper)
+        assert time_optimal_bound(case).spm >= solution.plan.spm * (1 - 1e-3), trial
+    assert planned >= 15
+
+
+def _drive_robots(tmp_path: Path) -> Path:
+    data = yaml.safe_load((ROOT / "cases" / "wang2023-side-panel-drive.yaml").read_text())
+    data["robots"] = robots_data()["robots"]
+    for key in ("safety_height_mm", "transfer_time_s"):
+        data["process"].pop(key, None)
+    data["name"] = "drive-robots"
+    path = tmp_path / "drive-robots.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+@pytest.mark.slow
+def test_every_command_runs_on_a_robot_case(tmp_path: Path) -> None:
+    """check, solve (the optimal law too, cams of every target), laws, bound --certified, sweep, tradeoff (a
+    case with a drive), cam, and the page's solve."""
+    from planning.cli import main
+    from planning.model.outcome import Outcome
+
+    case = str(ROBOTS_CASE)
+    drive = str(_drive_robots(tmp_path))
+    runs = [
+        ["check", case],
+        ["solve", case, "--out", str(tmp_path / "s"), "--cam", "all"],
+        [
+            "solve",
+            case,
+            "--law",
+            "optimal",
+            "--set",
+            "limits.crank_jerk_rad_s3=200",
+            "--no-plots",
+            "--out",
+            str(tmp_path / "o"),
+        ],
+        ["laws", case, "--out", str(tmp_path / "l")],
+        ["bound", case, "--certified"],
+        ["sweep", case, "--vary", "robots.loader.speed_mm_s=2500:4000:3", "--out", str(tmp_path / "w")],
+        ["tradeoff", drive, "--spm", "6:8:2", "--out", str(tmp_path / "t")],
+        ["cam", str(tmp_path / "s"), "--cam", "plcopen", "--out", str(tmp_path / "c")],
+        ["solve", drive, "--no-plots", "--out", str(tmp_path / "d")],
+    ]
+    for args in runs:
+        assert main(args) == 0, args
+    sweep = (tmp_path / "w" / "sweep.csv").read_text()
+    assert sweep.count("verified") >= 3
+    pytest.importorskip("flask")
+    from planning.web.server import create_app
+
+    client = create_app(ROOT / "cases").test_client()
+    loaded = client.get(f"/api/case/{ROBOTS_CASE.name}").get_json()
+    answer = client.post("/api/solve", json={"session": "r", "seq": 1, "case": loaded["case"]}).get_json()
+    assert answer["status"] == Outcome.VERIFIED and answer["result"]["robots"]["order"] == "overlapping"

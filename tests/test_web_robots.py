@@ -1,0 +1,86 @@
+"""The robots on the page (issue 39): their fields edited with real mouse and keyboard events in Chromium, the
+tools' needed heights drawn on the slide's panel, robots added to and removed from a case."""
+
+from __future__ import annotations
+
+import pytest
+
+from .web_page import CASES, browser_mark, chromium_profile, pick_case, running_server, wait_rendered
+
+ROBOTS_CASE = CASES / "wang2023-side-panel-robots.yaml"
+
+pytestmark = browser_mark()
+
+
+@pytest.fixture(scope="module")
+def site(tmp_path_factory):
+    with running_server(ROBOTS_CASE) as url, chromium_profile(tmp_path_factory.mktemp("chromium")) as browser:
+        yield url, browser
+
+
+@pytest.fixture
+def page(site):
+    url, browser = site
+    context = browser.new_context(viewport={"width": 1280, "height": 1400})
+    tab = context.new_page()
+    errors: list[str] = []
+    tab.on("pageerror", lambda e: errors.append(str(e)))
+    tab.goto(url)
+    wait_rendered(tab)
+    tab.errors = errors
+    yield tab
+    context.close()
+
+
+def click(tab, selector: str) -> None:  # noqa: ANN001 - a Playwright page
+    """A real mouse click at the middle of ``selector``'s box, scrolled into view first."""
+    target = tab.locator(selector)
+    target.scroll_into_view_if_needed()
+    box = target.bounding_box()
+    tab.mouse.click(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+
+
+def spm(tab) -> float:  # noqa: ANN001
+    return float(tab.evaluate("state.last.result.spm"))
+
+
+def test_the_robots_fields_edit_the_plan(page) -> None:
+    """The robots' section is on the form (no safety height, no transfer time), the chart draws each tool's
+    needed height; a slower unloader typed in with the keyboard gives fewer strokes, verified."""
+    assert page.locator('[data-field="robots.unloader.speed_mm_s"]').count() == 1
+    assert page.locator('[data-field="process.safety_height_mm"]').count() == 0
+    assert page.locator("#f-robots-unloader-interference_mm tbody tr").count() == 3
+    names = page.evaluate("document.querySelector('#motion-chart').data.map((t) => t.name)")
+    assert any(n.startswith("height the unloader's tool needs") for n in names)
+    assert any(n.startswith("height the loader's tool needs") for n in names)
+    fast = spm(page)
+    before = int(page.evaluate("document.body.dataset.rendered"))
+    click(page, '[data-field="robots.unloader.speed_mm_s"]')
+    page.keyboard.press("Control+A")
+    page.keyboard.type("2000")
+    page.keyboard.press("Tab")
+    wait_rendered(page, before)
+    page.wait_for_function("state.last && state.last.confirmed", timeout=60_000)
+    assert page.evaluate("state.last.result.verified")
+    assert spm(page) < fast
+    assert page.errors == []
+
+
+def test_robots_added_and_removed(page) -> None:
+    """The published case has no robots: "add robots" (a mouse click) gives it the template's two, verified;
+    "remove the robots" gives the one-height model back, its 12.123 strokes/min."""
+    pick_case(page, "wang2023-side-panel.yaml")
+    assert page.locator('[data-field="robots.unloader.speed_mm_s"]').count() == 0
+    before = int(page.evaluate("document.body.dataset.rendered"))
+    click(page, "#add-robots")
+    wait_rendered(page, before)
+    page.wait_for_function("state.last && state.last.confirmed && state.last.result", timeout=60_000)
+    assert page.locator('[data-field="robots.loader.path_mm"]').count() == 1
+    assert page.evaluate("state.last.result.verified") and page.evaluate("state.last.result.robots != null")
+    before = int(page.evaluate("document.body.dataset.rendered"))
+    click(page, "#remove-robots")
+    wait_rendered(page, before)
+    page.wait_for_function("state.last && state.last.confirmed && state.last.result", timeout=60_000)
+    assert page.evaluate("state.last.result.robots == null")
+    assert round(spm(page), 3) == 12.123
+    assert page.errors == []
