@@ -458,6 +458,8 @@ def _compare(case, args) -> int:
 
     if case.published is None or case.published.solution is None:
         raise CommandError(f"{args.case}: published.solution: the case has no published solution to compare")
+    if case.robots is not None:  # the published solution is the one-height model's (its transfer time)
+        raise CommandError(f"{args.case}: robots: the published solution has one safety height and one transfer time")
     # the paper's notation describes its own law: compare under the improved S-curve
     case = case.with_law(ImprovedSCurve.name)
     out = _output_folder(case, args, COMPARE_FILES)

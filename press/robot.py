@@ -175,20 +175,29 @@ class Robot:
         return self.curve.need(self.position(t_s, start_s, period_s))
 
 
-def crossing_offsets(robot: Robot) -> np.ndarray:
-    """The times [s from the robot's start] at which its tool passes its interference curve's points, in and
-    out (sorted): the curve's kinks and its last step, where a sampled clearance must look exactly."""
+def crossings(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
+    """``(times, needs)``: the times [s from the robot's start] at which its tool passes its interference
+    curve's points, in and out (sorted), and the height [mm] the tool needs at each point itself (the value
+    on the curve's side, where a step follows the last point): the curve's kinks and its step, where a sampled
+    clearance must look exactly."""
     move, out = robot.move, []
     for x in robot.curve.positions_mm:
         if not 0.0 < x < robot.path_mm:
             continue
+        need = float(np.interp(x, robot.curve.positions_mm, robot.curve.needed_height_mm))
         for travelled, since in ((robot.path_mm - x, 0.0), (x, move.duration_s + robot.dwell_s)):
             lo, hi = 0.0, move.duration_s
             for _ in range(BISECTIONS):  # the distance travelled is monotone in time
                 mid = 0.5 * (lo + hi)
                 lo, hi = (mid, hi) if float(move.state(mid)[0][()]) < travelled else (lo, mid)
-            out.append(since + hi)
-    return np.sort(np.array(out, dtype=float))
+            out.append((since + hi, need))
+    out.sort()
+    return np.array([t for t, _ in out], dtype=float), np.array([n for _, n in out], dtype=float)
+
+
+def crossing_offsets(robot: Robot) -> np.ndarray:
+    """The times of :func:`crossings`."""
+    return crossings(robot)[0]
 
 
 def clear_position_mm(curve: InterferenceCurve) -> float:
@@ -216,13 +225,16 @@ def time_to_clear_s(robot: Robot) -> float:
 BISECTIONS = 60  # halvings of a move's duration: below round-off of any move under a day
 
 
-def sample_offsets(robot: Robot, count: int) -> np.ndarray:
-    """``count`` times [s from the robot's start] over its occupancy: the curve's crossings
-    (:func:`crossing_offsets`) and evenly spaced times between, sorted (a fixed number, so that an NLP's rows
-    keep their shape)."""
-    crossings = crossing_offsets(robot)
-    even = np.linspace(0.0, robot.occupancy_s, max(count - crossings.size, 2))
-    return np.sort(np.concatenate([even, crossings]))[:count]
+def sample_points(robot: Robot, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """``count`` times [s from the robot's start] over its occupancy and the height [mm] the tool needs at
+    each: the curve's crossings (:func:`crossings`, each with its point's own need) and evenly spaced times
+    between, sorted (a fixed number, so that an NLP's rows keep their shape)."""
+    times, needs = crossings(robot)
+    even = np.linspace(0.0, robot.occupancy_s, max(count - times.size, 2))
+    all_times = np.concatenate([even, times])
+    all_needs = np.concatenate([robot.curve.need(robot.position_since_start(even)), needs])
+    order = np.argsort(all_times, kind="stable")[:count]
+    return all_times[order], all_needs[order]
 
 
 def time_needing(

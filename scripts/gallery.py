@@ -25,6 +25,7 @@ CAPTIONS = {
     "motion_vs_angle.png": "the motion against crank angle (`pressplan solve`)",
     "motion_vs_time.png": "the motion against time (`pressplan solve`)",
     "drive.png": "the drive (`pressplan solve`, a case with a drive)",
+    "interference.png": "the robots on their interference curves (`pressplan solve`, a case with robots)",
     "laws_overlay.png": "every motion law (`pressplan laws`)",
     "tradeoff.png": "RMS torque and energy at the line's rate (`pressplan tradeoff --spm 5:max:5`)",
     "sweep_1d.png": "a sweep over the transfer time (`pressplan sweep`; beyond 22 s no plan: the window cannot "

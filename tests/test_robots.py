@@ -319,3 +319,58 @@ def test_every_command_runs_on_a_robot_case(tmp_path: Path) -> None:
     loaded = client.get(f"/api/case/{ROBOTS_CASE.name}").get_json()
     answer = client.post("/api/solve", json={"session": "r", "seq": 1, "case": loaded["case"]}).get_json()
     assert answer["status"] == Outcome.VERIFIED and answer["result"]["robots"]["order"] == "overlapping"
+
+
+def _solved(data: dict):  # noqa: ANN202 - (Solution, Case)
+    case = case_from_data(data, "robots.yaml")
+    return solve(case), case
+
+
+def test_a_step_in_the_curve_is_held_on_its_needing_side() -> None:
+    """A curve that steps from the safety height to nothing at 580 mm: the loader going out later by 2 ms
+    passes the step with the slide about 2 mm too low, which the check at the step's exact time finds (a
+    sample just past the step would see the zero beyond it)."""
+    data = robots_data()
+    for name in ("unloader", "loader"):
+        data["robots"][name]["interference_mm"] = [[0, 705.7], [580, 705.7]]
+    solution, case = _solved(data)
+    assert solution.verification.passed
+    starts = dict(solution.plan.robot_starts_s)
+    starts["loader"] += 2e-3
+    moved = evaluate(replace(solution.plan, robot_starts_s=starts), case, least_energy=False)
+    failed = [c for c in moved.verification.failures() if c.id == "robots"]
+    assert failed and failed[0].name.startswith("loader") and failed[0].value < failed[0].limit - 0.5
+
+
+def test_in_turns_the_loader_is_back_before_the_next_unloader_leaves() -> None:
+    """Slow robots in turns (2.383 s each in and out), their tools needing almost nothing: the two
+    occupancies fill the cycle, the loader back just as the next unloader leaves; 10 ms later fails."""
+    data = robots_data()
+    data["robots"]["order"] = "in-turns"
+    for name in ("unloader", "loader"):
+        slow = {"speed_mm_s": 1500.0, "accel_mm_s2": 3000.0, "dwell_s": 0.05, "interference_mm": [[0, 5.0]]}
+        data["robots"][name].update(slow)
+    solution, case = _solved(data)
+    assert solution.verification.passed
+    assert solution.plan.period == pytest.approx(2 * case.robots_on_path[0].occupancy_s, rel=1e-6)
+    wrap = next(c for c in solution.verification.checks if c.name.startswith("the loader back before"))
+    starts = dict(solution.plan.robot_starts_s)
+    starts["loader"] += wrap.value + 0.01  # its return 10 ms after the next unloader has left
+    moved = evaluate(replace(solution.plan, robot_starts_s=starts), case, least_energy=False)
+    assert any(c.name.startswith("the loader back before") for c in moved.verification.failures())
+
+
+def test_a_robot_slower_than_the_plan_fails_its_check_without_an_exception() -> None:
+    """A neighbour's plan (a sweep's, the page's) checked against a case whose robot no longer fits its cycle:
+    a failed check, not a crash; a robot that never needs the slide up has nothing to fail."""
+    plan = shipped().plan
+    data = robots_data()
+    data["robots"]["unloader"]["speed_mm_s"] = 500.0
+    slow = case_from_data(data, "slow.yaml")
+    failures = evaluate(plan, slow, least_energy=False).verification.failures()
+    assert any(c.name == "unloader: in and out within the cycle" for c in failures)
+    data = robots_data()
+    data["robots"]["loader"]["interference_mm"] = [[0, 0.0]]
+    solution, _ = _solved(data)
+    assert solution.verification.passed
+    assert any(c.name == "loader: its tool never needs the slide up" for c in solution.verification.checks)

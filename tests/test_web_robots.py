@@ -51,8 +51,8 @@ def test_the_robots_fields_edit_the_plan(page) -> None:
     assert page.locator('[data-field="process.safety_height_mm"]').count() == 0
     assert page.locator("#f-robots-unloader-interference_mm tbody tr").count() == 3
     names = page.evaluate("document.querySelector('#motion-chart').data.map((t) => t.name)")
-    assert any(n.startswith("height the unloader's tool needs") for n in names)
-    assert any(n.startswith("height the loader's tool needs") for n in names)
+    assert any(n.startswith("robots.unloader: the height its tool needs") for n in names), names
+    assert any(n.startswith("robots.loader: the height its tool needs") for n in names), names
     fast = spm(page)
     before = int(page.evaluate("document.body.dataset.rendered"))
     click(page, '[data-field="robots.unloader.speed_mm_s"]')

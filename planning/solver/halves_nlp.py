@@ -432,9 +432,9 @@ def robot_bounds(bounds: Callable[..., tuple], case: Case, *args: Any) -> tuple[
     return np.append(lo, [-top] * len(ROBOT_VARIABLES)), np.append(hi, [top] * len(ROBOT_VARIABLES))
 
 
-def complete_robots(complete: Callable | None, case_robots: bool, values: dict[str, float]) -> dict[str, float]:
-    """``values`` (``complete`` applied first) with the robots' starts where a start lacks them: around TDC,
-    the unloader's way in and dwell before the middle of theta4 -> theta1, the loader's way in after it."""
+def complete_robots(complete: Callable | None, values: dict[str, float]) -> dict[str, float]:
+    """``values`` (``complete`` applied first) with the robots' starts where a start lacks them: the unloader
+    leaving at theta4, the loader halfway from theta4 to theta1."""
     values = dict(values if complete is None else complete(values))
     if "unloader_start" not in values:
         values["unloader_start"] = values["opening_time"]
@@ -482,7 +482,7 @@ def _build(
     complete = complete_exit if die_exit else None
     if robots:
         scales, bounds = partial(robot_scales, scales), partial(robot_bounds, bounds)
-        complete = partial(complete_robots, complete, True)
+        complete = partial(complete_robots, complete)
     return CycleNLP(
         program,
         *rows.bounds(),

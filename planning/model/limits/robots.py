@@ -42,8 +42,8 @@ from planning.model.limits.base import (
     total,
 )
 from planning.model.units import RPM
-from planning.tolerances import LIMIT_REL_TOL, REFINE_MARGIN, SAME_HEIGHT_MM, TIME_TOL_S
-from press.robot import Robot, crossing_offsets, sample_offsets, time_needing, time_to_clear_s
+from planning.tolerances import LIMIT_REL_TOL, REFINE_MARGIN, TIME_TOL_S
+from press.robot import Robot, crossings, sample_points, time_needing, time_to_clear_s
 
 ROBOT_SAMPLES = 48  # times of each robot's occupancy at which an NLP holds its clearance
 ROBOTS = ("unloader", "loader")  # the case's robots (``planning.model.case.ROBOT_NAMES``), in their order
@@ -81,6 +81,20 @@ def order_terms(case: Any) -> tuple[float, float]:
     if case.robots.order == "in-turns":
         return 0.0, unloader.occupancy_s
     return loader.move.duration_s, unloader.move.duration_s + unloader.dwell_s + time_to_clear_s(unloader)
+
+
+def least_period_s(case: Any) -> float:
+    """The shortest cycle [s] any schedule of the robots allows: each occupancy; in turns both (the loader
+    after the unloader, back before the next one leaves); overlapping, the unloader's dwell and clearing and the
+    loader's dwell (between theta3 and theta2 of one cycle)."""
+    robots = robots_by_name(case)
+    longest = max(r.occupancy_s for r in robots.values())
+    if len(robots) < 2:
+        return longest
+    u, ld = robots["unloader"], robots["loader"]
+    if case.robots.order == "in-turns":
+        return u.occupancy_s + ld.occupancy_s
+    return max(longest, u.dwell_s + time_to_clear_s(u) + ld.dwell_s)
 
 
 def span_s(case: Any) -> float:
@@ -127,8 +141,7 @@ class RobotsLimit(Limit):
                     f"robot_{r}_dwell": robot.dwell_s,
                     f"robot_{r}_present": 1.0,
                 }
-                offsets = sample_offsets(robot, ROBOT_SAMPLES)
-                needs = robot.curve.need(robot.position_since_start(offsets))
+                offsets, needs = sample_points(robot, ROBOT_SAMPLES)
             values |= {f"robot_{r}_offset_{k}": float(v) for k, v in enumerate(offsets)}
             values |= {f"robot_{r}_need_{k}": float(v) for k, v in enumerate(needs)}
         lead, clear = order_terms(case)
@@ -143,16 +156,18 @@ class RobotsLimit(Limit):
         }
 
     def at_draw_speed(self, draw: Any, speed: float) -> list[Check]:
-        """The robots in and out within the longest cycle the minimum crank speed allows (:func:`span_s`)."""
+        """The robots' shortest cycle (:func:`least_period_s`) within the longest the minimum crank speed
+        allows."""
         case = draw.case
         longest = 2 * np.pi / (case.limits.min_crank_speed_rpm * RPM)
         name = f"robots in and out ({case.robots.order}) within the longest cycle (limits.min_crank_speed_rpm)"
-        return [Check.of(self.id, name, span_s(case), longest, "s", "max", TIME_TOL_S)]
+        return [Check.of(self.id, name, least_period_s(case), longest, "s", "max", TIME_TOL_S)]
 
     def precheck(self, case: Any, given: float | None, lowest: float) -> Impossible | None:
-        """The robots' span (:func:`span_s`) within the longest cycle the minimum crank speed allows."""
+        """The robots' shortest cycle (:func:`least_period_s`) within the longest the minimum crank speed
+        allows."""
         longest = 2 * np.pi / (case.limits.min_crank_speed_rpm * RPM)
-        span = span_s(case)
+        span = least_period_s(case)
         if span <= longest:
             return None
         robots = robots_by_name(case)
@@ -192,42 +207,34 @@ class RobotsLimit(Limit):
 
     def check(self, dense: Dense) -> list[Check]:
         case, plan = dense.case, dense.plan
-        out = []
         missing = [robot.name for robot in case.robots_on_path if robot.name not in plan.robot_starts_s]
         if missing:  # a plan made without these robots (a neighbour's, another case's): no schedule to check
             name = f"{', '.join(missing)}: scheduled in the plan"
             return [Check.of("robots_order", name, float("nan"), 0.0, "s", "min", TIME_TOL_S)]
+        k, period = plan.robot_time_scale, plan.period
+        within = [_within_check(robot, robot.occupancy_s / k, period) for robot in case.robots_on_path]
+        if not all(c.passed for c in within):  # a robot longer than the cycle has no periodic schedule
+            return within
+        out, clearances = [], []
         for robot in case.robots_on_path:
             schedule = robot_schedule(dense, robot)
-            need = schedule.tightest_need_mm
-            c = Check.of(
-                self.id,
-                f"{robot.name}: slide height where its tool is closest",
-                need + schedule.least_clearance_mm,
-                need,
-                self.unit,
-                "min",
-                LIMIT_REL_TOL * max(need, 1.0),
-            )
-            if np.isfinite(schedule.least_clearance_mm):  # where: the tightest time
-                at = schedule.least_at_s
-                angle = float(np.degrees(plan.profile.at_time(np.array([at]))[0][0])) % 360.0
-                c = replace(c, peak=Peak(at, angle, ((at, at),)))
-            if not c.passed:  # the search raises the needs at the NLP's samples by the worst shortfall
-                factor = (1 / max(schedule.least_ratio, 0.5)) * (1 + REFINE_MARGIN) / (1 - REFINE_MARGIN)
-                c = replace(c, refine_by=("robots_need_factor", factor, np.inf))
-            out.append(c)
-            out += _path_checks(robot, plan.robot_time_scale)
-        out += _order_checks(case, plan, dense)
-        return out
+            clearances.append((_clearance_check(self, dense, schedule), schedule.least_ratio))
+            out.append(clearances[-1][0])
+            out += _path_checks(robot, k)
+        failed = [(c, ratio) for c, ratio in clearances if not c.passed]
+        if failed:  # the search raises the needs at the NLP's samples once, by the worst shortfall
+            worst, ratio = min(failed, key=lambda pair: pair[1])
+            factor = (1 / max(ratio, 0.5)) * (1 + REFINE_MARGIN) / (1 - REFINE_MARGIN)
+            out[out.index(worst)] = replace(worst, refine_by=("robots_need_factor", factor, np.inf))
+        return out + within + _order_checks(case, plan, dense)
 
     def bound_rows(self, mesh: BoundMesh) -> list[tuple[Any, Any, Any]]:
         """For each height a tool needs: the intervals that reach it take at least the robots' time there;
-        the period at least each occupancy (module docstring)."""
+        the period at least the robots' shortest cycle (:func:`least_period_s`; module docstring)."""
         case = mesh.case
         robots = robots_by_name(case)
         top = np.maximum(mesh.h[:-1], mesh.h[1:])  # an interval's highest slide position (h monotone on it)
-        rows = [(total(mesh.tau), max(r.occupancy_s for r in robots.values()), np.inf)]
+        rows = [(total(mesh.tau), least_period_s(case), np.inf)]
         for level in _levels(robots):
             above = np.flatnonzero(top >= level).tolist()
             need = _time_needing(case, robots, level)
@@ -238,6 +245,32 @@ class RobotsLimit(Limit):
     def relaxed_rows(self, mesh: Any) -> list[tuple[Any, Any, Any]]:
         """The same necessary conditions over the certified mesh (h monotone on each interval)."""
         return self.bound_rows(mesh)
+
+
+def _within_check(robot: Robot, occupancy_s: float, period_s: float) -> Check:
+    """The robot in and out within the cycle (its occupancy as it runs, at most the period)."""
+    name = f"{robot.name}: in and out within the cycle"
+    return Check.of("robots_order", name, occupancy_s, period_s, "s", "max", TIME_TOL_S)
+
+
+def _clearance_check(limit: RobotsLimit, dense: Dense, schedule: RobotSchedule) -> Check:
+    """The slide's height where the robot's tool is closest against what it needs there, located; a tool
+    that never needs height has nothing to keep (passes)."""
+    if not np.isfinite(schedule.least_clearance_mm):
+        return Check.of(limit.id, f"{schedule.name}: its tool never needs the slide up", 0.0, 0.0, "mm", "min", 0.0)
+    need = schedule.tightest_need_mm
+    c = Check.of(
+        limit.id,
+        f"{schedule.name}: slide height where its tool is closest",
+        need + schedule.least_clearance_mm,
+        need,
+        limit.unit,
+        "min",
+        LIMIT_REL_TOL * max(need, 1.0),
+    )
+    at = schedule.least_at_s
+    angle = float(np.degrees(dense.plan.profile.at_time(np.array([at]))[0][0])) % 360.0
+    return replace(c, peak=Peak(at, angle, ((at, at),)))
 
 
 def _levels(robots: dict[str, Robot]) -> list[float]:
@@ -286,18 +319,19 @@ def robot_schedule(dense: Dense, robot: Robot) -> RobotSchedule:
     k = plan.robot_time_scale
     period = plan.period
     start = plan.robot_starts_s[robot.name]  # [s of the planned schedule, period k * period]
-    exact = np.mod(start + crossing_offsets(robot), k * period) / k
+    offsets, at_points = crossings(robot)  # each with its point's own need (a step's needing side)
+    exact = np.mod(start + offsets, k * period) / k
     theta = plan.profile.at_time(exact)[0]
     t = np.concatenate([dense.t, exact])
     h = np.concatenate([dense.h, case.machine.height(np.asarray(theta))])
-    need = robot.needed_height(k * t, start, k * period)
+    need = np.concatenate([robot.needed_height(k * dense.t, start, k * period), at_points])
     needing = need > 0  # where the tool is over the die (elsewhere the slide is free, down to BDC)
     clearance = np.where(needing, h - need, np.inf)
     i = int(np.argmin(clearance))
     ratio = float(np.min(h[needing] / need[needing])) if np.any(needing) else 1.0
     move = robot.move.duration_s
     events = np.mod(start + np.array([0.0, move, move + robot.dwell_s, robot.occupancy_s]), k * period) / k
-    over = time_needing(robot, SAME_HEIGHT_MM) / k
+    over = time_needing(robot, float(np.nextafter(0.0, 1.0))) / k  # any height at all
     return RobotSchedule(
         robot.name, start / k, tuple(events.tolist()), float(clearance[i]), float(t[i]), ratio, over, float(need[i])
     )
@@ -339,8 +373,8 @@ def _path_checks(robot: Robot, scale: float) -> list[Check]:
 
 
 def _order_checks(case: Any, plan: Any, dense: Dense) -> list[Check]:
-    """Each robot at the die between the draws, within the period; the loader after the unloader (in the
-    order the case says). Times from theta3, within the period."""
+    """Each robot at the die between the draws; the loader after the unloader (in the order the case says;
+    in turns also back before the next unloader leaves). Times from theta3, within the period."""
     period = plan.period
     t3 = float(dense.key_times[2])
     free = float(np.mod(dense.key_times[1] - t3, period))  # theta3 -> theta2: the time outside the draw
@@ -359,15 +393,16 @@ def _order_checks(case: Any, plan: Any, dense: Dense) -> list[Check]:
         what = "grips after theta3" if name == "unloader" else "has dropped the blank"
         margin = min(at_die[name], free - at_die[name])
         out.append(Check.of("robots_order", f"{name}: {what}, before theta2", margin, 0.0, "s", "min", TIME_TOL_S))
-        occupancy = robot.occupancy_s / k
-        name_within = f"{name}: in and out within the cycle"
-        out.append(Check.of("robots_order", name_within, occupancy, period, "s", "max", TIME_TOL_S))
     if len(robots) == 2:
         u, ld = robots["unloader"], robots["loader"]
         grip, dropped = at_die["unloader"], at_die["loader"]
         if case.robots.order == "in-turns":
-            gap = (dropped - (ld.dwell_s + ld.move.duration_s) / k) - (grip + (u.dwell_s + u.move.duration_s) / k)
-            name = "the loader leaves after the unloader is back"
+            back = grip + (u.dwell_s + u.move.duration_s) / k  # the unloader at its waiting point again
+            leaves = dropped - (ld.dwell_s + ld.move.duration_s) / k  # the loader leaves its own
+            wrap = (grip - u.move.duration_s / k + period) - (dropped + ld.move.duration_s / k)
+            name = "the loader back before the next unloader leaves"
+            out.append(Check.of("robots_order", name, wrap, 0.0, "s", "min", TIME_TOL_S))
+            gap, name = leaves - back, "the loader leaves after the unloader is back"
         else:
             gap = (dropped - ld.dwell_s / k) - (grip + (u.dwell_s + time_to_clear_s(u)) / k)
             name = "the loader reaches the die once the unloader is clear of it"

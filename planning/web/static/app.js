@@ -743,7 +743,6 @@ function drawCharts() {
     if (state.pinned) traces.push({ x: xOf(state.pinned.curves), y: state.pinned.curves[panel.key], name: "pinned " + TRACE_NAMES[panel.key], yaxis: name, line: { dash: "dot", color: "#777", width: 1 } });
   });
   traces.push(...limitTraces(ans.limit_lines, x, axis, axes));
-  if (axes.slider_height_mm && r.robots) traces.push(...robotTraces(r, c, x, axes.slider_height_mm));
   if (axes.slider_height_mm) {
     const keyX = r.key_points.map((k) => (axis === "time" ? k.time_s : k.angle_deg));
     const keyIndex = keyX.map((v) => nearest(x, v));
@@ -756,18 +755,6 @@ function drawCharts() {
   if (!chart.dataset.follows) { chart.on("plotly_hover", followChart); chart.dataset.follows = "1"; }
   drawDrive(r, c, x, axis);
   drawEnergy(r, c, x, axis);
-}
-
-// each robot's tool: the slide height it needs where it is over the die, on the slide height's panel (the
-// interference chart of `pressplan solve`, interference.png, draws the same)
-const ROBOT_COLOURS = { unloader: "#d62728", loader: "#2ca02c" };
-function robotTraces(r, c, x, yaxis) {
-  return r.robots.robots.map((robot) => {
-    const need = c[`${robot.name}_needed_height_mm`] || [];
-    const least = robot.least_clearance_mm;
-    const words = least != null ? `, least clearance ${least.toFixed(2)} mm` : "";
-    return { x, y: need.map((v) => (v > 0 ? v : null)), yaxis, name: `height the ${robot.name}'s tool needs [mm]${words}`, line: { color: ROBOT_COLOURS[robot.name] || "#000", width: 1.5 }, connectgaps: false };
-  });
 }
 
 function nearest(xs, v) {
