@@ -56,6 +56,8 @@ SAME_SPEED_RAD_S = 1e-12  # [rad/s] two crank speeds this close are the same (a 
 SAME_TIME_S = 1e-12  # [s] a grid point this close to a knot is the knot
 KNOT_TIME_S = 1e-9  # [s] a time this close after a knot is the knot (where a key point falls; a left
 # limit at a knot is taken this share of the segment before it)
+SAME_POSITION_MM = 1e-9  # [mm] a robot this close to a point of its interference curve is at it (its position
+# sums its move's pieces: about 1e-13 mm of round-off at the die centre)
 SAME_HEIGHT_MM = 1e-9  # [mm] a height this far outside the stroke still counts as its end; the die height
 # counts up to this
 SAME_SCORE = 1e-9  # [s, or the objective's normalised score] a solution must beat the best by this to

@@ -38,6 +38,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from planning.tolerances import SAME_POSITION_MM, TIME_TOL_S
+
 
 @dataclass(frozen=True)
 class MoveLimits:
@@ -63,6 +65,7 @@ class Move:
         """``(s, v, a)`` at times ``tau_s`` [s] from the move's start: the distance travelled [mm] (0 before
         the move, ``length_mm`` after it), the speed [mm/s] and the acceleration [mm/s^2]."""
         tau = np.clip(np.asarray(tau_s, dtype=float), 0.0, self.duration_s)
+        done = tau >= self.duration_s  # at the end exactly (the pieces' sum carries round-off)
         s, v, a = np.zeros_like(tau), np.zeros_like(tau), np.zeros_like(tau)
         start, s0, v0 = 0.0, 0.0, 0.0
         for k, (length, a0, jerk) in enumerate(self.pieces):
@@ -77,7 +80,7 @@ class Move:
                 v0 + a0 * length + jerk * length**2 / 2,
             )
             start += length
-        return s, v, a
+        return np.where(done, self.length_mm, s), np.where(done, 0.0, v), np.where(done, 0.0, a)
 
 
 def fastest_move(length_mm: float, limits: MoveLimits) -> Move:
@@ -128,7 +131,7 @@ class InterferenceCurve:
         """The height needed at positions ``x_mm`` [mm]."""
         x = np.asarray(x_mm, dtype=float)
         heights = np.interp(x, self.positions_mm, self.needed_height_mm)
-        return np.where(x > self.positions_mm[-1], 0.0, heights)
+        return np.where(x > self.positions_mm[-1] + SAME_POSITION_MM, 0.0, heights)
 
 
 @dataclass(frozen=True)
@@ -154,7 +157,7 @@ class Robot:
     def position(self, t_s: np.ndarray, start_s: float, period_s: float) -> np.ndarray:
         """The position [mm] at cycle times ``t_s`` [s] of a robot that leaves its waiting point at ``start_s``
         [s] each cycle of ``period_s`` [s] (in, dwell, out, then waiting)."""
-        if self.occupancy_s > period_s:
+        if self.occupancy_s > period_s + TIME_TOL_S:  # (equal up to round-off: the plan's period at it)
             took = f"in, dwell and out take {self.occupancy_s:g} s"
             raise ValueError(f"{self.name}: {took}, longer than the cycle {period_s:g} s")
         return self.position_since_start(np.mod(np.asarray(t_s, dtype=float) - start_s, period_s))

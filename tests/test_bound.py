@@ -69,6 +69,7 @@ def test_jerk_limited_bound_converges_and_tightens(servo_case):
     assert time_optimal_bound(free, 1440).spm > spm[-1] + 0.1
 
 
+@pytest.mark.slow  # every law and the jerk-limited bound: 24 s
 def test_laws_against_the_jerk_limited_bound(servo_case):
     """Issue 5: with a crank-jerk limit the best law reaches >= 95 % of the jerk-limited bound, and
     no law exceeds the bound."""

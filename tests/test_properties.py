@@ -25,10 +25,10 @@ from .random_cases import CASES, build_case, seeded_case, seeded_offset_case
 
 RANDOM_SET = 100  # presses of each kind (draw speed given, or left to the planner) in the normal run
 VERIFIED_SHARE = 0.9  # of them at least this share end in a verified plan
-OFFSET_SET = 40  # offset crank-sliders: the first half in the normal run, the second in the slow tier
-RANDOM_PARTS = 4  # each set in parts of 25 presses (tests the workers share)
+OFFSET_SET = 40  # offset crank-sliders: the first quarter in the normal run, the others in the slow tier
+RANDOM_PARTS = 5  # each set in parts of 20 presses (tests the workers share)
 QUICK_PARTS = 1  # of them in the normal run; the others in the slow tier (CI runs both)
-UPPER_BOUND_SET = 4  # verified presses of each part checked against the certified upper bound (32 in all)
+UPPER_BOUND_SET = 4  # verified presses of each part checked against the certified upper bound (40 in all)
 UPPER_BOUND_LAWS_SET = 30  # random presses whose every law and bracket motion the slow run checks against it
 SLOW_CASES = 2000
 SLOW_CHUNK = 100
@@ -126,12 +126,13 @@ def test_no_law_and_no_bracket_motion_above_the_upper_bound(seed):
 
 
 @pytest.mark.parametrize(
-    "half", [pytest.param(0, id="first half"), pytest.param(1, id="second half", marks=pytest.mark.slow)]
+    "quarter",
+    [pytest.param(k, id=f"quarter {k + 1}", marks=[] if k == 0 else [pytest.mark.slow]) for k in range(4)],
 )
-def test_random_offset_presses_end_verified(half):
+def test_random_offset_presses_end_verified(quarter):
     """Offset crank-sliders (the slide's line up to 12 % of the crank radius to either side) through the same
     properties: the offset formula in the NLPs, the verification and the asymmetric inverse height."""
-    seeds = range(half * OFFSET_SET // 2, (half + 1) * OFFSET_SET // 2)
+    seeds = range(quarter * OFFSET_SET // 4, (quarter + 1) * OFFSET_SET // 4)
     outcomes = [outcome(seeded_offset_case(seed)) for seed in seeds]
     assert outcomes.count("verified") >= VERIFIED_SHARE * len(outcomes), sorted(set(outcomes))
 

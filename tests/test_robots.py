@@ -182,25 +182,57 @@ def test_bad_robots_are_refused_naming_the_field() -> None:
     plain = yaml.safe_load(PUBLISHED.read_text())
     del plain["process"]["transfer_time_s"]
     assert "process.transfer_time_s" in _refused(plain)
+    off_centre = copy.deepcopy(data)
+    off_centre["robots"]["loader"]["interference_mm"] = [[100, 700], [750, 0]]
+    assert "robots.loader.interference_mm.0: the first row is the die centre" in _refused(off_centre)
+    full = copy.deepcopy(data)
+    full["robots"]["loader"]["interference_mm"] = [[0, 900.0], [750, 0]]  # the stroke: TDC, an instant
+    assert "at or above the stroke" in _refused(full)
 
 
-def test_check_refuses_robots_too_slow_for_any_cycle() -> None:
+@pytest.mark.parametrize(
+    ("change", "field", "what"),
+    [
+        ("robots.unloader.speed_mm_s=10", "robots.unloader.speed_mm_s", "shortest cycle"),
+        ("robots.unloader.dwell_s=100", "robots.unloader.dwell_s", "shortest cycle"),
+        ("robots.unloader.dwell_s=58.5", "robots.unloader.dwell_s", "time between the draws"),
+    ],
+)
+def test_impossible_robots_are_refused_naming_the_field(change: str, field: str, what: str, tmp_path: Path) -> None:
+    """A dwell of 58.5 s fits the longest cycle (60 s at 1 rpm) but not between two draws (the draw takes
+    1.455 s at 6.7 rpm): exit 3 naming the dwell; `check` fails the same condition (exit 3)."""
     run = subprocess.run(
-        [sys.executable, "-m", "planning.cli", "solve", str(ROBOTS_CASE), "--no-plots", "--out", "/dev/null/x"]
-        + ["--set", "robots.unloader.speed_mm_s=10"],
+        [sys.executable, "-m", "planning.cli", "solve", str(ROBOTS_CASE), "--no-plots", "--out", str(tmp_path / "o")]
+        + ["--set", change],
         capture_output=True,
         text=True,
         cwd=ROOT,
     )
-    assert run.returncode in (2, 3) and "Traceback" not in run.stderr
+    assert run.returncode == 3 and "Traceback" not in run.stderr
+    assert f"infeasible: {field}: the robots' {what}" in run.stderr
+    assert not (tmp_path / "o").exists()
     check = subprocess.run(
-        [sys.executable, "-m", "planning.cli", "check", str(ROBOTS_CASE), "--set", "robots.unloader.speed_mm_s=10"],
+        [sys.executable, "-m", "planning.cli", "check", str(ROBOTS_CASE), "--set", change],
         capture_output=True,
         text=True,
         cwd=ROOT,
     )
-    assert check.returncode == 3
-    assert "FAIL  robots in and out" in check.stdout
+    assert check.returncode == 3 and f"FAIL  robots' {what}" in check.stdout
+
+
+def test_a_dwell_at_the_die_centre_needs_its_rows_height() -> None:
+    """A one-row curve (the tool needs the safety height at the die centre only): the dwell there holds it,
+    whatever round-off the move's pieces leave in the position (1694.8 mm at 37437 mm/s^2 leaves 2e-13 mm)."""
+    data = robots_data()
+    data["robots"]["unloader"].update({"path_mm": 1694.8, "accel_mm_s2": 37437.0, "interference_mm": [[0, 705.7]]})
+    case = case_from_data(data, "one-row.yaml")
+    robot = case.robots_on_path[0]
+    dwelling = robot.move.duration_s + 0.5 * robot.dwell_s
+    assert robot.curve.need(robot.position_since_start(np.array([dwelling])))[0] == 705.7
+    solution = solve(case)
+    assert solution.verification.passed
+    check = next(c for c in solution.verification.checks if c.name.startswith("unloader: slide height"))
+    assert check.limit == 705.7
 
 
 def _random_robots(rng: np.random.Generator) -> dict:

@@ -786,8 +786,8 @@ def _drive_mass_checks(case: Case) -> None:
 
 def _transfer_checks(case: Case) -> None:
     """The old model's two fields without robots, none with them; a robot's interference curve a table of
-    positions along its path (increasing, within it) and heights within the stroke, clear at its waiting
-    point."""
+    positions along its path (from the die centre, increasing, within the path) and heights below the stroke,
+    clear at its waiting point."""
     process = case.process
     if case.robots is None:
         for key in ("safety_height_mm", "transfer_time_s"):
@@ -816,11 +816,13 @@ def _curve_checks(where: str, robot: RobotModel, stroke: float) -> None:
             raise CaseError(f"{field}.{k}", f"position must lie on the path 0 ... {robot.path_mm:g} mm", x)
         if need < 0:
             raise CaseError(f"{field}.{k}", "height must be at least 0 mm above BDC", need)
-        if need > stroke:
-            reason = f"needs the slide {need:g} mm above BDC, above the stroke {stroke:g} mm: it can never pass"
+        if need >= stroke:
+            reason = f"needs the slide {need:g} mm above BDC, at or above the stroke {stroke:g} mm (TDC, an instant)"
             raise CaseError(f"{field}.{k}", reason, need)
     if any(b <= a for a, b in zip(positions, positions[1:], strict=False)):
         raise CaseError(field, "positions must increase from row to row", positions)
+    if positions[0] != 0:
+        raise CaseError(f"{field}.0", "the first row is the die centre: position 0 mm", positions[0])
     last_x, last_need = robot.interference_mm[-1]
     if last_x >= robot.path_mm and last_need > 0:
         reason = (

@@ -209,6 +209,9 @@ def _with_robots(text: str) -> tuple[str, str]:
     lines, safety, transfer = [], 700.0, 2.0
     for line in text.splitlines(keepends=True):
         key = line.strip().split(":")[0]
+        if key in ("closing_deg", "opening_deg"):  # no height is tied to them with robots
+            stage = "the feed stage starts" if key == "closing_deg" else "the return stage ends"
+            line = line.split("#")[0] + f"# {'theta1' if key == 'closing_deg' else 'theta4'}: {stage} (the law's)\n"
         if key in ("safety_height_mm", "transfer_time_s"):
             value = float(line.split(":")[1].split("#")[0])
             safety, transfer = (value, transfer) if key == "safety_height_mm" else (safety, value)

@@ -272,7 +272,7 @@ def interference_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> 
         paths.fill_between(t, 0, position, where=need > 0, color=colour, alpha=0.15, lw=0)
     heights.set_ylabel("height above BDC [mm]")
     heights.set_ylim(bottom=0)
-    heights.legend(loc="upper center", fontsize=8)  # the draw's part: the tools are out, the slide low
+    heights.legend(loc="best", fontsize=8)
     heights.set_title(f"robots on their interference curves ({result['robots']['order']})", fontsize=9, loc="left")
     paths.set_ylabel("position from the die centre [mm]")
     paths.set_xlabel("time from TDC [s]")

@@ -42,7 +42,7 @@ from planning.model.limits.base import (
     total,
 )
 from planning.model.units import RPM
-from planning.tolerances import LIMIT_REL_TOL, REFINE_MARGIN, TIME_TOL_S
+from planning.tolerances import LIMIT_REL_TOL, REFINE_MARGIN, SAME_POSITION_MM, TIME_TOL_S
 from press.robot import Robot, crossings, sample_points, time_needing, time_to_clear_s
 
 ROBOT_SAMPLES = 48  # times of each robot's occupancy at which an NLP holds its clearance
@@ -95,6 +95,49 @@ def least_period_s(case: Any) -> float:
     if case.robots.order == "in-turns":
         return u.occupancy_s + ld.occupancy_s
     return max(longest, u.dwell_s + time_to_clear_s(u) + ld.dwell_s)
+
+
+def demands(case: Any, draw_speed: float) -> list[tuple[float, tuple[float, str], str, str]]:
+    """What any schedule of the robots needs against the longest cycle the minimum crank speed allows, at
+    draw speed ``draw_speed`` [rad/s]: ``(need [s], (room [s], what the room is), what is needed, the field to
+    change)``: the shortest cycle (:func:`least_period_s`) within the longest; between the draws (from theta3 to
+    theta2, the draw itself at ``draw_speed``) the robots' part there (:func:`between_draws_s`)."""
+    longest = 2 * np.pi / (case.limits.min_crank_speed_rpm * RPM)
+    _, th2, th3, _ = case.key_angles
+    outside = longest - (th3 - th2) / draw_speed
+    field = _slowest_field(case)
+    return [
+        (least_period_s(case), (longest, "the longest cycle (limits.min_crank_speed_rpm)"), "shortest cycle", field),
+        (between_draws_s(case), (outside, "the longest time between the draws"), "time between the draws", field),
+    ]
+
+
+def _slowest_field(case: Any) -> str:
+    """The field of the robot that takes longest: its dwell where that is most of it, else its speed."""
+    robots = robots_by_name(case)
+    name = max(robots, key=lambda r: robots[r].occupancy_s)
+    robot = robots[name]
+    return f"robots.{name}.{'dwell_s' if robot.dwell_s > 2 * robot.move.duration_s else 'speed_mm_s'}"
+
+
+def between_draws_s(case: Any) -> float:
+    """The least time [s] the robots need between theta3 and theta2 of one cycle: the unloader grips after
+    theta3 and the loader has dropped before theta2, the order between them (in turns: the unloader's dwell
+    and way out, the loader's way in and dwell; overlapping: the unloader's dwell and clearing, the loader's
+    dwell); and each tool's time over a slide higher than it is anywhere in the draw (it cannot be there in
+    the draw)."""
+    robots = robots_by_name(case)
+    m = case.machine
+    _, th2, th3, _ = case.key_angles
+    above_draw = float(max(m.height(th2), m.height(th3))) + SAME_POSITION_MM  # the draw's highest slide
+    need = max(time_needing(r, above_draw) for r in robots.values())
+    if len(robots) == 2:
+        u, ld = robots["unloader"], robots["loader"]
+        if case.robots.order == "in-turns":
+            need = max(need, u.dwell_s + u.move.duration_s + ld.move.duration_s + ld.dwell_s)
+        else:
+            need = max(need, u.dwell_s + time_to_clear_s(u) + ld.dwell_s)
+    return need
 
 
 def span_s(case: Any) -> float:
@@ -156,28 +199,27 @@ class RobotsLimit(Limit):
         }
 
     def at_draw_speed(self, draw: Any, speed: float) -> list[Check]:
-        """The robots' shortest cycle (:func:`least_period_s`) within the longest the minimum crank speed
-        allows."""
+        """The robots' shortest cycle within the longest the minimum crank speed allows, and their time
+        between the draws within the longest time outside the draw at ``speed`` [rad/s] (:func:`demands`)."""
         case = draw.case
-        longest = 2 * np.pi / (case.limits.min_crank_speed_rpm * RPM)
-        name = f"robots in and out ({case.robots.order}) within the longest cycle (limits.min_crank_speed_rpm)"
-        return [Check.of(self.id, name, least_period_s(case), longest, "s", "max", TIME_TOL_S)]
+        out = []
+        for need, room, words, _ in demands(case, speed):
+            out.append(Check.of(self.id, f"robots' {words} <= {room[1]}", need, room[0], "s", "max", TIME_TOL_S))
+        return out
 
     def precheck(self, case: Any, given: float | None, lowest: float) -> Impossible | None:
-        """The robots' shortest cycle (:func:`least_period_s`) within the longest the minimum crank speed
-        allows."""
-        longest = 2 * np.pi / (case.limits.min_crank_speed_rpm * RPM)
-        span = least_period_s(case)
-        if span <= longest:
-            return None
-        robots = robots_by_name(case)
-        name = max(robots, key=lambda r: robots[r].occupancy_s)
-        reason = (
-            f"robots.{name}.speed_mm_s: the robots need {span:.3f} s in and out (robots.order = "
-            f"{case.robots.order}), longer than any cycle at limits.min_crank_speed_rpm = "
-            f"{case.limits.min_crank_speed_rpm:g} ({longest:.3f} s); robots.{name} is the slower"
-        )
-        return Impossible(reason, f"robots.{name}.speed_mm_s", span, longest)
+        """:meth:`at_draw_speed`'s conditions at the given draw speed (free: the highest the limits allow)."""
+        from planning.model.limits import draw_speed_bounds
+
+        speed = given if given is not None else min(draw_speed_bounds(case).values())
+        for need, (room, where), words, field in demands(case, speed):
+            if need > room + TIME_TOL_S:
+                reason = (
+                    f"{field}: the robots' {words} takes {need:.3f} s (robots.order = {case.robots.order}), "
+                    f"more than the {room:.3f} s of {where}"
+                )
+                return Impossible(reason, field, need, room)
+        return None
 
     def rows(self, nlp: Transcription) -> list[Row]:
         if nlp.height_at is None:
@@ -235,6 +277,10 @@ class RobotsLimit(Limit):
         robots = robots_by_name(case)
         top = np.maximum(mesh.h[:-1], mesh.h[1:])  # an interval's highest slide position (h monotone on it)
         rows = [(total(mesh.tau), least_period_s(case), np.inf)]
+        # the crank never slower than its minimum speed: each interval at most its angle at it (the robots'
+        # rows could otherwise stretch a cycle past the longest the limits allow)
+        w_min = case.limits.min_crank_speed_rpm * RPM
+        rows.append((mesh.tau - mesh.dtheta / w_min, -np.inf, 0.0))
         for level in _levels(robots):
             above = np.flatnonzero(top >= level).tolist()
             need = _time_needing(case, robots, level)
