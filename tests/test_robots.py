@@ -110,15 +110,13 @@ def test_the_bounds_stay_above_the_plan() -> None:
 
 
 def test_the_outputs_carry_the_robots(tmp_path: Path) -> None:
+    from planning import write_outputs
+    from planning.reports.report import summary_text
+
     out = tmp_path / "out"
-    run = subprocess.run(
-        [sys.executable, "-m", "planning.cli", "solve", str(ROBOTS_CASE), "--out", str(out), "--cam-points", "720"],
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-    )
-    assert run.returncode == 0, run.stderr
-    assert "least clearance" in run.stdout
+    write_outputs(shipped(), read_case(ROBOTS_CASE), out, {"cam_points": 720})
+    assert "least clearance" in (out / "summary.txt").read_text()
+    assert summary_text(json.loads((out / "result.json").read_text())).count("0.000 mm at") == 2
     result = json.loads((out / "result.json").read_text())
     block = result["robots"]
     assert block["order"] == "overlapping"

@@ -174,6 +174,7 @@ def test_other_sweep_in_the_same_folder_is_refused(tmp_path, capsys):
     assert "different sweep" in capsys.readouterr().err
 
 
+@pytest.mark.slow  # a local Dask cluster's start-up and its workers: 19 s
 def test_dask_cluster_gives_the_local_results(tmp_path):
     distributed = pytest.importorskip("dask.distributed")
     base = read_case(PUBLISHED_CASE).model_dump(exclude_none=True)
