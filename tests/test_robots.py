@@ -194,11 +194,14 @@ def test_bad_robots_are_refused_naming_the_field() -> None:
         ("robots.unloader.speed_mm_s=10", "robots.unloader.speed_mm_s", "shortest cycle"),
         ("robots.unloader.dwell_s=100", "robots.unloader.dwell_s", "shortest cycle"),
         ("robots.unloader.dwell_s=58.5", "robots.unloader.dwell_s", "time between the draws"),
+        # 30.1 s over 705.7 mm; the slide is above it 132 deg of the turn, 22 s at 1 rpm
+        ("robots.unloader.dwell_s=29.25", "robots.unloader.dwell_s", "time over a slide at or above 705.7 mm"),
     ],
 )
 def test_impossible_robots_are_refused_naming_the_field(change: str, field: str, what: str, tmp_path: Path) -> None:
     """A dwell of 58.5 s fits the longest cycle (60 s at 1 rpm) but not between two draws (the draw takes
-    1.455 s at 6.7 rpm): exit 3 naming the dwell; `check` fails the same condition (exit 3)."""
+    1.455 s at 6.7 rpm), one of 29.25 s fits between them but not above 705.7 mm, where the tool needs the
+    slide: exit 3 naming the dwell; `check` fails the same condition (exit 3)."""
     run = subprocess.run(
         [sys.executable, "-m", "planning.cli", "solve", str(ROBOTS_CASE), "--no-plots", "--out", str(tmp_path / "o")]
         + ["--set", change],

@@ -102,14 +102,40 @@ def demands(case: Any, draw_speed: float) -> list[tuple[float, tuple[float, str]
     draw speed ``draw_speed`` [rad/s]: ``(need [s], (room [s], what the room is), what is needed, the field to
     change)``: the shortest cycle (:func:`least_period_s`) within the longest; between the draws (from theta3 to
     theta2, the draw itself at ``draw_speed``) the robots' part there (:func:`between_draws_s`)."""
-    longest = 2 * np.pi / (case.limits.min_crank_speed_rpm * RPM)
+    w_min = case.limits.min_crank_speed_rpm * RPM
+    longest = 2 * np.pi / w_min
     _, th2, th3, _ = case.key_angles
     outside = longest - (th3 - th2) / draw_speed
     field = _slowest_field(case)
+    high, level, arc = _highest_demand(case)
+    above = f"longest time the slide can stay at or above {level:g} mm (limits.min_crank_speed_rpm)"
     return [
         (least_period_s(case), (longest, "the longest cycle (limits.min_crank_speed_rpm)"), "shortest cycle", field),
         (between_draws_s(case), (outside, "the longest time between the draws"), "time between the draws", field),
+        (high, (arc / w_min, above), f"time over a slide at or above {level:g} mm", field),
     ]
+
+
+ARC_GRID = 7201  # crank angles over a turn on which the arc above a height is measured (a 0.05 deg step)
+
+
+def _highest_demand(case: Any) -> tuple[float, float, float]:
+    """``(time [s], level [mm], arc [rad])``: of the heights the robots' curves name, the one whose time (the
+    robots' at or above it, :func:`_time_needing`) is largest against the crank angle over which the slide is
+    at or above it (``arc``: the grid's intervals that reach it, never less than the true arc); the slide stays
+    there at most ``arc / w_min``."""
+    robots = robots_by_name(case)
+    theta = np.linspace(0.0, 2 * np.pi, ARC_GRID)
+    h = case.machine.height(theta)
+    top = np.maximum(h[:-1], h[1:])
+    step = theta[1] - theta[0]
+    best = (0.0, 0.0, 2 * np.pi)
+    for level in _levels(robots):
+        arc = float(np.count_nonzero(top >= level) * step)
+        need = _time_needing(case, robots, level)
+        if arc <= 0 or need / arc > best[0] / best[2]:
+            best = (need, level, arc)
+    return best
 
 
 def _slowest_field(case: Any) -> str:
