@@ -53,6 +53,13 @@ def test_the_robots_fields_edit_the_plan(page) -> None:
     names = page.evaluate("document.querySelector('#motion-chart').data.map((t) => t.name)")
     assert any(n.startswith("robots.unloader: the height its tool needs") for n in names), names
     assert any(n.startswith("robots.loader: the height its tool needs") for n in names), names
+    chart = page.locator("#robots-chart")  # the interference chart: needs, least clearances, paths
+    assert chart.is_visible()
+    robots = page.evaluate("document.querySelector('#robots-chart').data.map((t) => t.name)")
+    for name in ("unloader", "loader"):
+        assert f"height the {name}'s tool needs [mm]" in robots
+        assert f"{name}: least clearance 0.00 mm" in robots
+        assert f"{name} on its path [mm from the die centre]" in robots
     fast = spm(page)
     before = int(page.evaluate("document.body.dataset.rendered"))
     click(page, '[data-field="robots.unloader.speed_mm_s"]')
@@ -82,5 +89,6 @@ def test_robots_added_and_removed(page) -> None:
     wait_rendered(page, before)
     page.wait_for_function("state.last && state.last.confirmed && state.last.result", timeout=60_000)
     assert page.evaluate("state.last.result.robots == null")
+    assert not page.locator("#robots-chart").is_visible()
     assert round(spm(page), 3) == 12.123
     assert page.errors == []

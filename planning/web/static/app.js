@@ -355,7 +355,7 @@ function clearPlan() {
   $("#key-points tbody").innerHTML = "";
   $("#stages tbody").innerHTML = "";
   Plotly.purge("motion-chart");
-  for (const id of ["drive-chart", "energy-chart"]) { Plotly.purge(id); $("#" + id).style.display = "none"; }
+  for (const id of ["robots-chart", "drive-chart", "energy-chart"]) { Plotly.purge(id); $("#" + id).style.display = "none"; }
   $("#mechanism-svg").innerHTML = "";
   $("#utilisation").innerHTML = "";
   showBadge("no plan");
@@ -753,8 +753,39 @@ function drawCharts() {
   layout.annotations = [...annotations, ...notes];
   Plotly.react("motion-chart", traces, layout, { responsive: true, displaylogo: false });
   if (!chart.dataset.follows) { chart.on("plotly_hover", followChart); chart.dataset.follows = "1"; }
+  drawRobots(r, c, x, axis);
   drawDrive(r, c, x, axis);
   drawEnergy(r, c, x, axis);
+}
+
+// the interference chart (`pressplan solve`'s interference.png): the slide's height against the height each
+// tool needs where it is over the die, the least clearance marked; below, each robot's position on its path
+const ROBOT_COLOURS = { unloader: "#d62728", loader: "#2ca02c" };
+function drawRobots(r, c, x, axis) {
+  const el = $("#robots-chart");
+  if (!r.robots) { Plotly.purge(el); el.style.display = "none"; return; }
+  el.style.display = "block";
+  const traces = [{ x, y: c.slider_height_mm, name: "slide height [mm]", line: { color: "#1f77b4" } }];
+  for (const robot of r.robots.robots) {
+    const colour = ROBOT_COLOURS[robot.name] || "#000";
+    const need = c[`${robot.name}_needed_height_mm`];
+    traces.push({ x, y: need.map((v) => (v > 0 ? v : null)), name: `height the ${robot.name}'s tool needs [mm]`, line: { color: colour }, connectgaps: false });
+    if (robot.least_clearance_mm != null) {
+      const at = axis === "time" ? robot.least_clearance_time_s : c.crank_angle_deg[nearest(c.time_s, robot.least_clearance_time_s)];
+      const clearance = (Math.round(robot.least_clearance_mm * 100) / 100 + 0).toFixed(2);
+      traces.push({ x: [at], y: [robot.needed_there_mm], mode: "markers", marker: { symbol: "triangle-down", size: 10, color: colour }, name: `${robot.name}: least clearance ${clearance} mm` });
+    }
+    traces.push({ x, y: c[`${robot.name}_position_mm`], yaxis: "y2", name: `${robot.name} on its path [mm from the die centre]`, line: { color: colour, dash: "dot" } });
+  }
+  const layout = {
+    ...cycleChartLayout(r, x, axis, -0.18),
+    title: { text: `robots on their interference curves (${r.robots.order})`, font: { size: 12 }, x: 0.01, xanchor: "left" },
+    margin: { l: 60, r: 30, t: 30, b: 40 },
+    xaxis: { title: { text: xAxisTitle(axis) }, anchor: "y2" },
+    yaxis: { ...ROUND_TICKS, domain: [0.45, 1], rangemode: "tozero", title: { text: "height [mm]" } },
+    yaxis2: { ...ROUND_TICKS, domain: [0, 0.38], rangemode: "tozero", title: { text: "path [mm]" } },
+  };
+  Plotly.react(el, traces, layout, { responsive: true, displaylogo: false });
 }
 
 function nearest(xs, v) {
