@@ -223,7 +223,9 @@ def _set_option(parser: argparse.ArgumentParser, text: str) -> None:
 
 
 def _setting(text: str) -> tuple[str, object]:
-    """An argparse type: ``FIELD=VALUE`` -> (dotted field, value read as a YAML scalar: 1.8, 2e3, free)."""
+    """An argparse type: ``FIELD=VALUE`` -> (dotted field, value read as a YAML scalar: 1.8, 2e3, free; or a table
+    of rows, ``[[0, 700], [600, 700], [750, 0]]``, for a field that holds one: an interference curve, a forming
+    force)."""
     from planning.model.case_file import CaseFileError, load_yaml
 
     field, sep, value = text.partition("=")
@@ -234,8 +236,9 @@ def _setting(text: str) -> tuple[str, object]:
         parsed = load_yaml(value, f"--set {field}")
     except CaseFileError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
-    if isinstance(parsed, (dict, list)):
-        raise argparse.ArgumentTypeError(f"--set {field}: one value, not a section or a list")
+    table = isinstance(parsed, list) and bool(parsed) and all(isinstance(row, list) for row in parsed)
+    if isinstance(parsed, dict) or (isinstance(parsed, list) and not table):
+        raise argparse.ArgumentTypeError(f"--set {field}: one value or a table of rows, not a section or a list")
     return field, parsed
 
 

@@ -407,3 +407,15 @@ def test_a_robot_slower_than_the_plan_fails_its_check_without_an_exception() -> 
     solution, _ = _solved(data)
     assert solution.verification.passed
     assert any(c.name == "loader: its tool never needs the slide up" for c in solution.verification.checks)
+
+
+def test_a_curve_is_set_from_the_command_line(capsys: pytest.CaptureFixture[str]) -> None:
+    """``--set`` takes a table of rows for a field that holds one (an interference curve), refuses a flat list."""
+    from planning.cli import main
+
+    curve = "robots.unloader.interference_mm=[[0, 700], [300, 700], [450, 0]]"
+    assert main(["check", str(ROBOTS_CASE), "--json", "--set", curve]) == 0
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as info:
+        main(["check", str(ROBOTS_CASE), "--set", "robots.unloader.interference_mm=[1, 2]"])
+    assert info.value.code == 2 and "one value or a table of rows" in capsys.readouterr().err
