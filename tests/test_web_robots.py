@@ -92,3 +92,34 @@ def test_robots_added_and_removed(page) -> None:
     assert not page.locator("#robots-chart").is_visible()
     assert round(spm(page), 3) == 12.123
     assert page.errors == []
+
+
+def test_the_robots_form_fits_a_small_screen_with_a_bad_cell(site) -> None:
+    """At 800x600 the robots' fieldsets fit the form's panel (no sideways scrolling), also with a bad cell
+    typed into a curve's table (its message below the table, the table in place); each tool's need drawn down
+    to zero where it leaves the die."""
+    url, browser = site
+    context = browser.new_context(viewport={"width": 800, "height": 600})
+    tab = context.new_page()
+    tab.goto(url)
+    wait_rendered(tab)
+    panel = "document.querySelector('#form-panel')"
+    assert tab.evaluate(f"{panel}.scrollWidth <= {panel}.clientWidth")
+    table = "#f-robots-unloader-interference_mm"
+    before_box = tab.locator(table).bounding_box()
+    before = int(tab.evaluate("document.body.dataset.rendered"))
+    click(tab, f"{table} tbody tr:nth-child(2) td:first-child input")
+    tab.keyboard.press("Control+A")
+    tab.keyboard.type("6o0")
+    tab.keyboard.press("Tab")
+    wait_rendered(tab, before)
+    message = tab.locator('.msg[data-for="robots.unloader.interference_mm"]')
+    assert "valid number" in message.inner_text()
+    assert tab.evaluate(f"{panel}.scrollWidth <= {panel}.clientWidth")
+    assert tab.locator(table).bounding_box()["x"] == before_box["x"]  # the table stays where it was
+    needs = tab.evaluate(
+        "document.querySelector('#robots-chart').data.filter((t) => t.name.startsWith('height the'))"
+        ".map((t) => t.y.filter((v) => v !== null))"
+    )
+    assert needs and all(0 in ys for ys in needs)
+    context.close()

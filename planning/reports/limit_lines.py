@@ -58,6 +58,13 @@ def robot_windows(result: dict[str, Any], axis: str, x: np.ndarray) -> list[tupl
     return [(keys["opening"][at], float(x[-1])), (float(x[0]), keys["closing"][at])]
 
 
+def needing(need: np.ndarray) -> np.ndarray:
+    """Where a tool's need is drawn: the samples where it needs height and the one either side of each run
+    (the line then reaches 0 where the tool leaves the die, not the last sample above it)."""
+    over = need > 0
+    return over | np.roll(over, 1) | np.roll(over, -1)
+
+
 def limit_lines(result: dict[str, Any], columns: dict[str, np.ndarray], axis: str) -> list[LimitLine]:
     """Every limit ``result`` (``result.json``'s data: ``process``, ``limits``, ``key_points``) sets, over the
     samples ``columns`` (``trajectory.csv``'s), against time (``axis`` "time") or crank angle."""
@@ -120,6 +127,6 @@ def limit_lines(result: dict[str, Any], columns: dict[str, np.ndarray], axis: st
     for robot in (result.get("robots") or {}).get("robots", ()):  # each tool's need where it needs any
         need = np.asarray(columns[f"{robot['name']}_needed_height_mm"], dtype=float)
         label = f"robots.{robot['name']}: the height its tool needs"
-        upper = np.where(need > 0, need, np.nan)
+        upper = np.where(needing(need), need, np.nan)
         lines.append(LimitLine(f"robots.{robot['name']}", label, "slider_height_mm", x, upper))
     return lines

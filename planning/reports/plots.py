@@ -16,7 +16,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from planning.model.outcome import Outcome
-from planning.reports.limit_lines import LimitLine, limit_lines, robot_windows
+from planning.reports.limit_lines import LimitLine, limit_lines, needing, robot_windows
 from planning.tolerances import TINY_RATE
 
 WINDOW_COLOUR, DRAW_COLOUR = "#d9ecff", "#e2f0d9"  # the robot's window, the draw
@@ -262,7 +262,8 @@ def interference_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> 
     for r in result["robots"]["robots"]:
         name, colour = r["name"], ROBOT_COLOURS.get(r["name"], "k")
         need = np.asarray(traj[f"{name}_needed_height_mm"], dtype=float)
-        heights.plot(t, np.where(need > 0, need, np.nan), color=colour, lw=1.4, label=f"height the {name}'s tool needs")
+        shown = np.where(needing(need), need, np.nan)
+        heights.plot(t, shown, color=colour, lw=1.4, label=f"height the {name}'s tool needs")
         if r["least_clearance_mm"] is not None:
             at = r["least_clearance_time_s"]
             label = f"{name}: least clearance {round(r['least_clearance_mm'], 2) + 0.0:.2f} mm"  # no "-0.00"

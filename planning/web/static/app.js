@@ -769,7 +769,9 @@ function drawRobots(r, c, x, axis) {
   for (const robot of r.robots.robots) {
     const colour = ROBOT_COLOURS[robot.name] || "#000";
     const need = c[`${robot.name}_needed_height_mm`];
-    traces.push({ x, y: need.map((v) => (v > 0 ? v : null)), name: `height the ${robot.name}'s tool needs [mm]`, line: { color: colour }, connectgaps: false });
+    // drawn where it needs height and one sample either side (the line reaches 0 where the tool leaves)
+    const shown = need.map((v, i) => (v > 0 || need[i - 1] > 0 || need[i + 1] > 0 ? v : null));
+    traces.push({ x, y: shown, name: `height the ${robot.name}'s tool needs [mm]`, line: { color: colour }, connectgaps: false });
     if (robot.least_clearance_mm != null) {
       const at = axis === "time" ? robot.least_clearance_time_s : c.crank_angle_deg[nearest(c.time_s, robot.least_clearance_time_s)];
       const clearance = (Math.round(robot.least_clearance_mm * 100) / 100 + 0).toFixed(2);
