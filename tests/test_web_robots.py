@@ -95,7 +95,8 @@ def test_robots_added_and_removed(page) -> None:
 
 
 def test_the_robots_form_fits_a_small_screen_with_a_bad_cell(site) -> None:
-    """At 800x600 the robots' fieldsets fit the form's panel (no sideways scrolling), also with a bad cell
+    """At 800x600 the robots' fieldsets fit the form's panel and the stage table the result's (no sideways
+    scrolling), also with a bad cell
     typed into a curve's table (its message below the table, the table in place); each tool's need drawn down
     to zero where it leaves the die."""
     url, browser = site
@@ -105,6 +106,8 @@ def test_the_robots_form_fits_a_small_screen_with_a_bad_cell(site) -> None:
     wait_rendered(tab)
     panel = "document.querySelector('#form-panel')"
     assert tab.evaluate(f"{panel}.scrollWidth <= {panel}.clientWidth")
+    result = "document.querySelector('#result-panel')"  # the stage table's long binding names wrap
+    assert tab.evaluate(f"{result}.scrollWidth <= {result}.clientWidth")
     table = "#f-robots-unloader-interference_mm"
     before_box = tab.locator(table).bounding_box()
     before = int(tab.evaluate("document.body.dataset.rendered"))
