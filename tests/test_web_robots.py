@@ -126,3 +126,25 @@ def test_the_robots_form_fits_a_small_screen_with_a_bad_cell(site) -> None:
     )
     assert needs and all(0 in ys for ys in needs)
     context.close()
+
+
+def test_one_robot_removed_and_added_back(page) -> None:
+    """"remove the loader" (a mouse click) plans the press with its unloader alone, verified, at least as fast;
+    "add the loader" brings the template's back."""
+    both = spm(page)
+    before = int(page.evaluate("document.body.dataset.rendered"))
+    click(page, "#remove-loader")
+    wait_rendered(page, before)
+    page.wait_for_function("state.last && state.last.confirmed && state.last.result", timeout=60_000)
+    assert page.locator('[data-field="robots.loader.path_mm"]').count() == 0
+    assert page.evaluate("state.last.result.verified")
+    assert [r["name"] for r in page.evaluate("state.last.result.robots.robots")] == ["unloader"]
+    assert spm(page) >= both - 1e-9
+    assert page.locator("#remove-unloader").count() == 0  # the last robot goes with "remove the robots"
+    before = int(page.evaluate("document.body.dataset.rendered"))
+    click(page, "#add-loader")
+    wait_rendered(page, before)
+    page.wait_for_function("state.last && state.last.confirmed && state.last.result", timeout=60_000)
+    assert page.locator('[data-field="robots.loader.path_mm"]').count() == 1
+    assert page.evaluate("state.last.result.verified")
+    assert page.errors == []

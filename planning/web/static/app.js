@@ -57,6 +57,13 @@ function buildForm(data) {
     }
     if (section === "robots") {
       fs.appendChild(button({ id: "remove-robots" }, "remove the robots", "back to one safety height and one transfer time (the template press's)", removeRobots));
+      for (const name of ROBOT_NAMES) { // a robot left out is added back from the template
+        if (data.robots[name] == null) fs.appendChild(button({ id: `add-${name}` }, `add the ${name}`, `the ${name} of the template press (pressplan new --robots)`, () => addRobot(name)));
+      }
+    }
+    if (section.startsWith("robots.")) {
+      const name = section.slice("robots.".length), other = ROBOT_NAMES.find((n) => n !== name);
+      if (data.robots[other] != null) fs.appendChild(button({ id: `remove-${name}` }, `remove the ${name}`, `the press without its ${name} (the other robot stays)`, () => removeRobot(name)));
     }
     form.appendChild(fs);
   }
@@ -124,6 +131,25 @@ function addRobots() {
   state.data = data;
   buildForm(data);
   setStatus("robots added: the template press's; enter your robots' figures", "busy");
+  solveNow();
+}
+
+const ROBOT_NAMES = ["unloader", "loader"];
+
+function addRobot(name) {
+  const data = caseFromForm();
+  const kind = getPath(data, "press.mechanism") || "crank-slider";
+  data.robots[name] = structuredClone(state.meta.robot_templates[kind].robots[name]);
+  state.data = data;
+  buildForm(data);
+  solveNow();
+}
+
+function removeRobot(name) {
+  const data = caseFromForm();
+  delete data.robots[name];
+  state.data = data;
+  buildForm(data);
   solveNow();
 }
 
