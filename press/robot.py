@@ -198,11 +198,6 @@ def crossings(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
     return np.array([t for t, _ in out], dtype=float), np.array([n for _, n in out], dtype=float)
 
 
-def crossing_offsets(robot: Robot) -> np.ndarray:
-    """The times of :func:`crossings`."""
-    return crossings(robot)[0]
-
-
 def clear_position_mm(curve: InterferenceCurve) -> float:
     """The position [mm] from which on the tool needs nothing: clear of the die (the point after the last that
     needs height, or the last point, beyond which the curve is zero)."""

@@ -40,6 +40,14 @@ def click(tab, selector: str) -> None:  # noqa: ANN001 - a Playwright page
     tab.mouse.click(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
 
 
+def click_and_confirm(tab, selector: str) -> None:  # noqa: ANN001 - a Playwright page
+    """A real mouse click on ``selector``, then the page's confirmed answer."""
+    before = int(tab.evaluate("document.body.dataset.rendered"))
+    click(tab, selector)
+    wait_rendered(tab, before)
+    tab.wait_for_function("state.last && state.last.confirmed && state.last.result", timeout=60_000)
+
+
 def spm(tab) -> float:  # noqa: ANN001
     return float(tab.evaluate("state.last.result.spm"))
 
@@ -78,16 +86,10 @@ def test_robots_added_and_removed(page) -> None:
     "remove the robots" gives the one-height model back, its 12.123 strokes/min."""
     pick_case(page, "wang2023-side-panel.yaml")
     assert page.locator('[data-field="robots.unloader.speed_mm_s"]').count() == 0
-    before = int(page.evaluate("document.body.dataset.rendered"))
-    click(page, "#add-robots")
-    wait_rendered(page, before)
-    page.wait_for_function("state.last && state.last.confirmed && state.last.result", timeout=60_000)
+    click_and_confirm(page, "#add-robots")
     assert page.locator('[data-field="robots.loader.path_mm"]').count() == 1
     assert page.evaluate("state.last.result.verified") and page.evaluate("state.last.result.robots != null")
-    before = int(page.evaluate("document.body.dataset.rendered"))
-    click(page, "#remove-robots")
-    wait_rendered(page, before)
-    page.wait_for_function("state.last && state.last.confirmed && state.last.result", timeout=60_000)
+    click_and_confirm(page, "#remove-robots")
     assert page.evaluate("state.last.result.robots == null")
     assert not page.locator("#robots-chart").is_visible()
     assert round(spm(page), 3) == 12.123
@@ -132,19 +134,13 @@ def test_one_robot_removed_and_added_back(page) -> None:
     """"remove the loader" (a mouse click) plans the press with its unloader alone, verified, at least as fast;
     "add the loader" brings the template's back."""
     both = spm(page)
-    before = int(page.evaluate("document.body.dataset.rendered"))
-    click(page, "#remove-loader")
-    wait_rendered(page, before)
-    page.wait_for_function("state.last && state.last.confirmed && state.last.result", timeout=60_000)
+    click_and_confirm(page, "#remove-loader")
     assert page.locator('[data-field="robots.loader.path_mm"]').count() == 0
     assert page.evaluate("state.last.result.verified")
     assert [r["name"] for r in page.evaluate("state.last.result.robots.robots")] == ["unloader"]
     assert spm(page) >= both - 1e-9
     assert page.locator("#remove-unloader").count() == 0  # the last robot goes with "remove the robots"
-    before = int(page.evaluate("document.body.dataset.rendered"))
-    click(page, "#add-loader")
-    wait_rendered(page, before)
-    page.wait_for_function("state.last && state.last.confirmed && state.last.result", timeout=60_000)
+    click_and_confirm(page, "#add-loader")
     assert page.locator('[data-field="robots.loader.path_mm"]').count() == 1
     assert page.evaluate("state.last.result.verified")
     assert page.errors == []
