@@ -44,7 +44,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     ap.add_argument("--version", action="version", version=f"pressplan {_version()}")
     sub = ap.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    for add in (_case_commands, _batch_commands, _bound_command, _other_commands):
+    for add in (_case_commands, _batch_commands, _bound_command, _line_command, _other_commands):
         add(sub)
     return ap
 
@@ -161,6 +161,21 @@ def _bound_command(sub) -> None:  # noqa: ANN001 - argparse's sub-parsers
         help="the bracket's gap to reach [%%] (default 0.05); implies --bracket",
     )
     b.add_argument("--json", action="store_true", help="print JSON")
+
+
+def _line_command(sub) -> None:  # noqa: ANN001 - argparse's sub-parsers
+    """``line``: a press line on one master."""
+    ln = sub.add_parser(
+        "line",
+        help="plan a press line: its presses and robots on one master, the line's strokes per minute, verified",
+        description="Plan a line file (its stations' cases, the transfers between them): the line's period, what "
+        "binds it, each press's plan at the line's rate and its phase offset on the master, each robot's "
+        "schedule; every press's plan and every robot's schedule verified (docs/line.md).",
+    )
+    ln.add_argument("line", help="line file (YAML): stations, transfers, feeder, exit")
+    ln.add_argument("--out", help="output folder (default: out/<line name>)")
+    ln.add_argument("--no-plots", action="store_true", help="skip line_timing.png")
+    ln.add_argument("--json", action="store_true", help="print line_result.json instead of the summary")
 
 
 def _other_commands(sub) -> None:  # noqa: ANN001 - argparse's sub-parsers
@@ -299,13 +314,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         "serve": _serve,
         "new": _new,
         "cam": _cam,
+        "line": _line,
     }[args.command]
     try:
-        if args.command in ("plot", "serve", "new", "cam"):
+        if args.command in ("plot", "serve", "new", "cam", "line"):
             return command(args)
         return command(_read(args), args)
     except Exception as exc:
-        known = _exit_code(exc, getattr(args, "case", None) or getattr(args, "source", None))
+        named = getattr(args, "case", None) or getattr(args, "source", None) or getattr(args, "line", None)
+        known = _exit_code(exc, named)
         if known is None:
             raise
         return _fail(*known)
@@ -715,6 +732,25 @@ def _new(args) -> int:
     kind = f"a {args.mechanism} case{' with a drive' if args.drive else ''}{' with robots' if args.robots else ''}"
     print(f"{path}: {kind}, commented field by field, to edit. Next: pressplan check {path}")
     return EXIT_OK
+
+
+def _line(args) -> int:
+    """``pressplan line``: read the line and its stations' cases, plan, verify, write the line's files."""
+    from planning.model.line_file import read_line
+    from planning.reports.folder import ensure_writable
+    from planning.reports.line import LINE_FILES, summary_text, writers
+    from planning.reports.line import result as line_result
+    from planning.solver.line import solve_line
+
+    line = read_line(args.line)
+    out = Path(args.out) if args.out else Path("out") / line.name
+    ensure_writable(out)
+    solution = solve_line(line)
+    if not args.no_plots:
+        _load_plots()
+    args.case = args.line  # the file no output replaces
+    files = writers(solution, not args.no_plots)
+    return _write_and_report(out, files, line_result(solution), summary_text(solution), args, LINE_FILES)
 
 
 def _plot(args) -> int:

@@ -45,7 +45,7 @@ BLOCK = re.compile(
     r"(?P=indent)<!-- output:end -->",
     re.S,
 )
-OUT_OPTION = ("solve", "laws", "compare", "cam")  # commands that write a folder: sent to the scratch folder
+OUT_OPTION = ("solve", "laws", "compare", "cam", "line")  # commands that write a folder: sent to the scratch folder
 DROPPED = re.compile(r"^\s+(wrote |solver: )")  # lines that depend on the run, not on the case
 NUMBER = re.compile(r"[-+]?\d+(?:\.\d+)?")
 
@@ -144,7 +144,7 @@ def run(command: str) -> str:
     args = args[1:]
     if args[0] in OUT_OPTION and "--out" not in args:
         args += ["--out", f"out/{len(os.listdir('.'))}"]
-    if args[0] == "solve":
+    if args[0] in ("solve", "line"):
         args.append("--no-plots")
     out, err = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):

@@ -217,17 +217,18 @@ def _pydantic_field(exc: ValidationError) -> str:
     return ".".join(str(p) for p in _first_error(exc)["loc"])
 
 
-def _pydantic_line(exc: ValidationError, data: Any, label: str) -> str:
+def _pydantic_line(exc: ValidationError, data: Any, label: str, model: type[BaseModel] = Case) -> str:
+    """The one line of a file's first validation error (``model``: the file's, a case's or a line's)."""
     err = _first_error(exc)
     loc = [str(p) for p in err["loc"]]
     field = ".".join(loc)
     kind = err["type"]
     value = err.get("input")
     if kind == "extra_forbidden":
-        home = _section_of(loc[-1]) if len(loc) == 2 else None
+        home = _section_of(loc[-1]) if len(loc) == 2 and model is Case else None
         if home is not None and home != loc[0]:  # a key of another section: say where it belongs
             return f"{label}: {field}: unknown key here; it belongs under {home}: ({home}.{loc[-1]})"
-        valid = _fields_at(Case, loc[:-1])
+        valid = _fields_at(model, [p for p in loc[:-1] if not p.isdigit()])
         hint = difflib.get_close_matches(loc[-1], valid, n=1, cutoff=0.5)
         did = f"; did you mean '{hint[0]}'?" if hint else f"; valid keys: {', '.join(valid)}"
         return f"{label}: {field}: unknown key{did}"

@@ -637,3 +637,47 @@ def tradeoff_figure(rows: list[dict[str, Any]], case: Any, title: str) -> Figure
         _legend(ax, *twins, anchor=(1.12 if twins else 1.02, 1.0))
     top.set_title(title, fontsize=10)
     return fig
+
+
+LINE_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf")
+
+
+def line_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
+    """A press line over one master cycle (``planning.reports.line``): each press's slide and the height its
+    robots' tools need (dashed, where they need any); below, each robot's cycle as bars: inside a press in the
+    press's colour, its moves between the presses grey, away (the feeder's, the exit's) light."""
+    fig = Figure(figsize=(12, 7.2), layout="constrained")
+    FigureCanvasAgg(fig)
+    heights, bars = fig.subplots(2, 1, sharex=True, height_ratios=(3, 2))
+    t, period = traj["time_s"], result["period_s"]
+    colour = {s["name"]: LINE_COLOURS[k % len(LINE_COLOURS)] for k, s in enumerate(result["stations"])}
+    for s in result["stations"]:
+        name = s["name"]
+        heights.plot(t, traj[f"{name}_slide_mm"], color=colour[name], lw=1.8, label=f"{name}: slide")
+        need = np.asarray(traj[f"{name}_needed_height_mm"], dtype=float)
+        heights.plot(t, np.where(needing(need), need, np.nan), "--", color=colour[name], lw=1.2)
+    heights.plot([], [], "--", color="k", lw=1.2, label="height the robots' tools need")
+    heights.set_ylabel("height above BDC [mm]")
+    heights.set_ylim(bottom=0)
+    heights.legend(loc="upper left", fontsize=8, ncols=2)
+    title = f"{result['line']}: {result['spm']:.3f} strokes/min, cycle {period:.4f} s"
+    heights.set_title(title + f"; bottleneck: {result['bottleneck']['name']}", fontsize=9, loc="left")
+    names = []
+    for row, robot in enumerate(result["robots"]):
+        names.append(robot["name"])
+        for stretch in robot["stretches"]:
+            if stretch["what"] == "wait":
+                continue
+            inside = stretch["station"]
+            face = colour[inside] if inside else ("#bbbbbb" if stretch["what"] != "away" else "#e6e6e6")
+            for start in (stretch["start_s"], stretch["start_s"] - period):  # a stretch over the cycle's end wraps
+                bars.broken_barh([(start, stretch["duration_s"])], (row - 0.35, 0.7), facecolors=face)
+    bars.set_yticks(range(len(names)), names, fontsize=8)
+    bars.invert_yaxis()
+    bars.set_xlabel("time on the line's master [s]")
+    what = "robots: inside a press (its colour), moving between presses (grey), away (light)"
+    bars.set_title(what, fontsize=9, loc="left")
+    for ax in (heights, bars):
+        ax.grid(alpha=0.3)
+        ax.set_xlim(0.0, period)
+    return fig

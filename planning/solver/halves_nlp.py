@@ -360,10 +360,11 @@ def _objective(
     rate, peak, losses = kind
     q, params = c.q, c.params
     objective = params.period
-    if rate:
-        heat, energy = objective_terms(q, torque, states[2], times, losses)
-        objective = q["weight_period"] * params.period + q["weight_heat"] * heat + q["weight_energy"] * energy
-        objective -= q["weight_dwell"] * params.transfer_dwell
+    if rate:  # without a drive (a kinematic case at a line's rate): the period and the dwell only
+        objective = q["weight_period"] * params.period - q["weight_dwell"] * params.transfer_dwell
+        if torque is not None:
+            heat, energy = objective_terms(q, torque, states[2], times, losses)
+            objective += q["weight_heat"] * heat + q["weight_energy"] * energy
     if peak:  # the least grid peak: bus power <= bus_peak at every sample, bus_peak weighed (weight_peak)
         k = len(VARIABLES)  # the peak variable follows the cycle's
         bus_peak, power_unit = c.x[k] * c.p_scale[k], c.p_scale[k]
@@ -454,7 +455,6 @@ def _build(
     losses: bool = False,
 ) -> CycleNLP:
     law = get_law(law_name)
-    drive = drive or rate
     die_exit = zone and not rate  # the denser variant: the die exit held at its angles (smooth rows)
     zone = rate  # the rate NLP: every sample in the die zone held (its crank speed may peak there)
     layout = ParameterLayout(formula, limit_ids, drive, rate, links if drive else (), die_exit)
@@ -472,7 +472,8 @@ def _build(
     refinable = add_limit_rows(rows, nlp, layout)
     objective = _objective(rows, c, torque, states, times, (rate, peak, losses))
     problem = {"x": c.x, "p": ca.vertcat(c.p_case, c.p_scale), "f": objective, "g": ca.vertcat(*rows.g)}
-    kind = ("_rate" if rate else "_drive" if drive else "") + ("_exit" if die_exit else "")
+    kind = ("_rate" if rate else "_drive" if drive else "") + ("_kinematic" if rate and not drive else "")
+    kind += "_exit" if die_exit else ""
     kind += ("_peak" if peak else "") + ("_losses" if losses else "")
     options = {**CYCLE_OPTIONS, **(DRIVE_OPTIONS if drive else {}), **(RATE_OPTIONS if rate else {})}
     program = NLPSolver("press_cycle_" + law_name.replace("-", "_") + kind, problem, options, lift=lift)
@@ -513,7 +514,8 @@ def halves_nlp(
 ) -> CycleNLP:
     """The compiled NLP of motion law ``law`` on a mechanism of closed form ``formula`` holding the limits
     ``limit_ids``, with the motor's torque when ``drive`` (the mechanism's massive ``links`` in it);
-    ``rate``: the drive NLP of a target rate (see the module docstring); ``zone``: the limits that hold in
+    ``rate``: the NLP of a target rate (see the module docstring; without ``drive``: the period held, the
+    transfer dwell weighed, a kinematic case at a line's rate); ``zone``: the limits that hold in
     the die zone held at every sample there (the rate NLP's always; otherwise the denser variant a search
     turns to when a plan's crank speed peaks inside the die zone, between the crossings); ``peak``: the rate
     NLP with the bus power's peak as a variable (:data:`PEAK_VARIABLE`; the least grid peak); ``losses``: its
@@ -529,7 +531,7 @@ def halves_nlp_for(case: Case, drive: bool | None = None, rate: bool = False, pe
     limit_ids = nlp_limits(case, drive or rate)
     links = drive_links(case) if drive or rate else ()
     d = case.drive
-    losses = rate and (d.motor.copper_loss_at_rated_kW > 0 or d.converter_efficiency < 1)
+    losses = rate and d is not None and (d.motor.copper_loss_at_rated_kW > 0 or d.converter_efficiency < 1)
     law, formula = case.planner.motion_law, case.machine.formula
     return halves_nlp(law, formula, limit_ids, drive, rate, False, links, peak, losses)
 

@@ -37,12 +37,13 @@ from dataclasses import replace
 
 from planning.model.case import Case, Placement
 from planning.model.plan import Plan
-from planning.solver.halves_nlp import PEAK_VARIABLE, VARIABLE_INDEX, VARIABLES, halves_nlp_for
+from planning.solver.halves_nlp import PEAK_VARIABLE, ROBOT_VARIABLES, VARIABLE_INDEX, VARIABLES, halves_nlp_for
 from planning.solver.max_spm import solve_max_spm
 from planning.solver.neighbour import can_start
 from planning.solver.outcomes import Infeasible, NoPlanFound
 from planning.solver.search import Search, prepare
 from planning.solver.solution import AtRate, Solution, objective_value
+from planning.solver.starts import guesses_at_period
 from planning.solver.verify import evaluate, field_of_check
 from planning.tolerances import RATE_TOLERANCE, SAME_PERIOD_S
 
@@ -131,7 +132,8 @@ def _check_reachable(target: float, fastest: Solution, case: Case) -> None:
 def _rate_search(case: Case, placement: Placement, period: float, peak: bool = False) -> Search:
     """The rate NLP's search (``peak``: its peak variant) with the cycle time held at ``period`` [s] and every
     objective weight 0."""
-    search = prepare(case, placement, halves_nlp_for(case, drive=True, rate=True, peak=peak))
+    drive = case.drive is not None  # a kinematic case (a press in a line): its baseline only
+    search = prepare(case, placement, halves_nlp_for(case, drive=drive, rate=True, peak=peak))
     search.parameters = search.parameters.copy()
     search.parameters[search.parameter("target_period")] = period
     search.parameters[search.parameter("weight_period")] = 0.0
@@ -139,18 +141,44 @@ def _rate_search(case: Case, placement: Placement, period: float, peak: bool = F
     return search
 
 
+def solve_at_period(case: Case, period_s: float, fastest: Solution | None = None) -> Solution:
+    """``case``'s max-SPM plan run at cycle time ``period_s`` [s] (a press in a line; a drive is not needed):
+    the longest transfer dwell (:func:`_baseline`); its fastest plan where ``period_s`` is that plan's own.
+    ``fastest``: the case's max-SPM solution when the caller has it. :class:`Infeasible` for a period
+    shorter than the fastest plan's."""
+    case = case.with_objective("max-spm")
+    placement = case.planner.placement
+    if fastest is None:
+        fastest = solve_max_spm(case, placement)
+    _check_reachable(60.0 / period_s, fastest, case)
+    at_rate = case.with_objective(None, 60.0 / period_s)
+    try:
+        return _baseline(at_rate, placement, fastest, period_s, None, True)
+    except NoPlanFound:  # far slower than the fastest: starts built for the period (its draw speed kept)
+        guesses = guesses_at_period(case, fastest.plan.nlp_values["draw_speed"], period_s)
+        return _baseline(at_rate, placement, fastest, period_s, None, True, guesses)
+
+
 def _baseline(
-    case: Case, placement: Placement, fastest: Solution, period: float, neighbour: Plan | None, confirm: bool
+    case: Case,
+    placement: Placement,
+    fastest: Solution,
+    period: float,
+    neighbour: Plan | None,
+    confirm: bool,
+    more_starts: tuple[dict[str, float], ...] | list[dict[str, float]] = (),
 ) -> Solution:
     """The max-SPM plan run at cycle time ``period`` [s] with the spare time spent at the transfer speed:
-    the longest transfer dwell (see the module docstring). At the fastest rate it is the fastest plan."""
+    the longest transfer dwell (see the module docstring). At the fastest rate it is the fastest plan.
+    ``more_starts``: after the slowed fastest plan's."""
     if abs(fastest.plan.period - period) <= SAME_PERIOD_S:
         return fastest
     search = _rate_search(case, placement, period)
     time_unit = search.scale[VARIABLE_INDEX["transfer_dwell"]]
     search.parameters[search.parameter("weight_dwell")] = 1.0 / time_unit
     search.score = lambda solution: -float(solution.plan.parameters.transfer_dwell) / period
-    _run_starts(search, [_slowed(fastest.plan, period / fastest.plan.period, search)], neighbour, placement, confirm)
+    starts = [_slowed(fastest.plan, period / fastest.plan.period, search), *more_starts]
+    _run_starts(search, starts, neighbour, placement, confirm)
     try:
         return search.answer()
     except NoPlanFound as exc:
@@ -160,7 +188,7 @@ def _baseline(
 def _slowed(plan: Plan, factor: float, search: Search) -> dict[str, float]:
     """``plan``'s NLP values run ``factor`` times slower: every angle, so every key point and the cycle's
     closure, stays where it was (a start; speeds held within their bounds, the draw's in particular)."""
-    values = {}
+    values = {name: plan.nlp_values[name] * factor for name, _ in ROBOT_VARIABLES if name in plan.nlp_values}
     for name, j in VARIABLE_INDEX.items():
         kind = VARIABLES[j][1]
         value = plan.nlp_values[name]

@@ -221,7 +221,10 @@ def link_values(case: Case, links: tuple[str, ...]) -> dict[str, float]:
 
 def objective_values(case: Case) -> dict[str, float]:
     """The objective of the most strokes (the period alone); ``planning.solver.objectives`` sets the weights
-    per solve."""
+    per solve. Without a drive (a kinematic case at a line's rate) the drive's figures are placeholders its NLP
+    never reads."""
+    if case.drive is None:
+        return {name: 0.0 for name in OBJECTIVE} | {"weight_period": 1.0, "power_smoothing": 1.0}
     motor = case.drive.motor
     return {
         "weight_period": 1.0,

@@ -178,3 +178,27 @@ def die_exit(case: Case, w2: float) -> dict[str, float] | None:
         "die_up_time": D_ra + D_rd,
         "die_down_time": 0.5 * (closing + D_ra + D_rd + dwell + D_fa + x0["feed_decel_duration"]),
     }
+
+
+PERIOD_BISECTIONS = 60  # halvings of the transfer speed's range: below round-off
+
+
+def guesses_at_period(case: Case, w2: float, period_s: float) -> list[dict[str, float]]:
+    """Starts at cycle time ``period_s`` [s] and draw speed ``w2`` [rad/s] (a press run slower than its
+    fastest, in a line): :func:`guess`'s S-curves with the transfer speed whose rough cycle (the halves, the
+    transfer dwell and the draw at ``w2``) takes ``period_s``, found by bisection, peak speeds at two shares."""
+    _, th2, th3, _ = case.key_angles
+    draw_s = (th3 - th2) / w2
+
+    def cycle_s(values: dict[str, float]) -> float:
+        halves = ("feed_accel_duration", "feed_decel_duration", "return_accel_duration", "return_decel_duration")
+        return sum(values[k] for k in halves) + values["transfer_dwell"] + draw_s
+
+    starts = []
+    for share in (0.9, 0.6):
+        lo, hi = 1e-3 * w2, 2 * math.pi / period_s * 10
+        for _ in range(PERIOD_BISECTIONS):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if cycle_s(guess(case, w2, mid, share, 1.5)) > period_s else (lo, mid)
+        starts.append(guess(case, w2, 0.5 * (lo + hi), share, 1.5))
+    return starts

@@ -11,8 +11,9 @@ from planning.tolerances import TIME_TOL_S
 
 
 class CycleTimeLimit(Limit):
-    """The cycle time of a plan at a target rate (objectives ``min-rms-torque``, ``min-energy``): one row of
-    the rate NLP, free until a solve holds it at the parameter ``target_period`` (bounds set per solve);
+    """The cycle time of a plan at a target rate (objectives ``min-rms-torque``, ``min-energy``; a press in a
+    line, ``planning.solver.line``): one row of the rate NLP, free until a solve holds it at the parameter
+    ``target_period`` (bounds set per solve);
     checked on every plan of a case planned at a rate."""
 
     id = "cycle_time"
@@ -24,7 +25,7 @@ class CycleTimeLimit(Limit):
     goal = True
 
     def applies(self, case: Any) -> bool:
-        return case.drive is not None
+        return case.drive is not None or case.planner.target_spm is not None
 
     def parameter_values(self, case: Any) -> dict[str, float]:
         target = case.planner.target_spm

@@ -1,0 +1,205 @@
+"""Planning a press line (the model and its equations: ``planning.model.line``), in named steps: each station
+alone (its fastest verified plan with its robots), the line's period and what binds it, each station's plan at
+that period, the phase offsets, the robots' schedules on the master, the line's verification.
+
+A line is a success only when every station's plan at the line's period passes its own dense verification
+(its limits, its robots' clearances at every millisecond and at their curves' crossings) with its cycle
+time the line's, and every robot's schedule holds: the transfer robot's load starts at least its transfer
+time after its unload ends and its next unload at least that long after the load ends (the feeder's and the
+exit's loops within the period).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from planning.model.limits.base import Check
+from planning.model.line import Line, LineRobot, Station, occupancy_s, phase_offsets_s
+from planning.model.outcome import Outcome
+from planning.solver.max_spm import solve_max_spm
+from planning.solver.objectives import solve_at_period
+from planning.solver.outcomes import Infeasible, PlanningError
+from planning.solver.solution import Solution
+from planning.tolerances import SAME_PERIOD_S, TIME_TOL_S
+
+
+class StationError(PlanningError):
+    """A station without a verified plan (alone, or at the line's period): its outcome, its name in the reason."""
+
+    def __init__(self, station: Station, exc: PlanningError, when: str):
+        self.outcome = exc.outcome
+        self.station = station.name
+        super().__init__(f"station {station.name} ({station.path.name}) {when}: {exc.reason}")
+
+
+class LineUnverified(PlanningError):
+    """Plans for every station, but the line's verification failed (named in the reason)."""
+
+    outcome = Outcome.UNVERIFIED
+
+
+@dataclass(frozen=True)
+class RobotStretch:
+    """One stretch of a line robot's cycle on the line's master: ``what`` it does (``unload draw``, ``to
+    trim``, ``wait``, ``load trim``, ``back to draw``, ``away``), from ``start_s`` [s, within the period] for
+    ``duration_s`` [s]; ``station``: the press it is inside (None: outside every press)."""
+
+    what: str
+    start_s: float
+    duration_s: float
+    station: str | None = None
+
+
+@dataclass(frozen=True)
+class Bottleneck:
+    """What sets the line's period: a press alone with its robots (``kind`` "press") or a robot's loop
+    (``kind`` "robot"), by ``name``, with its period [s]."""
+
+    kind: str
+    name: str
+    period_s: float
+
+
+@dataclass(frozen=True)
+class LineSolution:
+    """A planned line: its period [s], each station alone and at the period, the phase offsets [s], each
+    robot's loop [s] and schedule, the bottleneck, the line's checks."""
+
+    line: Line
+    period_s: float
+    alone: tuple[Solution, ...]
+    at_line: tuple[Solution, ...]
+    offsets_s: tuple[float, ...]
+    loops_s: tuple[float, ...]
+    schedules: tuple[tuple[RobotStretch, ...], ...]
+    bottleneck: Bottleneck
+    checks: tuple[Check, ...]
+
+    @property
+    def spm(self) -> float:
+        return 60.0 / self.period_s
+
+    @property
+    def passed(self) -> bool:
+        return all(c.passed for c in self.checks)
+
+
+def solve_line(line: Line) -> LineSolution:
+    """The line's fastest verified plan (module docstring); raises a :class:`PlanningError` without one."""
+    alone = tuple(_alone(station) for station in line.stations)
+    loops = tuple(robot.loop_s(line.stations) for robot in line.robots)
+    bottleneck = _bottleneck(line, alone, loops)
+    period = bottleneck.period_s
+    _check_slow_enough(line, bottleneck)
+    at_line = tuple(_at_period(station, period, fastest) for station, fastest in zip(line.stations, alone, strict=True))
+    starts = [solution.plan.robot_starts_s for solution in at_line]
+    offsets = phase_offsets_s(period, line.robots, line.stations, starts)
+    schedules = tuple(_schedule(robot, line, period, offsets, starts) for robot in line.robots)
+    checks = _station_checks(line, at_line, period) + _robot_checks(line, schedules, period)
+    solution = LineSolution(
+        line, period, alone, at_line, tuple(float(o) for o in offsets), loops, schedules, bottleneck, checks
+    )
+    failed = [c for c in checks if not c.passed]
+    if failed:
+        raise LineUnverified(
+            f"the line's verification failed: {failed[0].name} ({failed[0].value:.6g} {failed[0].unit})"
+        )
+    return solution
+
+
+def _check_slow_enough(line: Line, bottleneck: Bottleneck) -> None:
+    """:class:`Infeasible` when a station cannot turn as slowly as the line's period asks: its minimum crank
+    speed makes a turn at most ``60 / min_crank_speed_rpm`` [s] long."""
+    for station in line.stations:
+        slowest = station.case.limits.min_crank_speed_rpm
+        if slowest > 0 and bottleneck.period_s > 60.0 / slowest:
+            raise Infeasible(
+                f"the line's cycle {bottleneck.period_s:.4g} s (set by {bottleneck.kind} {bottleneck.name}) is "
+                f"longer than station {station.name} can take: at its limits.min_crank_speed_rpm = {slowest:g} a "
+                f"turn takes at most {60.0 / slowest:.4g} s",
+                limit=f"{station.path.name}: limits.min_crank_speed_rpm",
+                value=slowest,
+            )
+
+
+def _alone(station: Station) -> Solution:
+    try:
+        return solve_max_spm(station.case, station.case.planner.placement)
+    except PlanningError as exc:
+        raise StationError(station, exc, "alone") from None
+
+
+def _at_period(station: Station, period_s: float, fastest: Solution) -> Solution:
+    try:
+        return solve_at_period(station.case, period_s, fastest)
+    except PlanningError as exc:
+        raise StationError(station, exc, f"at the line's {60 / period_s:.4g} strokes/min") from None
+
+
+def _bottleneck(line: Line, alone: tuple[Solution, ...], loops: tuple[float, ...]) -> Bottleneck:
+    """The longest of the stations' own periods and the robots' loops (a press where they tie)."""
+    press = max(range(len(alone)), key=lambda k: alone[k].plan.period)
+    robot = max(range(len(loops)), key=lambda j: loops[j])
+    if loops[robot] > alone[press].plan.period + SAME_PERIOD_S:
+        return Bottleneck("robot", line.robots[robot].name, loops[robot])
+    return Bottleneck("press", line.stations[press].name, alone[press].plan.period)
+
+
+def _schedule(
+    robot: LineRobot, line: Line, period_s: float, offsets: np.ndarray, starts: list[dict[str, float]]
+) -> tuple[RobotStretch, ...]:
+    """``robot``'s stretches over one master cycle from its first (an unload, or the feeder's load)."""
+    names = [s.name for s in line.stations]
+    stretches = []
+
+    def add(what: str, start: float, duration: float, station: str | None = None) -> float:
+        stretches.append(RobotStretch(what, float(np.mod(start, period_s)), duration, station))
+        return start + duration
+
+    if robot.unloads is not None:
+        k = robot.unloads
+        start = offsets[k] + starts[k]["unloader"]
+        end = add(f"unload {names[k]}", start, occupancy_s(line.stations[k], "unloader"), names[k])
+    if robot.loads is None:
+        end = add("away", end, robot.away_s)
+        return (*stretches, RobotStretch("wait", float(np.mod(end, period_s)), start + period_s - end))
+    k = robot.loads
+    load = offsets[k] + starts[k]["loader"]
+    if robot.unloads is None:  # the feeder: its load first
+        end = add(f"load {names[k]}", load, occupancy_s(line.stations[k], "loader"), names[k])
+        end = add("away", end, robot.away_s)
+        return (*stretches, RobotStretch("wait", float(np.mod(end, period_s)), load + period_s - end))
+    load = end + np.mod(load - end, period_s)
+    end = add("wait", add(f"to {names[k]}", end, robot.away_s), load - end - robot.away_s)
+    end = add(f"load {names[k]}", load, occupancy_s(line.stations[k], "loader"), names[k])
+    end = add(f"back to {names[robot.unloads]}", end, robot.away_s)
+    return (*stretches, RobotStretch("wait", float(np.mod(end, period_s)), start + period_s - end))
+
+
+def _station_checks(line: Line, at_line: tuple[Solution, ...], period_s: float) -> tuple[Check, ...]:
+    """Each station's plan at the line's period: verified (its failed checks, none allowed), its cycle time."""
+    checks = []
+    for station, solution in zip(line.stations, at_line, strict=True):
+        failed = len(solution.verification.failures())
+        checks.append(Check.of("line_station", f"{station.name}: failed checks", failed, 0, "", "max", 0.0))
+        checks.append(
+            Check.of(
+                "line_period", f"{station.name}: cycle time", solution.plan.period, period_s, "s", "equal", TIME_TOL_S
+            )
+        )
+    return tuple(checks)
+
+
+def _robot_checks(line: Line, schedules: tuple, period_s: float) -> tuple[Check, ...]:
+    """Each robot's cycle: its stretches one after the other from its unload (or the feeder's load) to the next,
+    one period in all, so each wait (a transfer's at the next press, the last before the next cycle) is at
+    least 0: the load at least its transfer time after the unload, the next unload as long after the load."""
+    checks = []
+    for robot, stretches in zip(line.robots, schedules, strict=True):
+        for stretch in stretches:
+            if stretch.what == "wait":
+                name = f"{robot.name}: wait from {stretch.start_s:.4f} s"
+                checks.append(Check.of("line_robot", name, stretch.duration_s, 0.0, "s", "min", TIME_TOL_S))
+    return tuple(checks)

@@ -1,0 +1,276 @@
+"""The press line (issue 43; docs/line.md): ``pressplan line`` on small lines (fast) and the shipped tandem
+line (slow), its rate against each press alone, the bottleneck named, and the written offsets and robot
+timings replayed by a check of this file's own (the slide from the crank angle by the crank-slider's closed
+form, each robot's trapezoid move from its written start, the interference curves by ``np.interp``), not the
+planner's verification."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from planning.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = Path(__file__).parent / "data" / "line"
+SHIPPED = ROOT / "cases" / "tandem-line" / "line.yaml"
+REPLAY_TOL_MM = 1e-3  # [mm] the replayed clearance may dip this far below 0 (the samples' round-off)
+REPLAY_TOL_S = 1e-6  # [s] a robot's gap between two presses may fall this short of its transfer move
+
+
+def _run(line: Path, out: Path, *more: str) -> dict:
+    code = main(["line", str(line), "--out", str(out), "--no-plots", *more])
+    assert code == 0
+    return json.loads((out / "line_result.json").read_text())
+
+
+@pytest.fixture(scope="module")
+def fast(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, Path]:
+    out = tmp_path_factory.mktemp("fast")
+    return _run(DATA / "fast.yaml", out), out
+
+
+@pytest.fixture(scope="module")
+def slow(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, Path]:
+    out = tmp_path_factory.mktemp("slow")
+    return _run(DATA / "slow.yaml", out), out
+
+
+def test_fast_transfers_leave_the_line_at_its_slowest_press(fast: tuple[dict, Path]) -> None:
+    result, _ = fast
+    alone = [s["spm_alone"] for s in result["stations"]]
+    assert result["status"] == "verified"
+    assert result["spm"] == pytest.approx(min(alone), rel=1e-9)
+    assert result["bottleneck"]["kind"] == "press"
+    assert result["bottleneck"]["name"] == result["stations"][int(np.argmin(alone))]["name"]
+
+
+def test_a_slow_transfer_binds_the_line_and_the_summary_names_it(slow: tuple[dict, Path]) -> None:
+    result, out = slow
+    assert result["status"] == "verified"
+    assert all(result["spm"] < s["spm_alone"] for s in result["stations"])
+    assert result["bottleneck"] == {**result["bottleneck"], "kind": "robot", "name": "first-second"}
+    robot = next(r for r in result["robots"] if r["name"] == "first-second")
+    occupancy = 2 * _trapezoid_time(400, 3000, 30000) + 0.05  # each press's robot: in, dwell, out
+    assert robot["loop_s"] == pytest.approx(2 * occupancy + 2 * 2.0, rel=1e-12)
+    assert result["period_s"] == pytest.approx(robot["loop_s"], rel=1e-12)
+    assert "bottleneck: robot first-second's loop" in (out / "line_summary.txt").read_text()
+
+
+@pytest.mark.parametrize("name", ["fast", "slow"])
+def test_written_timings_replayed_hold_every_clearance(name: str, request: pytest.FixtureRequest) -> None:
+    result, out = request.getfixturevalue(name)
+    clearance, gap, both = _replay(result, out, DATA / f"{name}.yaml")
+    assert clearance >= -REPLAY_TOL_MM
+    assert gap >= -REPLAY_TOL_S
+    assert not both
+
+
+def test_the_replay_finds_a_loader_started_late(fast: tuple[dict, Path]) -> None:
+    """The replay can fail: the bottleneck press's loader 20 ms late meets the slide coming down."""
+    result, out = fast
+    moved = json.loads(json.dumps(result))
+    moved["stations"][0]["robot_starts_s"]["loader"] += 0.02
+    clearance, _, _ = _replay(moved, out, DATA / "fast.yaml")
+    assert clearance < -1.0
+
+
+def test_the_replay_finds_a_press_shifted_on_the_master(slow: tuple[dict, Path]) -> None:
+    """The replay can fail: the second press (and its robots) 50 ms late leaves the slow transfer no time."""
+    result, out = slow
+    moved = json.loads(json.dumps(result))
+    for role in ("unloader", "loader"):
+        moved["stations"][1]["robot_starts_s"][role] += 0.05
+    _, gap, _ = _replay(moved, out, DATA / "slow.yaml")
+    assert gap < -0.01
+
+
+A = str(DATA / "press_a.yaml")
+B = str(DATA / "press_b.yaml")
+GOOD = {
+    "name": "bad",
+    "stations": [{"name": "first", "case": A}, {"name": "second", "case": B}],
+    "transfers": [{"unloads": "first", "loads": "second", "time_s": 0.1}],
+}
+BAD_LINES = [  # (what changes in GOOD, the field the line names, words of the problem)
+    (
+        {"stations": [{"name": "first", "case": A}, {"name": "second", "case": "nowhere.yaml"}]},
+        "stations.1.case",
+        "no such file",
+    ),
+    (
+        {"transfers": [{"unloads": "second", "loads": "first", "time_s": 0.1}]},
+        "transfers.0.loads",
+        "not the station after",
+    ),
+    ({"transfers": []}, "transfers", "none unloads 'first'"),
+    ({"transfers": [{"unloads": "first", "loads": "third", "time_s": 0.1}]}, "transfers.0.loads", "no station 'third'"),
+    (
+        {"transfers": [{"unloads": "first", "loads": "second", "time_s": 1, "path_mm": 100}]},
+        "transfers.0.path_mm",
+        "not both",
+    ),
+    ({"transfers": [{"unloads": "first", "loads": "second", "path_mm": 100}]}, "transfers.0.speed_mm_s", "missing"),
+    (
+        {"stations": [{"name": "first", "case": A}, {"name": "first", "case": B}]},
+        "stations.1.name",
+        "names two stations",
+    ),
+    ({"stations": [{"name": "first", "case": A}]}, "stations", "at least 2"),
+    ({"feeder": {"time_s": -1}}, "feeder.time_s", "greater than or equal to 0"),
+    ({"transfer": []}, "transfer", "did you mean 'transfers'"),
+    (
+        {
+            "stations": [
+                {"name": "first", "case": A},
+                {"name": "second", "case": str(ROOT / "cases" / "wang2023-side-panel.yaml")},
+            ]
+        },
+        "stations.1.case",
+        "has no robots.unloader",
+    ),
+]
+
+
+@pytest.mark.parametrize(("change", "field", "words"), BAD_LINES, ids=[b[1] + ":" + b[2] for b in BAD_LINES])
+def test_a_bad_line_file_is_one_line_naming_the_field(
+    change: dict, field: str, words: str, tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    path = tmp_path / "line.yaml"
+    path.write_text(yaml.safe_dump({**GOOD, **change}))
+    assert main(["line", str(path), "--out", str(tmp_path / "out"), "--no-plots"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and str(path) in err and f"{field}:" in err and words in err, err
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_line_slower_than_a_press_can_turn_is_infeasible_naming_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    """A transfer of 10 s asks a 20 s cycle of a press whose minimum crank speed allows 12 s: exit 3."""
+    case = yaml.safe_load((DATA / "press_b.yaml").read_text())
+    case["limits"]["min_crank_speed_rpm"] = 5
+    (tmp_path / "turning.yaml").write_text(yaml.safe_dump(case))
+    line = {**GOOD, "stations": [{"name": "first", "case": A}, {"name": "second", "case": "turning.yaml"}]}
+    line["transfers"] = [{"unloads": "first", "loads": "second", "time_s": 10.0}]
+    path = tmp_path / "line.yaml"
+    path.write_text(yaml.safe_dump(line))
+    assert main(["line", str(path), "--out", str(tmp_path / "out"), "--no-plots"]) == 3
+    err = capsys.readouterr().err
+    assert "robot first-second" in err and "station second" in err and "min_crank_speed_rpm" in err, err
+
+
+@pytest.mark.slow
+def test_the_shipped_tandem_line(tmp_path: Path) -> None:
+    """Four presses (crank-slider, link drive, offset crank), verified; the line at most its slowest press
+    alone, equal to it here (the transfers do not couple the presses); the timings replayed."""
+    result = _run(SHIPPED, tmp_path)
+    alone = [s["spm_alone"] for s in result["stations"]]
+    assert len(alone) == 4 and {s["mechanism"] for s in result["stations"]} == {"crank-slider", "link-drive"}
+    assert result["spm"] == pytest.approx(min(alone), rel=1e-9)
+    clearance, gap, both = _replay(result, tmp_path, SHIPPED)
+    assert clearance >= -REPLAY_TOL_MM and gap >= -REPLAY_TOL_S and not both
+
+
+def _trapezoid_time(length: float, speed: float, accel: float) -> float:
+    if length >= speed * speed / accel:
+        return length / speed + speed / accel
+    return 2 * math.sqrt(length / accel)
+
+
+def _travelled(tau: np.ndarray, length: float, speed: float, accel: float) -> np.ndarray:
+    """Distance along a rest-to-rest trapezoid (or triangle) move at times ``tau`` from its start."""
+    top = min(speed, math.sqrt(length * accel))
+    ramp = top / accel
+    total = _trapezoid_time(length, speed, accel)
+    t = np.clip(tau, 0.0, total)
+    up = 0.5 * accel * np.minimum(t, ramp) ** 2
+    cruise = top * np.clip(t - ramp, 0.0, total - 2 * ramp)
+    down_t = np.clip(t - (total - ramp), 0.0, ramp)
+    down = top * down_t - 0.5 * accel * down_t**2
+    return up + cruise + down
+
+
+def _position(robot: dict, t: np.ndarray, start: float, period: float) -> np.ndarray:
+    """The robot's distance from the die centre at line times ``t``: in, dwell, out from ``start``, then waiting."""
+    length, speed, accel = robot["path_mm"], robot["speed_mm_s"], robot["accel_mm_s2"]
+    assert robot.get("jerk_mm_s3") is None  # the replay's moves are trapezoids
+    move = _trapezoid_time(length, speed, accel)
+    tau = np.mod(t - start, period)
+    inward = length - _travelled(tau, length, speed, accel)
+    outward = _travelled(tau - move - robot.get("dwell_s", 0.0), length, speed, accel)
+    return np.where(tau < move + robot.get("dwell_s", 0.0), inward, outward)
+
+
+def _slide(case: dict, crank_deg: np.ndarray, path: Path) -> np.ndarray:
+    """The slide's height above BDC: an in-line crank-slider's closed form; other presses by their mechanism."""
+    press = case["press"]
+    if press.get("mechanism", "crank-slider") == "crank-slider" and not press.get("offset_mm"):
+        r, rod = press["crank_radius_mm"], press["rod_length_mm"]
+        th = np.radians(crank_deg)
+        return r * (1 + np.cos(th)) + rod - np.sqrt(rod**2 - (r * np.sin(th)) ** 2)  # the slide hangs below
+    from planning.model.case_file import read_case  # an offset crank or a linkage: its geometry's own model
+
+    return read_case(path).machine.height(np.radians(crank_deg))
+
+
+def _replay(result: dict, out: Path, line_file: Path) -> tuple[float, float, bool]:
+    """``(least clearance [mm], least gap [s] between a robot's stay in one press and the next beyond its
+    transfer move, whether a robot is ever inside two presses at once)`` from the written files alone."""
+    table = np.genfromtxt(out / "line_trajectory.csv", delimiter=",", names=True)
+    line = yaml.safe_load(line_file.read_text())
+    period, t = result["period_s"], table["time_s"]
+    inside: dict[str, list[np.ndarray]] = {}
+    least = math.inf
+    for station, entry in zip(result["stations"], line["stations"], strict=True):
+        case_path = line_file.parent / entry["case"]
+        case = yaml.safe_load(case_path.read_text())
+        slide = _slide(case, table[f"{station['name']}_crank_angle_deg"], case_path)
+        needs = []
+        for role in ("unloader", "loader"):
+            robot = case["robots"][role]
+            x = _position(robot, t, station["robot_starts_s"][role], period)
+            curve = np.array(robot["interference_mm"], dtype=float)
+            needs.append(np.interp(x, curve[:, 0], curve[:, 1], right=0.0))
+            name = _robot_of(result, station["name"], role)
+            inside.setdefault(name, []).append(x < robot["path_mm"] - REPLAY_TOL_MM)
+        least = min(least, float(np.min(slide - np.max(needs, axis=0))))
+    both = any(np.any(np.logical_and(*flags)) for flags in inside.values() if len(flags) == 2)
+    return least, _least_gap(result, line, line_file), both
+
+
+def _robot_of(result: dict, station: str, role: str) -> str:
+    key = "unloads" if role == "unloader" else "loads"
+    return next(r["name"] for r in result["robots"] if r[key] == station)
+
+
+def _least_gap(result: dict, line: dict, line_file: Path) -> float:
+    """Each transfer robot: from leaving one press to entering the next and back, less its move each way."""
+    period, least = result["period_s"], math.inf
+    by_name = {s["name"]: s for s in result["stations"]}
+    for transfer in line.get("transfers", []):
+        first, second = by_name[transfer["unloads"]], by_name[transfer["loads"]]
+        cases = {
+            s["name"]: yaml.safe_load((line_file.parent / e["case"]).read_text())
+            for s, e in zip(result["stations"], line["stations"], strict=True)
+        }
+        unloader = cases[first["name"]]["robots"]["unloader"]
+        loader = cases[second["name"]]["robots"]["loader"]
+        occupancy = {
+            k: 2 * _trapezoid_time(r["path_mm"], r["speed_mm_s"], r["accel_mm_s2"]) + r.get("dwell_s", 0.0)
+            for k, r in (("u", unloader), ("l", loader))
+        }
+        move = transfer.get("time_s")
+        if move is None:
+            move = _trapezoid_time(transfer["path_mm"], transfer["speed_mm_s"], transfer["accel_mm_s2"])
+        left = first["robot_starts_s"]["unloader"] + occupancy["u"]
+        enters = second["robot_starts_s"]["loader"]
+        there = np.mod(enters - left, period)
+        back = period - occupancy["u"] - there - occupancy["l"]
+        least = min(least, there - move, back - move)
+    return least
