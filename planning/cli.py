@@ -176,6 +176,17 @@ def _line_command(sub) -> None:  # noqa: ANN001 - argparse's sub-parsers
     ln.add_argument("--out", help="output folder (default: out/<line name>)")
     ln.add_argument("--no-plots", action="store_true", help="skip line_timing.png")
     ln.add_argument("--json", action="store_true", help="print line_result.json instead of the summary")
+    _set_option(ln, "replace a line field (feeder.time_s) or a station's case field (draw.limits.die_height_mm)")
+    ln.add_argument(
+        "--vary",
+        action="append",
+        default=[],
+        metavar="FIELD=START:STOP:COUNT",
+        help="sweep a line's or a station's numeric field (repeatable: a grid): line_sweep.csv and line_sweep.png",
+    )
+    ln.add_argument("--workers", type=whole(1, 256), default=2, help="local worker processes of a sweep (default 2)")
+    ln.add_argument("--scheduler", help="a sweep on a Dask distributed cluster at this address (tcp://host:8786)")
+    ln.add_argument("--progress", action="store_true", help=PROGRESS_HELP)
 
 
 def _other_commands(sub) -> None:  # noqa: ANN001 - argparse's sub-parsers
@@ -735,22 +746,63 @@ def _new(args) -> int:
 
 
 def _line(args) -> int:
-    """``pressplan line``: read the line and its stations' cases, plan, verify, write the line's files."""
+    """``pressplan line``: read the line and its stations' cases, plan, verify, write the line's files (with
+    ``--vary``: a sweep over the line)."""
+    from planning.model.case_file import CaseFileError
     from planning.model.line_file import read_line
     from planning.reports.folder import ensure_writable
     from planning.reports.line import LINE_FILES, summary_text, writers
     from planning.reports.line import result as line_result
     from planning.solver.line import solve_line
 
-    line = read_line(args.line)
+    sets = dict(args.set)
+    if len(sets) != len(args.set):
+        raise CommandError("--set: each field at most once")
+    try:
+        line = read_line(args.line, sets)
+    except CaseFileError as exc:
+        named = exc.field is not None and any(f == exc.field or f.endswith("." + exc.field) for f in sets)
+        raise CaseFileError(f"{exc} (from --set)" if named else str(exc), exc.field) from None
     out = Path(args.out) if args.out else Path("out") / line.name
     ensure_writable(out)
+    if args.vary:
+        return _line_sweep(line, sets, args, out)
     solution = solve_line(line)
     if not args.no_plots:
         _load_plots()
     args.case = args.line  # the file no output replaces
     files = writers(solution, not args.no_plots)
     return _write_and_report(out, files, line_result(solution), summary_text(solution), args, LINE_FILES)
+
+
+def _line_sweep(line, sets: dict, args, out: Path) -> int:  # noqa: ANN001 - a Line and the parsed arguments
+    """``pressplan line --vary``: the grid's lines planned on the workers, ``line_sweep.csv`` and its figure."""
+    from planning.line_sweep import LINE_SWEEP_FILES, parse_line_vary, run_line_sweep, write_rows
+    from planning.model.outcome import Outcome
+    from planning.reports.folder import write_atomic
+
+    varies = [parse_line_vary(v, args.line) for v in args.vary]
+    fields = [v.field for v in varies]
+    if len(set(fields)) != len(fields) or set(fields) & set(sets):
+        raise CommandError("--vary: each field at most once (and not also in --set)")
+    bar = ProgressBar("line sweep", args.progress)
+    rows = run_line_sweep(args.line, sets, varies, args.workers, args.scheduler, bar.update)
+    bar.close()
+    writers = {"line_sweep.csv": lambda p: write_rows(p, rows, fields)}
+    if len(varies) <= 2:
+        _load_plots()
+        from planning.reports.plots import save, sweep_figure
+
+        title = f"{line.name}: the line's strokes per minute over {' x '.join(fields)}"
+        writers["line_sweep.png"] = lambda p: save(sweep_figure(rows, fields, title), p)
+    files = write_atomic(out, writers, LINE_SWEEP_FILES, keep=args.line)
+    verified = sum(Outcome.of(r["status"]).succeeded for r in rows)
+    for row in rows:
+        values = ", ".join(f"{f} = {row[f]:g}" for f in fields)
+        what = f"{row['spm']:.3f} strokes/min, bottleneck {row['bottleneck']}" if "spm" in row else row["message"]
+        print(f"  {values}: {what}")
+    print(f"{line.name}: {len(rows)} points, {verified} verified; wrote {', '.join(str(f) for f in files)}")
+    return EXIT_OK
 
 
 def _plot(args) -> int:

@@ -86,17 +86,18 @@ def numeric_fields(model: type[BaseModel] = Case, prefix: str = "") -> list[str]
     return out
 
 
-def parse_vary(text: str) -> Vary:
-    """``FIELD=START:STOP:COUNT`` -> :class:`Vary`; :class:`SweepError` naming what is wrong."""
+def parse_vary(text: str, valid: list[str] | None = None, what: str = "a numeric case field") -> Vary:
+    """``FIELD=START:STOP:COUNT`` -> :class:`Vary`; :class:`SweepError` naming what is wrong. ``valid``: the
+    fields it may name (default: a case's numeric fields), ``what`` they are."""
     if "=" not in text:
         raise SweepError(f"--vary: expected FIELD=START:STOP:COUNT (got {text!r})")
     field, spec = text.split("=", 1)
     field = field.strip()
-    valid = numeric_fields()
+    valid = numeric_fields() if valid is None else valid
     if field not in valid:
         hint = difflib.get_close_matches(field, valid, n=1, cutoff=0.5)
         did = f"; did you mean '{hint[0]}'?" if hint else f"; numeric fields: {', '.join(valid)}"
-        raise SweepError(f"--vary: {field}: not a numeric case field{did}")
+        raise SweepError(f"--vary: {field}: not {what}{did}")
     parts = spec.split(":")
     if len(parts) != 3:
         raise SweepError(f"--vary: {field}: expected START:STOP:COUNT (got {spec!r})")

@@ -18,6 +18,7 @@ LAYERS = (  # module prefix -> layer, the most specific prefix wins
     ("planning.solver", 2),
     ("planning.reports", 3),
     ("planning.sweep", 3),
+    ("planning.line_sweep", 3),
     ("planning.tradeoff", 3),
     ("planning.timeline", 3),
     ("planning.web", 3),

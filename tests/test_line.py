@@ -6,6 +6,7 @@ planner's verification."""
 
 from __future__ import annotations
 
+import csv
 import json
 import math
 from pathlib import Path
@@ -163,6 +164,43 @@ def test_a_line_slower_than_a_press_can_turn_is_infeasible_naming_it(
     assert main(["line", str(path), "--out", str(tmp_path / "out"), "--no-plots"]) == 3
     err = capsys.readouterr().err
     assert "robot first-second" in err and "station second" in err and "min_crank_speed_rpm" in err, err
+
+
+def test_a_sweep_over_a_transfer_speed(tmp_path: Path) -> None:
+    """A slow transfer binds the line, a fast one leaves it to the first press; each row a verified line."""
+    args = ["line", str(DATA / "fast.yaml"), "--out", str(tmp_path), "--workers", "1"]
+    assert main([*args, "--vary", "transfers.0.speed_mm_s=1000:6000:2"]) == 0
+    rows = list(csv.DictReader((tmp_path / "line_sweep.csv").open()))
+    assert [r["status"] for r in rows] == ["verified", "verified"]
+    assert rows[0]["bottleneck"] == "robot first-second" and rows[1]["bottleneck"] == "press first"
+    assert float(rows[0]["spm"]) < float(rows[1]["spm"])
+    assert (tmp_path / "line_sweep.png").is_file()
+
+
+@pytest.mark.parametrize(
+    ("option", "words"),
+    [
+        (["--vary", "transfers.0.sped_mm_s=1:2:2"], "did you mean 'transfers.0.speed_mm_s'"),
+        (["--set", "transfers.3.speed_mm_s=100"], "transfers.3.speed_mm_s: no 3 there"),
+        (["--set", "second.limits.die_height_mm=-1"], "limits.die_height_mm"),
+        (["--set", "third.limits.die_height_mm=1"], "neither a line field nor a station's case field"),
+    ],
+)
+def test_a_bad_set_or_vary_is_one_line(
+    option: list[str], words: str, tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    assert main(["line", str(DATA / "fast.yaml"), "--out", str(tmp_path / "out"), *option]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and words in err, err
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.slow
+def test_a_station_field_set_for_a_run_slows_the_line(tmp_path: Path, fast: tuple[dict, Path]) -> None:
+    """The first press's slide acceleration halved: it alone is slower, and so is the line, still at it."""
+    result = _run(DATA / "fast.yaml", tmp_path, "--set", "first.limits.slider_accel_mm_s2=10000")
+    assert result["spm"] < fast[0]["spm"]
+    assert result["spm"] == pytest.approx(min(s["spm_alone"] for s in result["stations"]), rel=1e-9)
 
 
 @pytest.mark.slow

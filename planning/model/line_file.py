@@ -4,7 +4,9 @@ field."""
 
 from __future__ import annotations
 
+import copy
 from pathlib import Path
+from typing import Any
 
 from pydantic import ValidationError
 
@@ -15,23 +17,61 @@ from planning.model.line import EndModel, Line, LineModel, LineRobot, Station, T
 LINE_FIELDS = ("path_mm", "speed_mm_s", "accel_mm_s2")  # a transfer's move, when no time_s is given
 
 
-def read_line(path: str | Path) -> Line:
-    """Read, parse and validate a line file and each station's case; :class:`CaseFileError` (one line)."""
+def read_line(path: str | Path, overrides: dict[str, Any] | None = None) -> Line:
+    """Read, parse and validate a line file and each station's case; :class:`CaseFileError` (one line).
+    ``overrides``: dotted fields and the values that replace the file's, set before validation: a line
+    field (``transfers.0.speed_mm_s``, ``feeder.time_s``) or a station's case field after its name
+    (``draw.limits.slider_accel_mm_s2``)."""
     path = Path(path)
     label = str(path)
     data = load_yaml(_read_text(path), label)
     if not isinstance(data, dict):
         raise CaseFileError(f"{label}: expected a mapping of line fields at the top level")
+    data, by_station = _with_overrides(data, overrides or {}, label)
     try:
         model = LineModel.model_validate(data)
     except ValidationError as exc:
         raise CaseFileError(_pydantic_line(exc, data, label, LineModel), _pydantic_field(exc)) from None
-    stations = tuple(_station(model, k, path) for k in range(len(model.stations)))
+    stations = tuple(
+        _station(model, k, path, by_station.get(model.stations[k].name)) for k in range(len(model.stations))
+    )
     robots = _robots(model, label)
     return Line(model.name, model.title, stations, robots, path)
 
 
-def _station(model: LineModel, k: int, line_path: Path) -> Station:
+def _with_overrides(data: dict, overrides: dict[str, Any], label: str) -> tuple[dict, dict[str, dict[str, Any]]]:
+    """A copy of the line's mapping with its own overridden fields set, and each station's case overrides."""
+    data = copy.deepcopy(data)
+    names = [s.get("name") for s in data.get("stations") or [] if isinstance(s, dict)]
+    by_station: dict[str, dict[str, Any]] = {}
+    for field, value in overrides.items():
+        first, _, rest = field.partition(".")
+        if first in names and first not in LineModel.model_fields:
+            if not rest:
+                raise CaseFileError(f"{label}: {field}: a station's case field follows its name", field)
+            by_station.setdefault(first, {})[rest] = value
+            continue
+        if first not in LineModel.model_fields:
+            raise CaseFileError(
+                f"{label}: {field}: neither a line field nor a station's case field (draw.limits.die_height_mm)",
+                field,
+            )
+        *parents, leaf = field.split(".")
+        node: Any = data
+        for part in parents:
+            if isinstance(node, list) and part.isdigit() and int(part) < len(node):
+                node = node[int(part)]
+            elif isinstance(node, dict):
+                node = node.setdefault(part, {})
+            else:
+                raise CaseFileError(f"{label}: {field}: no {part} there", field)
+        if isinstance(node, list) or not isinstance(node, dict):
+            raise CaseFileError(f"{label}: {field}: not a field", field)
+        node[leaf] = value
+    return data, by_station
+
+
+def _station(model: LineModel, k: int, line_path: Path, overrides: dict[str, Any] | None = None) -> Station:
     """Station ``k``: its case read from its file (relative to the line file), with both robots and a law
     that plans at a rate."""
     entry = model.stations[k]
@@ -39,10 +79,14 @@ def _station(model: LineModel, k: int, line_path: Path) -> Station:
     names = [s.name for s in model.stations]
     if names.index(entry.name) != k:
         raise CaseFileError(f"{line_path}: stations.{k}.name: '{entry.name}' names two stations", f"stations.{k}.name")
+    if entry.name in LineModel.model_fields:
+        raise CaseFileError(
+            f"{line_path}: stations.{k}.name: '{entry.name}' is a line file's key", f"stations.{k}.name"
+        )
     case_path = line_path.parent / entry.case
     if not case_path.is_file():
         raise CaseFileError(f"{line_path}: {field}: no such file ({case_path})", field)
-    case = read_case(case_path)
+    case = read_case(case_path, overrides)
     missing = [role for role in ("unloader", "loader") if case.robots is None or getattr(case.robots, role) is None]
     if missing:
         raise CaseFileError(

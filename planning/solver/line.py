@@ -124,11 +124,22 @@ def _check_slow_enough(line: Line, bottleneck: Bottleneck) -> None:
             )
 
 
+_ALONE: dict[str, Solution] = {}  # each case's fastest plan, once per process (a line sweep's points share them)
+ALONE_KEPT = 64  # the most kept
+
+
 def _alone(station: Station) -> Solution:
-    try:
-        return solve_max_spm(station.case, station.case.planner.placement)
-    except PlanningError as exc:
-        raise StationError(station, exc, "alone") from None
+    """The station's fastest verified plan (solved once per process for the same case)."""
+    key = station.case.model_dump_json()
+    if key not in _ALONE:
+        try:
+            solution = solve_max_spm(station.case, station.case.planner.placement)
+        except PlanningError as exc:
+            raise StationError(station, exc, "alone") from None
+        if len(_ALONE) >= ALONE_KEPT:
+            _ALONE.pop(next(iter(_ALONE)))
+        _ALONE[key] = solution
+    return _ALONE[key]
 
 
 def _at_period(station: Station, period_s: float, fastest: Solution) -> Solution:
