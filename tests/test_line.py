@@ -60,7 +60,8 @@ def test_a_slow_transfer_binds_the_line_and_the_summary_names_it(slow: tuple[dic
     occupancy = 2 * _trapezoid_time(400, 3000, 30000) + 0.05  # each press's robot: in, dwell, out
     assert robot["loop_s"] == pytest.approx(2 * occupancy + 2 * 2.0, rel=1e-12)
     assert result["period_s"] == pytest.approx(robot["loop_s"], rel=1e-12)
-    assert "bottleneck: robot first-second's loop" in (out / "line_summary.txt").read_text()
+    summary = (out / "line_summary.txt").read_text()
+    assert "bottleneck: robot first-second's loop = unload first 0.517 + to second 2.000 + load second 0.517" in summary
 
 
 @pytest.mark.parametrize("name", ["fast", "slow"])
@@ -89,6 +90,20 @@ def test_the_replay_finds_a_press_shifted_on_the_master(slow: tuple[dict, Path])
         moved["stations"][1]["robot_starts_s"][role] += 0.05
     _, gap, _ = _replay(moved, out, DATA / "slow.yaml")
     assert gap < -0.01
+
+
+def test_the_line_verification_fails_a_press_off_its_offset(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    """The line's own checks can fail: with the slow transfer binding (no spare time), the second press 50 ms
+    off its offset leaves the robot less than its transfer move: unverified, exit 3, naming the robot's wait."""
+    from planning.model import line as model
+
+    offsets = model.phase_offsets_s
+    monkeypatch.setattr("planning.solver.line.phase_offsets_s", lambda *a: offsets(*a) + np.array([0.0, 0.05]))
+    assert main(["line", str(DATA / "slow.yaml"), "--out", str(tmp_path), "--no-plots"]) == 3
+    assert "unverified" in (err := capsys.readouterr().err) and "first-second: wait" in err, err
+    assert not (tmp_path / "line_result.json").exists()
 
 
 A = str(DATA / "press_a.yaml")

@@ -129,6 +129,9 @@ def summary_text(solution: LineSolution) -> str:
     line, period = solution.line, solution.period_s
     neck = solution.bottleneck
     what = f"press {neck.name} alone with its robots" if neck.kind == "press" else f"robot {neck.name}'s loop"
+    if neck.kind == "robot":  # what the loop is made of: its stays in the presses, its moves between them
+        stretches = solution.schedules[[r.name for r in line.robots].index(neck.name)]
+        what += " = " + " + ".join(f"{s.what} {s.duration_s:.3f}" for s in stretches if s.what != "wait") + " s"
     lines = [
         f"{line.name}: {solution.spm:.3f} strokes/min, cycle {period:.4f} s "
         f"({len(line.stations)} presses on one master, verified)",
