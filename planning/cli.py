@@ -761,7 +761,7 @@ def _line(args) -> int:
     try:
         line = read_line(args.line, sets)
     except CaseFileError as exc:
-        named = exc.field is not None and any(f == exc.field or f.endswith("." + exc.field) for f in sets)
+        named = exc.field is not None and any(_names(f, exc.field) for f in sets)
         raise CaseFileError(f"{exc} (from --set)" if named else str(exc), exc.field) from None
     out = Path(args.out) if args.out else Path("out") / line.name
     ensure_writable(out)
@@ -771,13 +771,20 @@ def _line(args) -> int:
     if not args.no_plots:
         _load_plots()
     args.case = args.line  # the file no output replaces
-    files = writers(solution, not args.no_plots)
-    return _write_and_report(out, files, line_result(solution), summary_text(solution), args, LINE_FILES)
+    files = writers(solution, not args.no_plots, sets)
+    return _write_and_report(out, files, line_result(solution, sets), summary_text(solution), args, LINE_FILES)
+
+
+def _names(setting: str, field: str) -> bool:
+    """Whether a line's error in ``field`` comes from the ``--set`` of ``setting``: the same field, the same
+    station's case field, or a sibling (a transfer's time set beside its path)."""
+    parent = setting.rpartition(".")[0]
+    return setting == field or setting.endswith("." + field) or (bool(parent) and field.startswith(parent + "."))
 
 
 def _line_sweep(line, sets: dict, args, out: Path) -> int:  # noqa: ANN001 - a Line and the parsed arguments
     """``pressplan line --vary``: the grid's lines planned on the workers, ``line_sweep.csv`` and its figure."""
-    from planning.line_sweep import LINE_SWEEP_FILES, parse_line_vary, run_line_sweep, write_rows
+    from planning.line_sweep import LINE_SWEEP_FILES, check_corners, parse_line_vary, run_line_sweep, write_rows
     from planning.model.outcome import Outcome
     from planning.reports.folder import write_atomic
 
@@ -785,6 +792,7 @@ def _line_sweep(line, sets: dict, args, out: Path) -> int:  # noqa: ANN001 - a L
     fields = [v.field for v in varies]
     if len(set(fields)) != len(fields) or set(fields) & set(sets):
         raise CommandError("--vary: each field at most once (and not also in --set)")
+    check_corners(args.line, sets, varies)  # a value no line takes: refused before any point is solved
     bar = ProgressBar("line sweep", args.progress)
     rows = run_line_sweep(args.line, sets, varies, args.workers, args.scheduler, bar.update)
     bar.close()

@@ -9,6 +9,7 @@ rows in the grid's order in ``line_sweep.csv``, the figure ``line_sweep.png``.
 from __future__ import annotations
 
 import csv
+import itertools
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -39,6 +40,18 @@ def line_fields(path: str | Path) -> list[str]:
 def parse_line_vary(text: str, path: str | Path) -> Vary:
     """``FIELD=START:STOP:COUNT`` over one of :func:`line_fields`; ``SweepError`` naming what is wrong."""
     return parse_vary(text, line_fields(path), "a line's numeric field")
+
+
+def check_corners(path: str | Path, sets: dict[str, Any], varies: list[Vary]) -> None:
+    """Read the line at each corner of the grid (every field at its first or last value): a value no line
+    takes is bad input before any point is solved (:class:`CaseFileError` naming it, from ``--vary``)."""
+    for corner in itertools.product(*((v.start, v.stop) for v in varies)):
+        point = dict(zip((v.field for v in varies), corner, strict=True))
+        try:
+            read_line(path, {**sets, **point})
+        except CaseFileError as exc:
+            values = ", ".join(f"{f}={x:g}" for f, x in point.items())
+            raise CaseFileError(f"{exc} (from --vary, at {values})", exc.field) from None
 
 
 def solve_points(path: str, sets: dict[str, Any], fields: list[str], points: list[tuple]) -> list[dict[str, Any]]:

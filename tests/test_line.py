@@ -55,13 +55,14 @@ def test_a_slow_transfer_binds_the_line_and_the_summary_names_it(slow: tuple[dic
     result, out = slow
     assert result["status"] == "verified"
     assert all(result["spm"] < s["spm_alone"] for s in result["stations"])
-    assert result["bottleneck"] == {**result["bottleneck"], "kind": "robot", "name": "first-second"}
-    robot = next(r for r in result["robots"] if r["name"] == "first-second")
+    assert result["bottleneck"] == {**result["bottleneck"], "kind": "robot", "name": "first->second"}
+    robot = next(r for r in result["robots"] if r["name"] == "first->second")
     occupancy = 2 * _trapezoid_time(400, 3000, 30000) + 0.05  # each press's robot: in, dwell, out
     assert robot["loop_s"] == pytest.approx(2 * occupancy + 2 * 2.0, rel=1e-12)
     assert result["period_s"] == pytest.approx(robot["loop_s"], rel=1e-12)
     summary = (out / "line_summary.txt").read_text()
-    assert "bottleneck: robot first-second's loop = unload first 0.517 + to second 2.000 + load second 0.517" in summary
+    loop = "unload first 0.517 + to second 2.000 + load second 0.517"
+    assert f"bottleneck: robot first->second's loop = {loop}" in summary
 
 
 @pytest.mark.parametrize("name", ["fast", "slow"])
@@ -102,7 +103,7 @@ def test_the_line_verification_fails_a_press_off_its_offset(
     offsets = model.phase_offsets_s
     monkeypatch.setattr("planning.solver.line.phase_offsets_s", lambda *a: offsets(*a) + np.array([0.0, 0.05]))
     assert main(["line", str(DATA / "slow.yaml"), "--out", str(tmp_path), "--no-plots"]) == 3
-    assert "unverified" in (err := capsys.readouterr().err) and "first-second: wait" in err, err
+    assert "unverified" in (err := capsys.readouterr().err) and "first->second: wait" in err, err
     assert not (tmp_path / "line_result.json").exists()
 
 
@@ -141,15 +142,28 @@ BAD_LINES = [  # (what changes in GOOD, the field the line names, words of the p
     ({"feeder": {"time_s": -1}}, "feeder.time_s", "greater than or equal to 0"),
     ({"transfer": []}, "transfer", "did you mean 'transfers'"),
     (
+        {"stations": [{"name": "first", "case": A}, {"name": "second", "case": str(DATA / "loader_only.yaml")}]},
+        "stations.1.case (second)",
+        "has no robots.unloader",
+    ),
+    (
         {
             "stations": [
                 {"name": "first", "case": A},
                 {"name": "second", "case": str(ROOT / "cases" / "wang2023-side-panel.yaml")},
             ]
         },
-        "stations.1.case",
-        "has no robots.unloader",
+        "stations.1.case (second)",
+        "has no robots: section",
     ),
+    (
+        {"stations": [{"name": "first", "case": A}, {"name": "second", "case": str(DATA / "broken.yaml")}]},
+        "stations.1.case (second)",
+        "broken.yaml: limits.slider_accel_mm_s2: input should be a valid number",
+    ),
+    ({"stations": [{"name": "first", "case": A}, {"name": "second", "case": "."}]}, "stations.1.case", "not a file"),
+    ({"stations": [{"name": "first", "case": A}, {"name": "exit", "case": B}]}, "stations.1.name", "a line file's key"),
+    ({"transfers": [{"unloads": "first", "loads": "second", "time_s": 0}]}, "transfers.0.time_s", "greater than 0"),
 ]
 
 
@@ -178,7 +192,7 @@ def test_a_line_slower_than_a_press_can_turn_is_infeasible_naming_it(
     path.write_text(yaml.safe_dump(line))
     assert main(["line", str(path), "--out", str(tmp_path / "out"), "--no-plots"]) == 3
     err = capsys.readouterr().err
-    assert "robot first-second" in err and "station second" in err and "min_crank_speed_rpm" in err, err
+    assert "robot first->second" in err and "station second" in err and "min_crank_speed_rpm" in err, err
 
 
 def test_a_sweep_over_a_transfer_speed(tmp_path: Path) -> None:
@@ -187,7 +201,7 @@ def test_a_sweep_over_a_transfer_speed(tmp_path: Path) -> None:
     assert main([*args, "--vary", "transfers.0.speed_mm_s=1000:6000:2"]) == 0
     rows = list(csv.DictReader((tmp_path / "line_sweep.csv").open()))
     assert [r["status"] for r in rows] == ["verified", "verified"]
-    assert rows[0]["bottleneck"] == "robot first-second" and rows[1]["bottleneck"] == "press first"
+    assert rows[0]["bottleneck"] == "robot first->second" and rows[1]["bottleneck"] == "press first"
     assert float(rows[0]["spm"]) < float(rows[1]["spm"])
     assert (tmp_path / "line_sweep.png").is_file()
 
@@ -199,6 +213,14 @@ def test_a_sweep_over_a_transfer_speed(tmp_path: Path) -> None:
         (["--set", "transfers.3.speed_mm_s=100"], "transfers.3.speed_mm_s: no 3 there"),
         (["--set", "second.limits.die_height_mm=-1"], "limits.die_height_mm"),
         (["--set", "third.limits.die_height_mm=1"], "neither a line field nor a station's case field"),
+        (
+            ["--set", "transfers.0.time_s=1"],
+            "transfers.0.path_mm: give time_s or the path and its limits, not both (from --set)",
+        ),
+        (
+            ["--vary", "feeder.time_s=-1:1:3"],
+            "feeder.time_s: input should be greater than or equal to 0 (got -1.0) (from --vary",
+        ),
     ],
 )
 def test_a_bad_set_or_vary_is_one_line(

@@ -66,11 +66,14 @@ class TransferModel(_Model):
     speed_mm_s: PathSpeed | None = Field(None, title="speed [mm/s]")
     accel_mm_s2: PathAccel | None = Field(None, title="acceleration [mm/s²]")
     jerk_mm_s3: PathJerk | None = Field(None, title="jerk [mm/s³]", description="Empty: none (trapezoid moves).")
-    time_s: LineTime | None = Field(None, title="time [s]", description="The move's time each way, for a path.")
+    time_s: Annotated[float, Field(gt=0, le=1e4)] | None = Field(
+        None, title="time [s]", description="The move's time each way, instead of a path."
+    )
 
 
 class EndModel(_Model):
-    """A line's end: the time its robot spends away from the press each cycle (fetching a blank, placing a part)."""
+    """A line's end: the time its robot spends away from the press each cycle (fetching a blank, placing a part);
+    a line without one: 0 (the robot's occupancy in the press alone, as for one press)."""
 
     time_s: LineTime = Field(title="time away [s]")
 
@@ -134,7 +137,7 @@ def occupancy_s(station: Station, role: str) -> float:
 
 def transfer_robot(model: TransferModel, index: int) -> LineRobot:
     """The transfer robot from station ``index`` to the next, its move from the file's path and limits."""
-    name = f"{model.unloads}-{model.loads}"
+    name = f"{model.unloads}->{model.loads}"  # unique: a station's name has no ">"
     if model.time_s is not None:
         return LineRobot(name, index, index + 1, model.time_s)
     limits = MoveLimits(model.speed_mm_s, model.accel_mm_s2, model.jerk_mm_s3)

@@ -84,23 +84,47 @@ def _station(model: LineModel, k: int, line_path: Path, overrides: dict[str, Any
             f"{line_path}: stations.{k}.name: '{entry.name}' is a line file's key", f"stations.{k}.name"
         )
     case_path = line_path.parent / entry.case
-    if not case_path.is_file():
+    if not case_path.exists():
         raise CaseFileError(f"{line_path}: {field}: no such file ({case_path})", field)
-    case = read_case(case_path, overrides)
-    missing = [role for role in ("unloader", "loader") if case.robots is None or getattr(case.robots, role) is None]
+    if not case_path.is_file():
+        raise CaseFileError(f"{line_path}: {field}: not a file ({case_path})", field)
+    where = f"{line_path}: {field} ({entry.name}): "
+    try:
+        case = read_case(case_path, overrides)
+    except CaseFileError as exc:
+        if not _has_robots(case_path, overrides):
+            missing = f"{entry.case} has no robots: section"
+            raise CaseFileError(
+                f"{where}{missing} (a station of a line needs its unloader and its loader)", field
+            ) from None
+        raise CaseFileError(where + str(exc), exc.field) from None
+    if case.robots is None:
+        missing_section = f"{entry.case} has no robots: section"
+        raise CaseFileError(f"{where}{missing_section} (a station of a line needs its unloader and its loader)", field)
+    missing = [role for role in ("unloader", "loader") if getattr(case.robots, role) is None]
     if missing:
         raise CaseFileError(
-            f"{line_path}: {field}: {entry.case} has no robots.{missing[0]} (a station of a line needs its unloader "
-            "and its loader on their interference curves)",
+            f"{where}{entry.case} has no robots.{missing[0]} (a station of a line needs its unloader and its loader "
+            "on their interference curves)",
             field,
         )
     if not LAWS[case.planner.motion_law].plans_at_rate:
         raise CaseFileError(
-            f"{line_path}: {field}: {entry.case} plans with the {case.planner.motion_law} law, which cannot run at "
-            "a line's rate; choose a law with halves (planner.motion_law)",
+            f"{where}{entry.case} plans with the {case.planner.motion_law} law, which cannot run at a line's rate; "
+            "choose a law with halves (planner.motion_law)",
             field,
         )
     return Station(entry.name, case, case_path)
+
+
+def _has_robots(case_path: Path, overrides: dict[str, Any] | None) -> bool:
+    """Whether the case file (with the run's ``overrides``) holds a ``robots:`` section: its mapping as read."""
+    try:
+        data = load_yaml(_read_text(case_path), str(case_path))
+    except CaseFileError:
+        return True  # not the robots' fault: the file's own error says what is
+    robots = (overrides or {}).get("robots", data.get("robots") if isinstance(data, dict) else None)
+    return robots is not None or any(f.startswith("robots.") for f in overrides or {})
 
 
 def _robots(model: LineModel, label: str) -> tuple[LineRobot, ...]:

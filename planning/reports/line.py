@@ -29,7 +29,8 @@ def station_times(solution: LineSolution, k: int, t_s: np.ndarray) -> np.ndarray
 
 def station_state(solution: LineSolution, k: int, t_s: np.ndarray) -> dict[str, np.ndarray]:
     """Station ``k`` at line times ``t_s``: its crank angle [deg] and speed [rad/s], its slide height [mm], each
-    robot's position on its path [mm] and need [mm], the least clearance [mm] (slide minus the highest need)."""
+    robot's position on its path [mm], the highest need [mm] and the clearance [mm] (the slide minus that need;
+    where no tool needs any, the slide's height, as in ``trajectory.csv``)."""
     station, plan = solution.line.stations[k], solution.at_line[k].plan
     local = station_times(solution, k, t_s)
     theta, omega, _, _ = plan.profile.at_time(local)
@@ -74,14 +75,25 @@ def cams(solution: LineSolution, points: int = CAM_POINTS) -> tuple[np.ndarray, 
     return np.column_stack(list(columns.values())), tuple(columns)
 
 
-def result(solution: LineSolution) -> dict[str, Any]:
+def result(solution: LineSolution, settings: dict[str, Any] | None = None) -> dict[str, Any]:
     """``line_result.json``: the line, each station (alone, at the line, its offset, its robots' starts on the
-    line's master), each robot (its loop and its stretches), the bottleneck, the checks."""
+    line's master, its least clearance on the 1 ms grid, its case fields set for the run), each robot (its loop
+    and its stretches), the bottleneck, the checks; ``settings``: the run's ``--set`` fields."""
+    settings = settings or {}
+    names = {s.name for s in solution.line.stations}
+    sets: dict[str, dict[str, Any]] = {}
+    for field, value in settings.items():
+        first, _, rest = field.partition(".")
+        if first in names:
+            sets.setdefault(first, {})[rest] = value
     line, period = solution.line, solution.period_s
+    t = np.arange(0.0, period, STEP_S)
     stations = []
     for k, station in enumerate(line.stations):
         alone, plan = solution.alone[k].plan, solution.at_line[k].plan
         offset = solution.offsets_s[k]
+        state = station_state(solution, k, t)
+        clearance = np.where(state["needed_height_mm"] > 0, state["clearance_mm"], np.inf)  # where a tool needs any
         stations.append(
             {
                 "name": station.name,
@@ -93,7 +105,10 @@ def result(solution: LineSolution) -> dict[str, Any]:
                 "phase_offset_deg": offset / period * 360.0,
                 "robot_starts_s": {r: float(np.mod(s + offset, period)) for r, s in plan.robot_starts_s.items()},
                 "robot_starts_own_s": dict(plan.robot_starts_s),
+                "least_clearance_mm": float(np.min(clearance)) if np.isfinite(np.min(clearance)) else None,
+                "least_clearance_time_s": float(t[int(np.argmin(clearance))]),
                 "verified": solution.at_line[k].verification.passed,
+                "set": dict(sets.get(station.name, {})),
             }
         )
     robots = [
@@ -111,6 +126,8 @@ def result(solution: LineSolution) -> dict[str, Any]:
     return {
         "line": line.name,
         "title": line.title,
+        "line_file": str(line.path),
+        "set": {f: v for f, v in settings.items() if f.partition(".")[0] not in names},
         "status": "verified" if solution.passed else "unverified",
         "spm": solution.spm,
         "period_s": period,
@@ -152,8 +169,9 @@ def summary_text(solution: LineSolution) -> str:
     return "\n".join(lines)
 
 
-def writers(solution: LineSolution, figures: bool) -> dict[str, Any]:
-    """The files of :data:`LINE_FILES` this run writes (the figure with ``figures``)."""
+def writers(solution: LineSolution, figures: bool, settings: dict[str, Any] | None = None) -> dict[str, Any]:
+    """The files of :data:`LINE_FILES` this run writes (the figure with ``figures``; ``settings``: the run's
+    ``--set`` fields, recorded)."""
     table, columns = trajectory(solution)
     cam_table, cam_columns = cams(solution)
     head = (
@@ -162,13 +180,13 @@ def writers(solution: LineSolution, figures: bool) -> dict[str, Any]:
     )
     out = {
         "line_summary.txt": lambda p: Path(p).write_text(summary_text(solution) + "\n", encoding="utf-8"),
-        "line_result.json": lambda p: write_json(p, result(solution)),
+        "line_result.json": lambda p: write_json(p, result(solution, settings)),
         "line_trajectory.csv": lambda p: write_table(p, table, columns),
         "line_cams.csv": lambda p: write_table(p, cam_table, cam_columns, head),
     }
     if figures:
         from planning.reports.plots import line_figure, save
 
-        data, traj = result(solution), dict(zip(columns, table.T, strict=True))
+        data, traj = result(solution, settings), dict(zip(columns, table.T, strict=True))
         out["line_timing.png"] = lambda p: save(line_figure(data, traj), p)
     return out

@@ -639,7 +639,10 @@ def tradeoff_figure(rows: list[dict[str, Any]], case: Any, title: str) -> Figure
     return fig
 
 
-LINE_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf")
+LINE_COLOURS = (  # one per station, up to a line's most (planning.model.line.MAX_STATIONS)
+    "#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b",
+    "#e377c2", "#17becf", "#bcbd22", "#7f7f7f", "#393b79", "#637939",
+)
 
 
 def line_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
@@ -659,9 +662,10 @@ def line_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
     heights.plot([], [], "--", color="k", lw=1.2, label="height the robots' tools need")
     heights.set_ylabel("height above BDC [mm]")
     heights.set_ylim(bottom=0)
-    heights.legend(loc="upper left", fontsize=8, ncols=2)
+    heights.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, borderaxespad=0.0)
+    neck = result["bottleneck"]
     title = f"{result['line']}: {result['spm']:.3f} strokes/min, cycle {period:.4f} s"
-    heights.set_title(title + f"; bottleneck: {result['bottleneck']['name']}", fontsize=9, loc="left")
+    heights.set_title(title + f"; bottleneck: {neck['kind']} {neck['name']}", fontsize=9, loc="left")
     names = []
     for row, robot in enumerate(result["robots"]):
         names.append(robot["name"])

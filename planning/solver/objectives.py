@@ -143,7 +143,9 @@ def _rate_search(case: Case, placement: Placement, period: float, peak: bool = F
 
 def solve_at_period(case: Case, period_s: float, fastest: Solution | None = None) -> Solution:
     """``case``'s max-SPM plan run at cycle time ``period_s`` [s] (a press in a line; a drive is not needed):
-    the longest transfer dwell (:func:`_baseline`); its fastest plan where ``period_s`` is that plan's own.
+    the longest transfer dwell (:func:`_baseline`), else (its optimum out of the solver's reach) the verified
+    plan at that period with the longest dwell the starts reach; its fastest plan where ``period_s`` is that
+    plan's own.
     ``fastest``: the case's max-SPM solution when the caller has it. :class:`Infeasible` for a period
     shorter than the fastest plan's."""
     case = case.with_objective("max-spm")
@@ -152,11 +154,31 @@ def solve_at_period(case: Case, period_s: float, fastest: Solution | None = None
         fastest = solve_max_spm(case, placement)
     _check_reachable(60.0 / period_s, fastest, case)
     at_rate = case.with_objective(None, 60.0 / period_s)
+    guesses = guesses_at_period(case, fastest.plan.nlp_values["draw_speed"], period_s)
     try:
         return _baseline(at_rate, placement, fastest, period_s, None, True)
     except NoPlanFound:  # far slower than the fastest: starts built for the period (its draw speed kept)
-        guesses = guesses_at_period(case, fastest.plan.nlp_values["draw_speed"], period_s)
+        pass
+    try:
         return _baseline(at_rate, placement, fastest, period_s, None, True, guesses)
+    except NoPlanFound:  # the dwell's optimum out of IPOPT's reach (it ends "infeasible" near a degenerate half)
+        return _at_period_feasible(at_rate, placement, fastest, period_s, guesses)
+
+
+def _at_period_feasible(
+    case: Case, placement: Placement, fastest: Solution, period: float, guesses: list[dict[str, float]]
+) -> Solution:
+    """A verified plan at cycle time ``period`` [s] without the dwell's objective (the rate NLP as a feasibility
+    problem, every weight 0), from the slowed fastest plan and the period's guesses; of those verified, the
+    longest transfer dwell."""
+    search = _rate_search(case, placement, period)
+    search.score = lambda solution: -float(solution.plan.parameters.transfer_dwell) / period
+    starts = [_slowed(fastest.plan, period / fastest.plan.period, search), *guesses]
+    _run_starts(search, starts, None, placement, True)
+    try:
+        return search.answer()
+    except NoPlanFound as exc:
+        raise NoPlanFound(f"no plan at {60 / period:.4g} strokes/min: {exc.reason}", exc.attempts) from None
 
 
 def _baseline(
