@@ -34,6 +34,9 @@ _EXPORTS = {
     "trajectory": ("planning.reports.report", "trajectory"),
     "write_outputs": ("planning.reports.outputs", "write_outputs"),
     "compare_laws": ("planning.reports.law_comparison", "compare_laws"),
+    "read_line": ("planning.model.line_file", "read_line"),
+    "solve_line": ("planning.solver.line", "solve_line"),
+    "write_line_outputs": ("planning.reports.line", "write_line_outputs"),
 }
 __all__ = sorted(_EXPORTS)
 

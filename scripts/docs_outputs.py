@@ -34,7 +34,7 @@ import re
 import shlex
 import sys
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -153,10 +153,12 @@ def run(command: str) -> str:
     return "".join(f"{line}\n" for line in lines if not DROPPED.match(line))
 
 
-def fresh_outputs(pages: tuple[Path, ...] = PAGES) -> list[tuple[Block, str]]:
-    """Each block with its command's output now."""
+def fresh_outputs(
+    pages: tuple[Path, ...] = PAGES, keep: Callable[[str], bool] = lambda command: True
+) -> list[tuple[Block, str]]:
+    """Each block (whose command ``keep`` accepts) with its command's output now."""
     with scratch():
-        return [(block, run(block.command)) for block in blocks(pages)]
+        return [(block, run(block.command)) for block in blocks(pages) if keep(block.command)]
 
 
 def fresh_values(pages: tuple[Path, ...] = PAGES, commands: set[str] | None = None) -> list[tuple[Value, str]]:

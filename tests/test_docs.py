@@ -28,10 +28,26 @@ def test_the_readme_is_short():
     assert len((ROOT / "README.md").read_bytes()) <= README_LIMIT_BYTES
 
 
+SLOW_BLOCKS = ("pressplan line ",)  # commands of tens of seconds (a whole press line): their blocks in the slow tier
+
+
+def _slow(command: str) -> bool:
+    return command.startswith(SLOW_BLOCKS)
+
+
 def test_every_shown_output_is_what_the_command_prints_now():
     docs = _docs_outputs()
-    blocks = docs.fresh_outputs()
+    blocks = docs.fresh_outputs(keep=lambda command: not _slow(command))
     assert len(blocks) >= 8 and any(b.page.name == "README.md" for b, _ in blocks)
+    stale = docs.stale(blocks)
+    assert not stale, f"run `python scripts/docs_outputs.py` (or fix the code): {stale}"
+
+
+@pytest.mark.slow
+def test_every_shown_output_of_a_long_command_is_what_it_prints_now():
+    docs = _docs_outputs()
+    blocks = docs.fresh_outputs(keep=_slow)
+    assert blocks
     stale = docs.stale(blocks)
     assert not stale, f"run `python scripts/docs_outputs.py` (or fix the code): {stale}"
 

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from planning.reports.folder import write_json, write_table
+from planning.reports.folder import write_atomic, write_json, write_table
 from planning.solver.line import LineSolution
 
 LINE_FILES = ("line_summary.txt", "line_result.json", "line_trajectory.csv", "line_cams.csv", "line_timing.png")
@@ -190,3 +190,10 @@ def writers(solution: LineSolution, figures: bool, settings: dict[str, Any] | No
         data, traj = result(solution, settings), dict(zip(columns, table.T, strict=True))
         out["line_timing.png"] = lambda p: save(line_figure(data, traj), p)
     return out
+
+
+def write_line_outputs(
+    solution: LineSolution, out: str | Path, figures: bool = True, settings: dict[str, Any] | None = None
+) -> list[Path]:
+    """Every file of ``pressplan line`` into the folder ``out`` (replaced as a whole; :data:`LINE_FILES`)."""
+    return write_atomic(Path(out), writers(solution, figures, settings), LINE_FILES, keep=solution.line.path)
