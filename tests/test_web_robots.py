@@ -130,6 +130,7 @@ def test_the_robots_form_fits_a_small_screen_with_a_bad_cell(site) -> None:
     context.close()
 
 
+@pytest.mark.slow  # 13 s of clicks; the fast tier adds and removes both robots (test_robots_added_and_removed)
 def test_one_robot_removed_and_added_back(page) -> None:
     """"remove the loader" (a mouse click) plans the press with its unloader alone, verified, at least as fast;
     "add the loader" brings the template's back."""
