@@ -168,6 +168,8 @@ BAD_LINES = [  # (what changes in GOOD, the field the line names, words of the p
     ({"stations": [{"name": "first", "case": A}, {"name": "second", "case": "."}]}, "stations.1.case", "not a file"),
     ({"stations": [{"name": "first", "case": A}, {"name": "exit", "case": B}]}, "stations.1.name", "a line file's key"),
     ({"transfers": [{"unloads": "first", "loads": "second", "time_s": 0}]}, "transfers.0.time_s", "greater than 0"),
+    ({"stations": 5}, "stations", "valid list"),
+    ({"stations": [{"name": "op.10", "case": A}, {"name": "second", "case": B}]}, "stations.0.name", "pattern"),
 ]
 
 
@@ -242,6 +244,18 @@ def test_a_station_field_set_for_a_run_slows_the_line(tmp_path: Path, fast: tupl
     result = _run(DATA / "fast.yaml", tmp_path, "--set", "first.limits.slider_accel_mm_s2=10000")
     assert result["spm"] < fast[0]["spm"]
     assert result["spm"] == pytest.approx(min(s["spm_alone"] for s in result["stations"]), rel=1e-9)
+
+
+@pytest.mark.slow
+def test_a_press_with_its_drive_runs_at_the_lines_period(tmp_path: Path) -> None:
+    """A slow transfer sets the line's cycle; the press with its drive (and an objective at a rate, not read in a
+    line) runs at it through the drive's NLP, verified; the replay's gaps hold."""
+    result = _run(DATA / "drive.yaml", tmp_path)
+    assert result["bottleneck"]["kind"] == "robot"
+    cup = next(s for s in result["stations"] if s["name"] == "cup")
+    assert cup["verified"] and cup["spm_alone"] > result["spm"]
+    _, gap, both = _replay(result, tmp_path, DATA / "drive.yaml")
+    assert gap >= -REPLAY_TOL_S and not both
 
 
 @pytest.mark.slow

@@ -17,7 +17,8 @@ loop: whatever station k's timing, station k+1's offset can put transfer k's loa
     T = max( max_k T_k, max_j L_j ),
 
 ``T_k`` the shortest period of station k alone with its robots (its own plan): a press that can run at
-``T_k`` runs at any longer period (its plan at ``T``: ``planning.solver.objectives.solve_at_period``). The
+``T_k`` runs at any longer period its minimum crank speed allows (its plan at ``T``:
+``planning.solver.objectives.solve_at_period``; a longer period is refused, ``planning.solver.line``). The
 offsets put each load in the middle of its window (the slack split evenly before and after it):
 
     phi_(k+1) = phi_k + s_u(k) + o_u(k) + t_k + (T - L_k) / 2 - s_l(k+1)   (mod T),  phi_1 = 0,
@@ -38,7 +39,7 @@ from planning.model.case import Case, PathAccel, PathJerk, PathSpeed
 from planning.model.units import Length
 from press.robot import Move, MoveLimits, fastest_move
 
-StationName = Annotated[str, StringConstraints(pattern=r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,39}$")]
+StationName = Annotated[str, StringConstraints(pattern=r"^[A-Za-z0-9][A-Za-z0-9_-]{0,39}$")]  # no ".": a --set's
 LineTime = Annotated[float, Field(ge=0, le=1e4)]  # [s]
 MAX_STATIONS = 12
 

@@ -42,7 +42,8 @@ def read_line(path: str | Path, overrides: dict[str, Any] | None = None) -> Line
 def _with_overrides(data: dict, overrides: dict[str, Any], label: str) -> tuple[dict, dict[str, dict[str, Any]]]:
     """A copy of the line's mapping with its own overridden fields set, and each station's case overrides."""
     data = copy.deepcopy(data)
-    names = [s.get("name") for s in data.get("stations") or [] if isinstance(s, dict)]
+    stations = data.get("stations")
+    names = [s.get("name") for s in stations if isinstance(s, dict)] if isinstance(stations, list) else []
     by_station: dict[str, dict[str, Any]] = {}
     for field, value in overrides.items():
         first, _, rest = field.partition(".")
@@ -97,7 +98,7 @@ def _station(model: LineModel, k: int, line_path: Path, overrides: dict[str, Any
             raise CaseFileError(
                 f"{where}{missing} (a station of a line needs its unloader and its loader)", field
             ) from None
-        raise CaseFileError(where + str(exc), exc.field) from None
+        raise CaseFileError(where + str(exc), f"{entry.name}.{exc.field}" if exc.field else field) from None
     if case.robots is None:
         missing_section = f"{entry.case} has no robots: section"
         raise CaseFileError(f"{where}{missing_section} (a station of a line needs its unloader and its loader)", field)

@@ -106,7 +106,9 @@ def result(solution: LineSolution, settings: dict[str, Any] | None = None) -> di
                 "robot_starts_s": {r: float(np.mod(s + offset, period)) for r, s in plan.robot_starts_s.items()},
                 "robot_starts_own_s": dict(plan.robot_starts_s),
                 "least_clearance_mm": float(np.min(clearance)) if np.isfinite(np.min(clearance)) else None,
-                "least_clearance_time_s": float(t[int(np.argmin(clearance))]),
+                "least_clearance_time_s": float(t[int(np.argmin(clearance))])
+                if np.isfinite(np.min(clearance))
+                else None,
                 "verified": solution.at_line[k].verification.passed,
                 "set": dict(sets.get(station.name, {})),
             }

@@ -361,10 +361,11 @@ def _objective(
     q, params = c.q, c.params
     objective = params.period
     if rate:  # without a drive (a kinematic case at a line's rate): the period and the dwell only
-        objective = q["weight_period"] * params.period - q["weight_dwell"] * params.transfer_dwell
+        objective = q["weight_period"] * params.period
         if torque is not None:
             heat, energy = objective_terms(q, torque, states[2], times, losses)
-            objective += q["weight_heat"] * heat + q["weight_energy"] * energy
+            objective = objective + q["weight_heat"] * heat + q["weight_energy"] * energy  # (the sum's old order)
+        objective -= q["weight_dwell"] * params.transfer_dwell
     if peak:  # the least grid peak: bus power <= bus_peak at every sample, bus_peak weighed (weight_peak)
         k = len(VARIABLES)  # the peak variable follows the cycle's
         bus_peak, power_unit = c.x[k] * c.p_scale[k], c.p_scale[k]

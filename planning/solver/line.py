@@ -22,7 +22,9 @@ from planning.solver.max_spm import solve_max_spm
 from planning.solver.objectives import solve_at_period
 from planning.solver.outcomes import Infeasible, PlanningError
 from planning.solver.solution import Solution
-from planning.tolerances import SAME_PERIOD_S, TIME_TOL_S
+from planning.tolerances import SAME_PERIOD_S, SAME_POSITION_MM, TIME_TOL_S
+
+INSIDE_STEP_S = 1e-3  # [s] the robots' overlap check's step (the presses' verification grid's)
 
 
 class StationError(PlanningError):
@@ -97,7 +99,8 @@ def solve_line(line: Line) -> LineSolution:
     starts = [solution.plan.robot_starts_s for solution in at_line]
     offsets = phase_offsets_s(period, line.robots, line.stations, starts)
     schedules = tuple(_schedule(robot, line, period, offsets, starts) for robot in line.robots)
-    checks = _station_checks(line, at_line, period) + _robot_checks(line, schedules, period)
+    checks = _station_checks(line, at_line, period) + _robot_checks(line, schedules)
+    checks += _inside_checks(line, at_line, offsets, period)
     solution = LineSolution(
         line, period, alone, at_line, tuple(float(o) for o in offsets), loops, schedules, bottleneck, checks
     )
@@ -119,7 +122,7 @@ def _check_slow_enough(line: Line, bottleneck: Bottleneck) -> None:
                 f"the line's cycle {bottleneck.period_s:.4g} s (set by {bottleneck.kind} {bottleneck.name}) is "
                 f"longer than station {station.name} can take: at its limits.min_crank_speed_rpm = {slowest:g} a "
                 f"turn takes at most {60.0 / slowest:.4g} s",
-                limit=f"{station.path.name}: limits.min_crank_speed_rpm",
+                limit=f"{station.name}.limits.min_crank_speed_rpm",
                 value=slowest,
             )
 
@@ -130,10 +133,11 @@ ALONE_KEPT = 64  # the most kept
 
 def _alone(station: Station) -> Solution:
     """The station's fastest verified plan (solved once per process for the same case)."""
-    key = station.case.model_dump_json()
+    case = station.case.with_objective("max-spm")  # a line plans for its rate: the case's objective not read
+    key = case.model_dump_json()
     if key not in _ALONE:
         try:
-            solution = solve_max_spm(station.case, station.case.planner.placement)
+            solution = solve_max_spm(case, case.planner.placement)
         except PlanningError as exc:
             raise StationError(station, exc, "alone") from None
         if len(_ALONE) >= ALONE_KEPT:
@@ -203,10 +207,33 @@ def _station_checks(line: Line, at_line: tuple[Solution, ...], period_s: float) 
     return tuple(checks)
 
 
-def _robot_checks(line: Line, schedules: tuple, period_s: float) -> tuple[Check, ...]:
+def _inside_checks(line: Line, at_line: tuple[Solution, ...], offsets_s: np.ndarray, period_s: float) -> tuple:
+    """Each transfer robot on the line's master at :data:`INSIDE_STEP_S`, from the presses' plans and offsets
+    (not from its schedule): the samples at which it is off its waiting point in both presses it serves
+    (none allowed)."""
+    t = np.arange(0.0, period_s, INSIDE_STEP_S)
+    checks = []
+    for robot in line.robots:
+        if robot.unloads is None or robot.loads is None:
+            continue
+        inside = []
+        for k, role in ((robot.unloads, "unloader"), (robot.loads, "loader")):
+            tool = next(r for r in line.stations[k].case.robots_on_path if r.name == role)
+            plan = at_line[k].plan
+            x = tool.position(t - offsets_s[k], plan.robot_starts_s[role], plan.period)
+            inside.append(x < tool.path_mm - SAME_POSITION_MM)
+        both = int(np.count_nonzero(inside[0] & inside[1]))
+        name = f"{robot.name}: samples inside both presses"
+        checks.append(Check.of("line_robot", name, both, 0, "", "max", 0.0))
+    return tuple(checks)
+
+
+def _robot_checks(line: Line, schedules: tuple[tuple[RobotStretch, ...], ...]) -> tuple[Check, ...]:
     """Each robot's cycle: its stretches one after the other from its unload (or the feeder's load) to the next,
     one period in all, so each wait (a transfer's at the next press, the last before the next cycle) is at
-    least 0: the load at least its transfer time after the unload, the next unload as long after the load."""
+    least 0: the load at least its transfer time after the unload, the next unload as long after the load.
+    The offsets are built so (``planning.model.line``); the check measures the waits from the presses' own
+    robot starts and the offsets, and fails where either drifts."""
     checks = []
     for robot, stretches in zip(line.robots, schedules, strict=True):
         for stretch in stretches:

@@ -40,7 +40,7 @@ from planning.model.plan import Plan
 from planning.solver.halves_nlp import PEAK_VARIABLE, ROBOT_VARIABLES, VARIABLE_INDEX, VARIABLES, halves_nlp_for
 from planning.solver.max_spm import solve_max_spm
 from planning.solver.neighbour import can_start
-from planning.solver.outcomes import Infeasible, NoPlanFound
+from planning.solver.outcomes import Infeasible, NoPlanFound, Unverified
 from planning.solver.search import Search, prepare
 from planning.solver.solution import AtRate, Solution, objective_value
 from planning.solver.starts import guesses_at_period
@@ -157,11 +157,11 @@ def solve_at_period(case: Case, period_s: float, fastest: Solution | None = None
     guesses = guesses_at_period(case, fastest.plan.nlp_values["draw_speed"], period_s)
     try:
         return _baseline(at_rate, placement, fastest, period_s, None, True)
-    except NoPlanFound:  # far slower than the fastest: starts built for the period (its draw speed kept)
+    except (NoPlanFound, Unverified):  # far slower than the fastest: starts built for the period (draw speed kept)
         pass
     try:
-        return _baseline(at_rate, placement, fastest, period_s, None, True, guesses)
-    except NoPlanFound:  # the dwell's optimum out of IPOPT's reach (it ends "infeasible" near a degenerate half)
+        return _baseline(at_rate, placement, fastest, period_s, None, True, guesses, slowed=False)
+    except (NoPlanFound, Unverified):  # the dwell's optimum out of IPOPT's reach ("infeasible" near a degenerate half)
         return _at_period_feasible(at_rate, placement, fastest, period_s, guesses)
 
 
@@ -189,17 +189,19 @@ def _baseline(
     neighbour: Plan | None,
     confirm: bool,
     more_starts: tuple[dict[str, float], ...] | list[dict[str, float]] = (),
+    slowed: bool = True,
 ) -> Solution:
     """The max-SPM plan run at cycle time ``period`` [s] with the spare time spent at the transfer speed:
     the longest transfer dwell (see the module docstring). At the fastest rate it is the fastest plan.
-    ``more_starts``: after the slowed fastest plan's."""
+    ``more_starts``: after the slowed fastest plan's (``slowed`` False: instead of it)."""
     if abs(fastest.plan.period - period) <= SAME_PERIOD_S:
         return fastest
     search = _rate_search(case, placement, period)
     time_unit = search.scale[VARIABLE_INDEX["transfer_dwell"]]
     search.parameters[search.parameter("weight_dwell")] = 1.0 / time_unit
     search.score = lambda solution: -float(solution.plan.parameters.transfer_dwell) / period
-    starts = [_slowed(fastest.plan, period / fastest.plan.period, search), *more_starts]
+    starts = [_slowed(fastest.plan, period / fastest.plan.period, search)] if slowed else []
+    starts += list(more_starts)
     _run_starts(search, starts, neighbour, placement, confirm)
     try:
         return search.answer()
@@ -209,7 +211,8 @@ def _baseline(
 
 def _slowed(plan: Plan, factor: float, search: Search) -> dict[str, float]:
     """``plan``'s NLP values run ``factor`` times slower: every angle, so every key point and the cycle's
-    closure, stays where it was (a start; speeds held within their bounds, the draw's in particular)."""
+    closure, stays where it was (a start; speeds held within their bounds, the draw's in particular); the
+    robots' starts, where it has robots, at the same angles too (their times ``factor`` times later)."""
     values = {name: plan.nlp_values[name] * factor for name, _ in ROBOT_VARIABLES if name in plan.nlp_values}
     for name, j in VARIABLE_INDEX.items():
         kind = VARIABLES[j][1]

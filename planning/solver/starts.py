@@ -181,6 +181,9 @@ def die_exit(case: Case, w2: float) -> dict[str, float] | None:
 
 
 PERIOD_BISECTIONS = 60  # halvings of the transfer speed's range: below round-off
+PERIOD_SPEED_RANGE = (1e-3, 10.0)  # the transfer speed searched: this share of the draw's ... times a turn a period
+PERIOD_PEAK_SHARES = (0.9, 0.6)  # the guesses' peak speeds, shares of the constant-speed acceleration bound
+PERIOD_INSIDE = 1.5  # the key points this many quarters into the halves (as the free placement's guesses)
 
 
 def guesses_at_period(case: Case, w2: float, period_s: float) -> list[dict[str, float]]:
@@ -195,10 +198,10 @@ def guesses_at_period(case: Case, w2: float, period_s: float) -> list[dict[str, 
         return sum(values[k] for k in halves) + values["transfer_dwell"] + draw_s
 
     starts = []
-    for share in (0.9, 0.6):
-        lo, hi = 1e-3 * w2, 2 * math.pi / period_s * 10
+    for share in PERIOD_PEAK_SHARES:
+        lo, hi = PERIOD_SPEED_RANGE[0] * w2, PERIOD_SPEED_RANGE[1] * 2 * math.pi / period_s
         for _ in range(PERIOD_BISECTIONS):
             mid = 0.5 * (lo + hi)
-            lo, hi = (mid, hi) if cycle_s(guess(case, w2, mid, share, 1.5)) > period_s else (lo, mid)
-        starts.append(guess(case, w2, 0.5 * (lo + hi), share, 1.5))
+            lo, hi = (mid, hi) if cycle_s(guess(case, w2, mid, share, PERIOD_INSIDE)) > period_s else (lo, mid)
+        starts.append(guess(case, w2, 0.5 * (lo + hi), share, PERIOD_INSIDE))
     return starts

@@ -13,8 +13,8 @@ from planning.tolerances import TIME_TOL_S
 class CycleTimeLimit(Limit):
     """The cycle time of a plan at a target rate (objectives ``min-rms-torque``, ``min-energy``; a press in a
     line, ``planning.solver.line``): one row of the rate NLP, free until a solve holds it at the parameter
-    ``target_period`` (bounds set per solve);
-    checked on every plan of a case planned at a rate."""
+    ``target_period`` (bounds set per solve); checked on every plan of a case planned at a rate (a line's press,
+    planned for the most strokes with the line's rate beside it, by the line's own check instead)."""
 
     id = "cycle_time"
     name = "cycle time at the target rate"
