@@ -93,16 +93,18 @@ def solve_line(line: Line) -> LineSolution:
     alone = tuple(_alone(station) for station in line.stations)
     loops = tuple(robot.loop_s(line.stations) for robot in line.robots)
     bottleneck = _bottleneck(line, alone, loops)
-    period = bottleneck.period_s
+    period_s = bottleneck.period_s
     _check_slow_enough(line, bottleneck)
-    at_line = tuple(_at_period(station, period, fastest) for station, fastest in zip(line.stations, alone, strict=True))
+    at_line = tuple(
+        _at_period(station, period_s, fastest) for station, fastest in zip(line.stations, alone, strict=True)
+    )
     starts = [solution.plan.robot_starts_s for solution in at_line]
-    offsets = phase_offsets_s(period, line.robots, line.stations, starts)
-    schedules = tuple(_schedule(robot, line, period, offsets, starts) for robot in line.robots)
-    checks = _station_checks(line, at_line, period) + _robot_checks(line, schedules)
-    checks += _inside_checks(line, at_line, offsets, period)
+    offsets = phase_offsets_s(period_s, line.robots, line.stations, starts)
+    schedules = tuple(_schedule(robot, line, period_s, offsets, starts) for robot in line.robots)
+    checks = _station_checks(line, at_line, period_s) + _robot_checks(line, schedules)
+    checks += _inside_checks(line, at_line, offsets, period_s)
     solution = LineSolution(
-        line, period, alone, at_line, tuple(float(o) for o in offsets), loops, schedules, bottleneck, checks
+        line, period_s, alone, at_line, tuple(float(o) for o in offsets), loops, schedules, bottleneck, checks
     )
     failed = [c for c in checks if not c.passed]
     if failed:
