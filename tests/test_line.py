@@ -346,12 +346,12 @@ def _least_gap(result: dict, line: dict, line_file: Path) -> float:
     """Each transfer robot: from leaving one press to entering the next and back, less its move each way."""
     period, least = result["period_s"], math.inf
     by_name = {s["name"]: s for s in result["stations"]}
+    cases = {
+        s["name"]: yaml.safe_load((line_file.parent / e["case"]).read_text())
+        for s, e in zip(result["stations"], line["stations"], strict=True)
+    }
     for transfer in line.get("transfers", []):
         first, second = by_name[transfer["unloads"]], by_name[transfer["loads"]]
-        cases = {
-            s["name"]: yaml.safe_load((line_file.parent / e["case"]).read_text())
-            for s, e in zip(result["stations"], line["stations"], strict=True)
-        }
         unloader = cases[first["name"]]["robots"]["unloader"]
         loader = cases[second["name"]]["robots"]["loader"]
         occupancy = {

@@ -37,7 +37,7 @@ from pydantic import BaseModel, ConfigDict, Field, StringConstraints
 
 from planning.model.case import Case, PathAccel, PathJerk, PathSpeed
 from planning.model.units import Length
-from press.robot import Move, MoveLimits, fastest_move
+from press.robot import Move, MoveLimits, Robot, fastest_move
 
 StationName = Annotated[str, StringConstraints(pattern=r"^[A-Za-z0-9][A-Za-z0-9_-]{0,39}$")]  # no ".": a --set's
 LineTime = Annotated[float, Field(ge=0, le=1e4)]  # [s]
@@ -131,9 +131,14 @@ class Line:
     path: Path
 
 
+def tool(station: Station, role: str) -> Robot:
+    """``station``'s ``role`` robot (unloader, loader) on its path in that press."""
+    return next(r for r in station.case.robots_on_path if r.name == role)
+
+
 def occupancy_s(station: Station, role: str) -> float:
     """How long ``station``'s ``role`` robot (unloader, loader) is off its waiting point per cycle [s]."""
-    return next(r.occupancy_s for r in station.case.robots_on_path if r.name == role)
+    return tool(station, role).occupancy_s
 
 
 def transfer_robot(model: TransferModel, index: int) -> LineRobot:

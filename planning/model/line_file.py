@@ -90,18 +90,17 @@ def _station(model: LineModel, k: int, line_path: Path, overrides: dict[str, Any
     if not case_path.is_file():
         raise CaseFileError(f"{line_path}: {field}: not a file ({case_path})", field)
     where = f"{line_path}: {field} ({entry.name}): "
+    no_robots = CaseFileError(
+        f"{where}{entry.case} has no robots: section (a station of a line needs its unloader and its loader)", field
+    )
     try:
         case = read_case(case_path, overrides)
     except CaseFileError as exc:
         if not _has_robots(case_path, overrides):
-            missing = f"{entry.case} has no robots: section"
-            raise CaseFileError(
-                f"{where}{missing} (a station of a line needs its unloader and its loader)", field
-            ) from None
+            raise no_robots from None
         raise CaseFileError(where + str(exc), f"{entry.name}.{exc.field}" if exc.field else field) from None
     if case.robots is None:
-        missing_section = f"{entry.case} has no robots: section"
-        raise CaseFileError(f"{where}{missing_section} (a station of a line needs its unloader and its loader)", field)
+        raise no_robots
     missing = [role for role in ("unloader", "loader") if getattr(case.robots, role) is None]
     if missing:
         raise CaseFileError(

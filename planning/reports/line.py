@@ -94,6 +94,8 @@ def result(solution: LineSolution, settings: dict[str, Any] | None = None) -> di
         offset = solution.offsets_s[k]
         state = station_state(solution, k, t)
         clearance = np.where(state["needed_height_mm"] > 0, state["clearance_mm"], np.inf)  # where a tool needs any
+        least = int(np.argmin(clearance))
+        needed = bool(np.isfinite(clearance[least]))
         stations.append(
             {
                 "name": station.name,
@@ -105,10 +107,8 @@ def result(solution: LineSolution, settings: dict[str, Any] | None = None) -> di
                 "phase_offset_deg": offset / period * 360.0,
                 "robot_starts_s": {r: float(np.mod(s + offset, period)) for r, s in plan.robot_starts_s.items()},
                 "robot_starts_own_s": dict(plan.robot_starts_s),
-                "least_clearance_mm": float(np.min(clearance)) if np.isfinite(np.min(clearance)) else None,
-                "least_clearance_time_s": float(t[int(np.argmin(clearance))])
-                if np.isfinite(np.min(clearance))
-                else None,
+                "least_clearance_mm": float(clearance[least]) if needed else None,
+                "least_clearance_time_s": float(t[least]) if needed else None,
                 "verified": solution.at_line[k].verification.passed,
                 "set": dict(sets.get(station.name, {})),
             }

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from planning.model.limits.base import Check
-from planning.model.line import Line, LineRobot, Station, occupancy_s, phase_offsets_s
+from planning.model.line import Line, LineRobot, Station, occupancy_s, phase_offsets_s, tool
 from planning.model.outcome import Outcome
 from planning.solver.max_spm import solve_max_spm
 from planning.solver.objectives import solve_at_period
@@ -220,10 +220,10 @@ def _inside_checks(line: Line, at_line: tuple[Solution, ...], offsets_s: np.ndar
             continue
         inside = []
         for k, role in ((robot.unloads, "unloader"), (robot.loads, "loader")):
-            tool = next(r for r in line.stations[k].case.robots_on_path if r.name == role)
+            robot_in_press = tool(line.stations[k], role)
             plan = at_line[k].plan
-            x = tool.position(t - offsets_s[k], plan.robot_starts_s[role], plan.period)
-            inside.append(x < tool.path_mm - SAME_POSITION_MM)
+            x = robot_in_press.position(t - offsets_s[k], plan.robot_starts_s[role], plan.period)
+            inside.append(x < robot_in_press.path_mm - SAME_POSITION_MM)
         both = int(np.count_nonzero(inside[0] & inside[1]))
         name = f"{robot.name}: samples inside both presses"
         checks.append(Check.of("line_robot", name, both, 0, "", "max", 0.0))
