@@ -664,7 +664,8 @@ def _bound(case, args) -> int:
         f"{data['peak_crank_speed_rpm']:.2f} rpm, draw {bound.draw_speed_rpm:.3f} rpm, "
         + (f"idle time for the robots {bound.window_slack_s:.3f} s" if case.robots else "")
         + (f"idle time in the robot's window {bound.window_slack_s:.3f} s" if case.robots is None else "")
-        + (f"; crank jerk <= {bound.crank_jerk_limit_rad_s3:g} rad/s^3)" if bound.crank_jerk_limit_rad_s3 else ")")
+        + (f"; crank jerk <= {bound.crank_jerk_limit_rad_s3:g} rad/s^3" if bound.crank_jerk_limit_rad_s3 else "")
+        + (f"; the hold's {case.standstill_s:g} s added, the crank free to stop)" if case.standstill_s else ")")
     )
     if upper is not None:
         left = f"; left out: {', '.join(upper.left_out)}" if upper.left_out else ""

@@ -20,6 +20,8 @@ from __future__ import annotations
 
 LIMIT_REL_TOL = 1e-6  # relative: a limit's dense check passes within this share of the limit (six digits:
 # more than any press's data has, far above the round-off of evaluating the closed forms)
+HOLD_STILL_MM = 1e-3  # [mm] the slide stands at its hold height within a micrometre (the hold's check)
+HOLD_STILL_RAD_S = 1e-9  # [rad/s] the crank stands in a hold (a cam's standstill is still to round-off)
 TIME_TOL_S = 1e-6  # [s] a time limit (the robot's window, a target cycle time): a microsecond
 ANGLE_TOL_RAD = 1e-6  # [rad] the key angles reached and the cycle closed (0.06 millidegree, far below a
 # resolver's count; the time-at-angle search converges to 1e-14)

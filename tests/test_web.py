@@ -783,3 +783,35 @@ def test_the_cam_is_proved_on_the_page_and_downloaded_as_the_cli_writes_it(page,
     page.wait_for_function("document.querySelector('#cam-message').textContent !== ''", timeout=60_000)
     assert "|slider acceleration|" in page.locator("#cam-message").inner_text()
     assert page.locator("#cam-download").is_disabled()
+
+
+@browser
+def test_a_hold_is_shown_and_its_time_edited_with_the_mouse_and_keys(page) -> None:
+    """The coining case's hold: the page's numbers are the CLI's, the standstill is shaded and named on the chart
+    against time, the summary says where the crank stands; the hold's time clicked, typed and left with Tab
+    gives the CLI's plan of the new time."""
+    pick_case(page, "coining-hold.yaml")
+    data = load_yaml((CASES / "coining-hold.yaml").read_text(encoding="utf-8"))
+    label = "cases/coining-hold.yaml"
+    case = case_from_data(copy.deepcopy(data), label)
+    result = result_dict(solve(case), case)
+    assert page.locator("#spm").inner_text() == f"{result['spm']:.3f}"
+    page.locator("#summary").locator("xpath=..").locator("summary").click()  # the summary unfolded
+    assert "stands 0.3000 s" in page.locator("#summary").inner_text()
+    page.locator("#x-axis").select_option("time")
+    notes = page.evaluate("document.getElementById('motion-chart').layout.annotations.map((a) => a.text)")
+    assert "hold 0.3 s" in notes, notes
+    shapes = page.evaluate("document.getElementById('motion-chart').layout.shapes.map((s) => [s.x0, s.x1])")
+    t3 = next(k["time_s"] for k in result["key_points"] if k["name"] == "draw_end")
+    start = t3 + result["hold"]["brake_s"]
+    assert any(abs(a - start) < 1e-9 and abs(b - start - 0.3) < 1e-9 for a, b in shapes), shapes
+    before = int(page.evaluate("document.body.dataset.rendered"))
+    page.locator('[data-field="process.hold_time_s"]').click(click_count=3)  # the mouse selects the value
+    page.keyboard.type("0.5")
+    page.keyboard.press("Tab")
+    wait_rendered(page, before)
+    data["process"]["hold_time_s"] = 0.5
+    longer = case_from_data(data, label)
+    assert page.locator("#spm").inner_text() == f"{solve(longer).plan.spm:.3f}"
+    assert "stands 0.5000 s" in page.locator("#summary").inner_text()
+    screenshot(page, "web-hold")

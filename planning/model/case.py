@@ -19,6 +19,7 @@ from pydantic import BaseModel, ConfigDict, Field, create_model
 
 from planning.model.errors import CaseError, show_value
 from planning.model.laws import DEFAULT_LAW, LAWS, LawName
+from planning.model.laws.base import HALVES
 from planning.model.limits import LIMITS, Draw
 from planning.model.limits.robots import span_s
 from planning.model.units import (
@@ -248,6 +249,19 @@ class ProcessModel(_Model):
             "from θ2 to BDC. Needs a drive to matter."
         ),
     )  # [[height above BDC mm, force kN], ...], linear between points
+    hold_time_s: Seconds | None = Field(
+        None,
+        title="hold at the bottom [s]",
+        description=(
+            "The slide stands still this long after the draw (coining, calibrating), the crank stopped at "
+            "process.hold_height_mm; empty: no hold."
+        ),
+    )
+    hold_height_mm: Height | None = Field(
+        None,
+        title="hold height [mm above BDC]",
+        description="Where the slide stands in the hold: empty or 0 at BDC, else this high on its way down.",
+    )
 
 
 def _limits_model() -> type[_Model]:
@@ -558,6 +572,26 @@ class Case(_Model):
         return np.radians([k.closing_deg, k.draw_start_deg, k.draw_end_deg, k.opening_deg])
 
     @property
+    def hold_angle(self) -> float | None:
+        """The crank angle [rad] of the hold (``process.hold_time_s``): the bottom dead centre's, or where the
+        slide passes ``process.hold_height_mm`` on its way down; None without a hold."""
+        if self.process.hold_time_s is None:
+            return None
+        m, height = self.machine, self.hold_height_mm
+        return float(m.bdc_angle) if height == 0 else float(m.angles_at_height(height)[0])
+
+    @property
+    def hold_height_mm(self) -> float:
+        """Where the slide stands in a hold [mm above BDC]: ``process.hold_height_mm``, BDC (0) when empty."""
+        return self.process.hold_height_mm or 0.0
+
+    @property
+    def standstill_s(self) -> float:
+        """The hold's time [s] (``process.hold_time_s``), 0 without a hold: a bound adds it to the fastest
+        motion that stops at the hold's angle."""
+        return self.process.hold_time_s or 0.0
+
+    @property
     def transfer_time_s(self) -> float:
         """The time [s] the transfer needs between the draws: ``process.transfer_time_s``, or with robots the
         least time from the first leaving its waiting point to the last back (``limits.robots.span_s``): what
@@ -628,10 +662,12 @@ class Case(_Model):
         planner = self.planner.model_copy(update={"motion_law": law, "law_parameter": None})
         case = self.model_copy(update={"planner": planner})
         _law_checks(case)
+        _hold_checks(case)
         _objective_checks(case)
         return case
 
 
+HOLD_BRAKE_MIN_DEG = 0.5  # [deg] the crank brakes from the draw speed to the hold over at least this angle
 ROBOT_NAMES = ("unloader", "loader")  # the robots a case may have, in the order they move
 KEY_POINT_NAMES = ("closing", "draw_start", "draw_end", "opening")
 KEY_POINT_FIELDS = ("closing_deg", "draw_start_deg", "draw_end_deg", "opening_deg")
@@ -651,6 +687,7 @@ def cross_checks(case: Case) -> None:
                 angles[i],
             )
     _transfer_checks(case)
+    _hold_checks(case)
     for limit in LIMITS:
         limit.validate(case)
     fixed = case.planner.law_parameter
@@ -830,6 +867,33 @@ def _curve_checks(where: str, robot: RobotModel, stroke: float) -> None:
             "be clear of the die there (end the curve before the path's end, or at 0 mm)"
         )
         raise CaseError(field, reason, last_need)
+
+
+def _hold_checks(case: Case) -> None:
+    """A hold stands below the stroke's top, after the draw's end and before the opening, under a law with
+    halves (the crank brakes from the draw speed to stand at it, ``planning.model.cycle``)."""
+    process = case.process
+    if process.hold_time_s is None:
+        if process.hold_height_mm is not None:
+            raise CaseError("process.hold_height_mm", "needs process.hold_time_s (how long the slide stands)", True)
+        return
+    if not case.hold_height_mm < case.machine.stroke:
+        reason = f"must lie below the stroke's top ({case.machine.stroke:.1f} mm above BDC)"
+        raise CaseError("process.hold_height_mm", reason, process.hold_height_mm)
+    if LAWS[case.planner.motion_law].transcription != HALVES:
+        reason = "the optimal law plans no hold yet: choose a law with halves (improved-s-curve, ...)"
+        raise CaseError("planner.motion_law", reason, case.planner.motion_law)
+    hold_deg = math.degrees(case.hold_angle)
+    k = case.key_points
+    if not k.draw_end_deg < hold_deg - HOLD_BRAKE_MIN_DEG:
+        reason = (
+            f"must lie before the hold at {hold_deg:.2f} deg (process.hold_height_mm = {case.hold_height_mm:g}): "
+            "the draw ends, then the crank brakes to stand there"
+        )
+        raise CaseError("key_points.draw_end_deg", reason, k.draw_end_deg)
+    if not hold_deg < k.opening_deg:
+        reason = f"must lie after the hold at {hold_deg:.2f} deg (process.hold_height_mm = {case.hold_height_mm:g})"
+        raise CaseError("key_points.opening_deg", reason, k.opening_deg)
 
 
 def _law_checks(case: Case) -> None:

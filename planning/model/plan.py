@@ -75,6 +75,25 @@ class Plan:
         share = (t - tk[k]) / max(tk[k + 1] - tk[k], TINY)
         return f"{segment_in_words(self.profile.segments[k].name)}, {100 * share:.0f} % in"
 
+    def in_planned_stop(self, theta: np.ndarray) -> np.ndarray:
+        """Whether each crank angle ``theta`` [rad] lies in the hold's planned stop: from theta3, where the crank
+        brakes, through the standstill to the end of the return's rise from rest (all False without a hold).
+        By angle, so that a cam's realised motion (its own segments and times) is read the same way."""
+        stop = self.planned_stop()
+        if stop is None:
+            return np.zeros(np.shape(theta), dtype=bool)
+        turn = np.mod(np.asarray(theta, dtype=float), 2 * math.pi)
+        return (turn >= stop[0]) & (turn <= stop[1])
+
+    def planned_stop(self) -> tuple[float, float] | None:
+        """``(from, to)`` [rad]: the crank angles of the hold's planned stop, theta3 to the end of the return's
+        rise from rest (which sweeps ``D (0 + wm2) / 2``); None without a hold."""
+        p = self.parameters
+        if not getattr(p, "has_hold", False):
+            return None
+        rise = float(p.return_accel_duration) * float(p.return_peak_speed) / 2
+        return float(p.draw_end), float(p.hold_angle) + rise
+
     def transfer_window(self) -> float:
         """Achieved time [s] from theta4 to theta1 through TDC."""
         t = self.key_times()
@@ -127,7 +146,7 @@ def plan_of(
     themselves (a neighbour's warm start; ``plan.json``'s plan)."""
     th1, th2, th3, th4 = (float(a) for a in case.key_angles)
     if layout is None:
-        params: PlanParameters = params_from_numbers(values, th2, th3, case.planner.motion_law)
+        params: PlanParameters = params_from_numbers(values, th2, th3, case.planner.motion_law, hold_of(case))
         profile = profile_from_tdc(params)
     else:
         durations, jerks = [], []
@@ -152,10 +171,25 @@ def plan_of(
     return replace(plan, structure=structure, nlp_values=dict(values), robot_starts_s=robots)
 
 
-def params_from_numbers(values: dict[str, float], theta2: float, theta3: float, law: str) -> CycleParameters:
-    """A numeric :class:`CycleParameters` of motion law ``law`` from the NLP variable values (inside units)."""
-    keys = [f for f in CycleParameters.__dataclass_fields__ if f not in ("draw_start", "draw_end", "motion_law")]
-    return CycleParameters(**{k: float(values[k]) for k in keys}, draw_start=theta2, draw_end=theta3, motion_law=law)
+def hold_of(case: Any) -> dict[str, Any]:
+    """The hold of ``case`` as :class:`CycleParameters` fields: ``hold_time`` [s] and ``hold_angle`` [rad]
+    (0 and None without a hold)."""
+    if case.process.hold_time_s is None:
+        return {}
+    return {"hold_time": float(case.process.hold_time_s), "hold_angle": case.hold_angle}
+
+
+FROM_CASE = ("draw_start", "draw_end", "motion_law", "hold_time", "hold_angle")  # CycleParameters not NLP variables
+
+
+def params_from_numbers(
+    values: dict[str, float], theta2: float, theta3: float, law: str, hold: dict[str, Any] | None = None
+) -> CycleParameters:
+    """A numeric :class:`CycleParameters` of motion law ``law`` from the NLP variable values (inside units);
+    ``hold``: :func:`hold_of` the case."""
+    keys = [f for f in CycleParameters.__dataclass_fields__ if f not in FROM_CASE]
+    numbers = {k: float(values[k]) for k in keys}
+    return CycleParameters(**numbers, draw_start=theta2, draw_end=theta3, motion_law=law, **(hold or {}))
 
 
 SUB_SEGMENTS = {"accel": "acceleration", "decel": "deceleration"}

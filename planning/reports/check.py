@@ -62,6 +62,19 @@ def check_case(case: Case) -> dict[str, Any]:
         "max_draw_speed_rpm": w_max / RPM,
         "max_draw_speed_by_limit_rpm": {k: (b / RPM if math.isfinite(b) else None) for k, b in bounds.items()},
         "warnings": warnings(case),
+        **({"hold": _hold(case)} if case.hold_angle is not None else {}),
+    }
+
+
+def _hold(case: Case) -> dict[str, float]:
+    """The hold at the bottom: its time [s], the slide's height [mm above BDC], the crank's angle [deg] and the
+    angle the crank brakes over from theta3 [deg]."""
+    hold_deg = math.degrees(case.hold_angle)
+    return {
+        "time_s": case.process.hold_time_s,
+        "height_mm": case.hold_height_mm,
+        "angle_deg": hold_deg,
+        "brake_deg": hold_deg - case.key_points.draw_end_deg,
     }
 
 
@@ -114,6 +127,12 @@ def check_text(report: dict[str, Any]) -> str:
         lines.append(
             f"  {k['name']:<11} {k['angle_deg']:9.2f} {k['height_mm']:10.2f} "
             f"{k['slider_speed_mm_s']:14.2f} {k['direction']:<3}"
+        )
+    hold = report.get("hold")
+    if hold:
+        lines.append(
+            f"  hold: the slide stands {hold['time_s']:g} s at {hold['height_mm']:g} mm above BDC (crank at "
+            f"{hold['angle_deg']:.2f} deg), the crank braking to it over {hold['brake_deg']:.2f} deg from theta3"
         )
     lines += ["", "  checks"]
     for c in report["checks"]:

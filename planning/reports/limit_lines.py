@@ -65,6 +65,16 @@ def needing(need: np.ndarray) -> np.ndarray:
     return over | np.roll(over, 1) | np.roll(over, -1)
 
 
+def planned_stop(result: dict[str, Any], columns: dict[str, np.ndarray]) -> np.ndarray:
+    """Where the crank stops by plan (a hold: ``result.json``'s ``hold``, theta3 to the end of the return's
+    rise), at the samples ``columns``; all False without a hold."""
+    angle = np.mod(np.asarray(columns["crank_angle_deg"], dtype=float), 360.0)
+    hold = result.get("hold")
+    if not hold:
+        return np.zeros(angle.shape, dtype=bool)
+    return (angle >= hold["stop_from_deg"]) & (angle <= hold["stop_to_deg"])
+
+
 def limit_lines(result: dict[str, Any], columns: dict[str, np.ndarray], axis: str) -> list[LimitLine]:
     """Every limit ``result`` (``result.json``'s data: ``process``, ``limits``, ``key_points``) sets, over the
     samples ``columns`` (``trajectory.csv``'s), against time (``axis`` "time") or crank angle."""
@@ -93,7 +103,7 @@ def limit_lines(result: dict[str, Any], columns: dict[str, np.ndarray], axis: st
         add("limits.die_height_mm", f"limits.die_height_mm = {die:g} mm", "slider_height_mm", die, everywhere)
     for key, quantity, text, where, both in (
         ("crank_speed_rpm", "crank_speed_rpm", "{v:g} rpm", everywhere, False),
-        ("min_crank_speed_rpm", "crank_speed_rpm", "{v:g} rpm", everywhere, False),
+        ("min_crank_speed_rpm", "crank_speed_rpm", "{v:g} rpm", ~planned_stop(result, columns), False),
         ("crank_accel_rad_s2", "crank_accel_rad_s2", "±{v:g} rad/s²", everywhere, True),
         ("crank_jerk_rad_s3", "crank_jerk_rad_s3", "±{v:g} rad/s³", everywhere, True),
         (

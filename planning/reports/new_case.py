@@ -54,6 +54,8 @@ key_points:                          # crank angle from TDC [deg], in this order
 """
     + _SIDE_PANEL_PROCESS
     + "  # draw_speed_rpm: 6.7              # a fixed crank speed for the draw; leave out to let the planner choose\n"
+    + "  # hold_time_s: 0.3                 # a hold at the bottom (coining): the slide stands this long after the\n"
+    + "  # hold_height_mm: 0                #   draw, here at BDC (theta3 must lie before it: docs/modes.md)\n"
     + _SIDE_PANEL_LIMITS
     + """\
   # crank_speed_rpm: 30              # optional: the crank's top speed, acceleration, jerk, the slide's top

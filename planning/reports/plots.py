@@ -25,6 +25,7 @@ LEGEND_RIGHT = 0.66  # the panels end here; their legends stand right of them
 LEGEND_ANCHOR = (1.09, 1.0)  # a legend's top left corner, in its panel's axes fraction (past the twin's label)
 PLOT_FORMATS = ("png", "svg", "pdf")
 FIGURES = ("motion_vs_time", "motion_vs_angle")
+HOLD_COLOUR = "#8c7a5b"  # a hold's standstill
 
 
 def read_table(path: Path) -> dict[str, np.ndarray]:
@@ -70,7 +71,30 @@ def _decorate(ax, result: dict[str, Any], axis: str, x: np.ndarray, label: bool)
     )
     for k in result["key_points"]:
         ax.axvline(k[at], color="#444444", lw=0.8, ls=":", zorder=1)
+    _hold_band(ax, result, keys["draw_end"], axis, label)
     ax.grid(True, lw=0.3, alpha=0.6)
+
+
+def _hold_band(ax, result: dict[str, Any], draw_end: dict, axis: str, label: bool) -> None:  # noqa: ANN001
+    """A hold's standstill hatched (against time; against crank angle a line at its angle), labelled once."""
+    hold = result.get("hold")
+    if not hold:
+        return
+    text = f"hold: {hold['time_s']:g} s at {hold['height_mm']:g} mm above BDC" if label else None
+    if axis == "time":
+        start = draw_end["time_s"] + hold["brake_s"]
+        ax.axvspan(
+            start,
+            start + hold["time_s"],
+            facecolor="none",
+            edgecolor=HOLD_COLOUR,
+            hatch="///",
+            lw=0,
+            zorder=0,
+            label=text,
+        )
+    else:
+        ax.axvline(hold["angle_deg"], color=HOLD_COLOUR, lw=1.2, zorder=1, label=text)
 
 
 def _key_ticks(ax, result: dict[str, Any], axis: str) -> None:
@@ -640,8 +664,18 @@ def tradeoff_figure(rows: list[dict[str, Any]], case: Any, title: str) -> Figure
 
 
 LINE_COLOURS = (  # one per station, up to a line's most (planning.model.line.MAX_STATIONS)
-    "#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b",
-    "#e377c2", "#17becf", "#bcbd22", "#7f7f7f", "#393b79", "#637939",
+    "#1f77b4",
+    "#d62728",
+    "#2ca02c",
+    "#9467bd",
+    "#ff7f0e",
+    "#8c564b",
+    "#e377c2",
+    "#17becf",
+    "#bcbd22",
+    "#7f7f7f",
+    "#393b79",
+    "#637939",
 )
 
 

@@ -18,6 +18,7 @@ from planning.model.limits import draw_speed_bounds
 from planning.model.limits.capacity import curve, has_curve, tonnage_use, torque_capacity_kNm
 from planning.model.limits.slider_accel import SliderAccelLimit
 from planning.model.outcome import Outcome
+from planning.model.plan import Plan
 from planning.model.profile import MAX_STEP_S, Profile
 from planning.model.units import rounded_down
 from planning.reports.robots import robot_columns, robot_lines, robot_values, robots_block
@@ -40,6 +41,7 @@ TRAJECTORY_COLUMNS = (
 )
 DRIVE_COLUMNS = ("crank_torque_Nm", "motor_speed_rpm", "motor_torque_Nm", "motor_power_kW")  # with a drive
 POWER_COLUMNS = ("copper_loss_kW", "bus_power_kW", "grid_power_kW", "storage_energy_kJ")  # drive.electrical
+HOLD_FIELDS = {"hold_time_s", "hold_height_mm"}  # result.json's process: without a hold, as before it had one
 MAX_ROWS = 200_000  # trajectory rows at most: a cycle longer than 200 s gets a step of period / MAX_ROWS
 
 
@@ -163,10 +165,11 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
         "half_durations_s": {k: float(p.half(k)[0]) for k in HALVES} if hasattr(p, "half") else None,
         "segment_count": len(plan.profile.segments),
         "transfer_dwell_s": float(p.transfer_dwell),
+        **({"hold": hold_block(plan, case)} if getattr(p, "has_hold", False) else {}),
         "transfer_window_s": plan.transfer_window(),
         "max_abs_slider_accel_mm_s2": accel.value,
         "binding_constraints": binding(solution),
-        "process": case.process.model_dump(),
+        "process": case.process.model_dump(exclude=set() if case.hold_angle is not None else HOLD_FIELDS),
         "limits": case.limits.model_dump(),
         "key_points": key_points(solution),
         "segments": segments(solution),
@@ -294,14 +297,49 @@ def _plan_lines(r: dict[str, Any]) -> list[str]:
         f"  peaks: crank acceleration {r['peak_crank_accel_rad_s2']:.3f} rad/s^2, "
         f"crank jerk {r['peak_crank_jerk_rad_s3']:.3f} rad/s^3",
         f"  halves: feed {hd['feed_accel']:.4f} / {hd['feed_decel']:.4f} s, return {hd['return_accel']:.4f} / "
-        f"{hd['return_decel']:.4f} s; draw {r['cycle_time_s'] - sum(hd.values()) - r['transfer_dwell_s']:.4f} s"
+        f"{hd['return_decel']:.4f} s; draw {_draw_s(r):.4f} s"
         if hd
         else f"  free profile: {r['segment_count']} segments of constant jerk (no halves), "
         f"|jerk| <= {r['limits']['crank_jerk_rad_s3']:g} rad/s^3",
         f"  {'theta4 -> theta1' if r.get('robots') else 'robot window theta4 -> theta1'}: "
         f"{r['transfer_window_s']:.4f} s; "
         f"max |slider accel| {r['max_abs_slider_accel_mm_s2']:.1f} mm/s^2",
+        *_hold_lines(r),
     ]
+
+
+def _draw_s(r: dict[str, Any]) -> float:
+    """The draw's time [s]: the cycle's but the halves', the dwell's and a hold's (brake and standstill)."""
+    hold = r.get("hold")
+    held = hold["brake_s"] + hold["time_s"] if hold else 0.0
+    return r["cycle_time_s"] - sum(r["half_durations_s"].values()) - r["transfer_dwell_s"] - held
+
+
+def _hold_lines(r: dict[str, Any]) -> list[str]:
+    """A hold's line: the brake from the draw's end and the standstill (none without a hold)."""
+    hold = r.get("hold")
+    if not hold:
+        return []
+    return [
+        f"  hold: the crank brakes {hold['brake_s']:.4f} s from theta3 to {hold['angle_deg']:.3f} deg and stands "
+        f"{hold['time_s']:.4f} s, the slide {hold['height_mm']:g} mm above BDC"
+    ]
+
+
+def hold_block(plan: Plan, case: Case) -> dict[str, float]:
+    """``result.json``'s hold: its time [s], the slide's height [mm above BDC], the crank's angle [deg], the
+    brake's time [s] from theta3 and the planned stop's crank angles [deg] (theta3 to the return's rise's end:
+    the least crank speed does not hold there)."""
+    p = plan.parameters
+    start, end = plan.planned_stop()
+    return {
+        "time_s": float(p.hold_time),
+        "height_mm": case.hold_height_mm,
+        "angle_deg": math.degrees(float(p.hold_angle)),
+        "brake_s": float(p.brake_duration),
+        "stop_from_deg": math.degrees(start),
+        "stop_to_deg": math.degrees(end),
+    }
 
 
 def _draw_words(r: dict[str, Any]) -> str:

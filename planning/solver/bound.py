@@ -26,7 +26,10 @@ motions, so the number is not certified to bound every motion (on the published 
 intervals, where a motion meeting every limit makes 13.0405). The drive's speed and
 acceleration limits enter as bounds on s and alpha. A crank-jerk limit J enters between neighbouring
 intervals as ``|alpha_{i+1} - alpha_i| <= J (tau_i + tau_{i+1}) / 2`` (``planning.model.limits.crank_jerk``).
-Without a crank
+With a hold at the bottom (``process.hold_time_s``) the crank stops at the hold's angle for the hold time:
+the bound leaves the least crank speed out (the crank stops in a hold, the plan decides where its stop
+begins and ends) and adds the hold's time to the fastest motion's (any plan with the hold, its standstill
+cut out, is a motion the bound's problem admits). Without a crank
 acceleration limit the slack can be realised: near TDC dh/dtheta -> 0, so the slider does not feel the
 crank's acceleration there and the crank may slow almost to a stop at no cost in slider acceleration.
 """
@@ -184,7 +187,7 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
     s_opt, tau_opt = np.maximum(xs[:n], 0.0), xs[n:]
     s_next_opt = np.roll(s_opt, -1)
     motion = 2 * dth / (np.sqrt(s_opt) + np.sqrt(s_next_opt))
-    period = float(np.sum(tau_opt))
+    period = float(np.sum(tau_opt)) + case.standstill_s  # a hold: the fastest motion, then the standstill
     return Bound(
         spm=60.0 / period,
         cycle_time_s=period,

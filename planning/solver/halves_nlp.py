@@ -250,8 +250,9 @@ def _cycle(law_name: str, layout: ParameterLayout, variables: tuple) -> _Cycle:
     unit = {name: p_scale[i] for i, (name, _) in enumerate(VARIABLES)}
     q = layout.symbols(p_case)
     fields = [f for f in CycleParameters.__dataclass_fields__ if f in v]
+    hold = {"hold_time": q["hold_time"], "hold_angle": q["hold_angle"]} if layout.hold else {}
     params = CycleParameters(
-        **{f: v[f] for f in fields}, draw_start=q["theta2"], draw_end=q["theta3"], motion_law=law_name
+        **{f: v[f] for f in fields}, draw_start=q["theta2"], draw_end=q["theta3"], motion_law=law_name, **hold
     )
     segs = cycle_segments(params)
     states = knot_states(q["theta3"], params.draw_speed, 0.0, segs)
@@ -266,15 +267,15 @@ def _shape_rows(rows: Rows, c: _Cycle, law) -> None:  # noqa: ANN001 - a Law
     """The halves monotone (the peaks above the speeds they join), one jerk per S-curve where the law says
     so (Eq. 14), the cycle closed at 2 pi."""
     p, unit = c.params, c.unit
-    w1, w2 = p.transfer_speed, p.draw_speed
+    w1, w2, wr = p.transfer_speed, p.draw_speed, p.return_start_speed  # wr: w2, or 0 after a hold
     wm1, wm2 = p.feed_peak_speed, p.return_peak_speed
-    peaks = ca.vertcat(wm1 - w1, wm1 - w2, wm2 - w2, wm2 - w1) / unit["draw_speed"]
+    peaks = ca.vertcat(wm1 - w1, wm1 - w2, wm2 - wr, wm2 - w1) / unit["draw_speed"]
     rows.add("peak speeds above their ends", peaks, 0, np.inf, "planner.motion_law")
     if law.one_jerk_per_curve:  # Eq. 14: one jerk J for both halves of each S-curve
         d_fa, d_fd = p.feed_accel_duration, p.feed_decel_duration
         d_ra, d_rd = p.return_accel_duration, p.return_decel_duration
         t2 = unit["feed_accel_duration"] ** 2 * unit["draw_speed"]
-        one_jerk = ca.vertcat((wm1 - w1) * d_fd**2 - (wm1 - w2) * d_fa**2, (wm2 - w2) * d_rd**2 - (wm2 - w1) * d_ra**2)
+        one_jerk = ca.vertcat((wm1 - w1) * d_fd**2 - (wm1 - w2) * d_fa**2, (wm2 - wr) * d_rd**2 - (wm2 - w1) * d_ra**2)
         rows.add("one jerk per S-curve (Eq. 14)", one_jerk / t2, 0.0, 0.0, "planner.motion_law")
     # the cycle closes: theta at the draw start is theta2 + 2 pi
     rows.add("cycle closes", c.states[c.n_before][0] - (c.q["theta2"] + 2 * np.pi), 0.0, 0.0, "key_points")
@@ -294,6 +295,8 @@ def _key_point_rows(rows: Rows, c: _Cycle) -> tuple[int, tuple[ca.SX, ca.SX]]:
     # published structure (Fig. 6): theta4 at x3 + 3 T14 (three quarters into the return deceleration),
     # theta1 at x1 + T1 (a quarter into the feed acceleration); bounds switched per solve
     rd_start = params.return_accel_duration
+    if params.has_hold:  # the brake and the standstill come first
+        rd_start = rd_start + params.brake_duration + params.hold_time
     fa_start = rd_start + params.return_decel_duration + params.transfer_dwell
     published = ca.vertcat(
         t4 - (rd_start + 0.75 * params.return_decel_duration),
@@ -454,11 +457,12 @@ def _build(
     links: tuple[str, ...] = (),
     peak: bool = False,
     losses: bool = False,
+    hold: bool = False,
 ) -> CycleNLP:
     law = get_law(law_name)
     die_exit = zone and not rate  # the denser variant: the die exit held at its angles (smooth rows)
     zone = rate  # the rate NLP: every sample in the die zone held (its crank speed may peak there)
-    layout = ParameterLayout(formula, limit_ids, drive, rate, links if drive else (), die_exit)
+    layout = ParameterLayout(formula, limit_ids, drive, rate, links if drive else (), die_exit, hold)
     robots = "robots" in limit_ids
     variables = VARIABLES + ((PEAK_VARIABLE,) if peak else ()) + (EXIT_VARIABLES if die_exit else ())
     variables += ROBOT_VARIABLES if robots else ()
@@ -475,12 +479,14 @@ def _build(
     problem = {"x": c.x, "p": ca.vertcat(c.p_case, c.p_scale), "f": objective, "g": ca.vertcat(*rows.g)}
     kind = ("_rate" if rate else "_drive" if drive else "") + ("_kinematic" if rate and not drive else "")
     kind += "_exit" if die_exit else ""
-    kind += ("_peak" if peak else "") + ("_losses" if losses else "")
+    kind += ("_peak" if peak else "") + ("_losses" if losses else "") + ("_hold" if hold else "")
     options = {**CYCLE_OPTIONS, **(DRIVE_OPTIONS if drive else {}), **(RATE_OPTIONS if rate else {})}
     program = NLPSolver("press_cycle_" + law_name.replace("-", "_") + kind, problem, options, lift=lift)
     scales = peak_variable_scales if peak else exit_variable_scales if die_exit else variable_scales
     bounds = peak_variable_bounds if peak else exit_variable_bounds if die_exit else variable_bounds
-    denser = None if zone or die_exit else partial(halves_nlp, law_name, formula, limit_ids, drive, rate, True, links)
+    denser = None
+    if not (zone or die_exit):
+        denser = partial(halves_nlp, law_name, formula, limit_ids, drive, rate, True, links, hold=hold)
     complete = complete_exit if die_exit else None
     if robots:
         scales, bounds = partial(robot_scales, scales), partial(robot_bounds, bounds)
@@ -512,6 +518,7 @@ def halves_nlp(
     links: tuple[str, ...] = (),
     peak: bool = False,
     losses: bool = False,
+    hold: bool = False,
 ) -> CycleNLP:
     """The compiled NLP of motion law ``law`` on a mechanism of closed form ``formula`` holding the limits
     ``limit_ids``, with the motor's torque when ``drive`` (the mechanism's massive ``links`` in it);
@@ -520,9 +527,10 @@ def halves_nlp(
     the die zone held at every sample there (the rate NLP's always; otherwise the denser variant a search
     turns to when a plan's crank speed peaks inside the die zone, between the crossings); ``peak``: the rate
     NLP with the bus power's peak as a variable (:data:`PEAK_VARIABLE`; the least grid peak); ``losses``: its
-    supply energy through the copper loss and the converter (``planning.solver.nlp.objective_terms``). Built
-    on first use in a process, then reused for every case and start."""
-    return _build(law, formula, limit_ids, drive, rate, zone, links, peak, losses)
+    supply energy through the copper loss and the converter (``planning.solver.nlp.objective_terms``);
+    ``hold``: the crank brakes after the draw and stands (``planning.model.cycle``). Built on first use in a
+    process, then reused for every case and start."""
+    return _build(law, formula, limit_ids, drive, rate, zone, links, peak, losses, hold)
 
 
 def halves_nlp_for(case: Case, drive: bool | None = None, rate: bool = False, peak: bool = False) -> CycleNLP:
@@ -533,8 +541,8 @@ def halves_nlp_for(case: Case, drive: bool | None = None, rate: bool = False, pe
     links = drive_links(case) if drive or rate else ()
     d = case.drive
     losses = rate and d is not None and (d.motor.copper_loss_at_rated_kW > 0 or d.converter_efficiency < 1)
-    law, formula = case.planner.motion_law, case.machine.formula
-    return halves_nlp(law, formula, limit_ids, drive, rate, False, links, peak, losses)
+    law, formula, hold = case.planner.motion_law, case.machine.formula, case.hold_angle is not None
+    return halves_nlp(law, formula, limit_ids, drive, rate, False, links, peak, losses, hold)
 
 
 def fresh_build(case: Case) -> CycleNLP:
@@ -542,4 +550,5 @@ def fresh_build(case: Case) -> CycleNLP:
     drive = case.drive is not None
     limit_ids = nlp_limits(case, drive)
     links = drive_links(case) if drive else ()
-    return _build(case.planner.motion_law, case.machine.formula, limit_ids, drive, False, False, links)
+    hold = case.hold_angle is not None
+    return _build(case.planner.motion_law, case.machine.formula, limit_ids, drive, False, False, links, hold=hold)

@@ -41,7 +41,7 @@ def solve_max_spm(
     _multi_start(search, neighbour, ran)
     if search.best is None:
         _try_harder(search, neighbour)
-    if search.best is None:
+    if search.best is None and case.hold_angle is None:  # a hold stops the crank: never one constant speed
         _constant_speed(search)
     return search.answer()
 

@@ -67,6 +67,7 @@ OBJECTIVE = (
 # die speed is held at fixed crank angles from theta3 to the die-height crossing (smooth rows, exact there)
 EXIT_SAMPLES = 12
 EXIT = tuple(f"die_exit_{part}_{k}" for k in range(EXIT_SAMPLES) for part in ("angle", "slope")) + ("die_exit_active",)
+HOLD = ("hold_time", "hold_angle")  # the hold at the bottom: its time [s] and crank angle [rad]
 DRAW_SAMPLES_DRIVE = 80  # with a drive the draw is sampled finer: the forming force changes fast there
 FORMING_SAMPLES = DRAW_SAMPLES_DRIVE + 1  # forming force [N] at the draw's samples, theta2 ... theta3
 POWER_SMOOTHING = 1e-3  # epsilon of the rate NLP's smooth max(P, 0), as a share of rated torque x base speed
@@ -84,6 +85,7 @@ class ParameterLayout:
     rate: bool = False
     links: tuple[str, ...] = ()
     die_exit: bool = False  # the die exit's angles (:data:`EXIT`; a halves NLP's denser variant)
+    hold: bool = False  # the hold at the bottom (:data:`HOLD`)
 
     @property
     def limits(self) -> tuple[Limit, ...]:
@@ -94,6 +96,7 @@ class ParameterLayout:
         """Every parameter's name but the forming force's, in vector order."""
         names = [f"geometry_{g}" for g in self.formula.geometry_names] + list(STRUCTURE)
         names += EXIT if self.die_exit else ()
+        names += HOLD if self.hold else ()
         for limit in self.limits:
             names += [p for p in limit.parameters if p not in names]
         if self.drive:
@@ -135,6 +138,8 @@ class ParameterLayout:
         values |= structure_values(case)
         if self.die_exit:
             values |= exit_values(case)
+        if self.hold:
+            values |= {"hold_time": case.process.hold_time_s, "hold_angle": case.hold_angle}
         for limit in self.limits:
             values |= limit.parameter_values(case)
         if self.drive:

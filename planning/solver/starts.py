@@ -41,12 +41,13 @@ def guess(case: Case, w2: float, w1: float, peak_share: float, inside: float) ->
         D_a = angle / ((w_from + wm) / 2 + ratio * (wm + w_to) / 2)  # a symmetric half sweeps D (v0 + v1) / 2
         return D_a, ratio * D_a
 
+    lead, th_return, w_return = hold_lead(case, w2)
     D_fa, D_fd = halves(th2 - th1, w1, w2)
-    D_ra, D_rd = halves(th4 - th3, w2, w1)
+    D_ra, D_rd = halves(th4 - th_return, w_return, w1)
     T_c = (th1 + 2 * math.pi - th4) / w1
     share = inside / sc.SUBSEGMENTS
-    t4 = D_ra + (1 - share) * D_rd
-    t1 = D_ra + D_rd + T_c + share * D_fa
+    t4 = lead + D_ra + (1 - share) * D_rd
+    t1 = lead + D_ra + D_rd + T_c + share * D_fa
     t_feed_end = t1 - share * D_fa + D_fa + D_fd
     return {
         "transfer_speed": w1,
@@ -62,8 +63,17 @@ def guess(case: Case, w2: float, w1: float, peak_share: float, inside: float) ->
         "closing_time": t1,
         "opening_time": t4,
         "die_down_time": 0.5 * (t1 + t_feed_end),
-        "die_up_time": 0.5 * t4,
+        "die_up_time": 0.5 * (lead + t4),
     }
+
+
+def hold_lead(case: Case, w2: float) -> tuple[float, float, float]:
+    """``(time [s] from theta3 to the return's start, the angle [rad] and speed [rad/s] it starts at)``: 0,
+    theta3, ``w2``; after a hold the brake's time (``2 (theta_h - theta3) / w2``) and the hold's, theta_h, 0."""
+    th3 = float(case.key_angles[2])
+    if case.hold_angle is None:
+        return 0.0, th3, w2
+    return 2 * (case.hold_angle - th3) / w2 + case.process.hold_time_s, case.hold_angle, 0.0
 
 
 def transfer_speeds(case: Case) -> tuple[float, float]:
@@ -80,7 +90,8 @@ def published_starts(case: Case, w2: float, neighbour: Plan | None) -> list[dict
     w_transfer, w_min = transfer_speeds(case)
     starts = [guess(case, w2, w_transfer, share, 1.0) for share in (0.9, 0.6)]
     starts.append(guess(case, w2, 0.5 * (w_transfer + w_min), 0.75, 1.0))
-    starts.append(constant_speed(case, w2, 1.0))
+    if case.hold_angle is None:  # a hold stops the crank: never one constant speed
+        starts.append(constant_speed(case, w2, 1.0))
     if neighbour is not None and neighbour.placement == "published":
         starts = [neighbour.nlp_values] + starts
     return starts
@@ -135,7 +146,8 @@ def free_starts(
     starts += [exit_start] if exit_start is not None else []
     starts.append(guess(case, w2, w_transfer, 0.9, 1.5))
     starts.append(guess(case, w2, 2 * w_min, 0.95, 2.0))
-    starts.append(constant_speed(case, w2, 1.5))
+    if case.hold_angle is None:
+        starts.append(constant_speed(case, w2, 1.5))
     return starts
 
 
@@ -144,11 +156,11 @@ def die_exit(case: Case, w2: float) -> dict[str, float] | None:
     caps the crank at the crossing the slide rises through after theta3: ``v_die / |h'|`` there. A start of
     that structure: the return's halves sweep theta3 to that crossing only, and the transfer runs at the cap
     (or the speed the transfer time needs, the lower) from the crossing through the robot's window, theta4
-    in the transfer. None where the draw ends above the die height."""
+    in the transfer. None where the draw ends above the die height, or with a hold (its return starts at rest)."""
     m = case.machine
     th1, _, th3, th4 = case.key_angles
     die = case.limits.die_height_mm
-    if float(m.height(th3)) >= die:
+    if float(m.height(th3)) >= die or case.hold_angle is not None:
         return None
     up = float(m.angles_at_height(min(die, m.stroke))[1])
     if not th3 < up < th4:

@@ -3,7 +3,9 @@
 The grid bound (``planning.solver.bound``) restricts the motion (constant crank acceleration on each
 interval, the slider's limit at the interval's ends): it approaches the true optimum from below and is
 not an upper bound. Here the same question is relaxed instead: every motion that meets the limits also
-meets the relaxed problem, so the relaxed optimum is an upper bound on its strokes/min.
+meets the relaxed problem, so the relaxed optimum is an upper bound on its strokes/min. With a hold at the
+bottom the least crank speed is left out and the hold's time added (a plan with the hold, its standstill cut
+out, meets the relaxed problem; ``planning.solver.bound``).
 
 Variables: ``s_i`` [rad^2/s^2] the crank speed squared at the nodes (any motion's own values there) and
 ``tau_p`` [s] the time spent on each piece of each interval (pieces cut each interval; any motion's own
@@ -197,7 +199,7 @@ def upper_bound(case: Case, points: int = UPPER_POINTS, pieces: int = UPPER_PIEC
     res = solver.solve(r.x0, r.lbx, r.ubx, r.lbg, r.ubg, clip_to_bounds=False)
     if res.return_status != SOLVED:  # not IPOPT's "acceptable" level: its rows may be violated by far more
         raise NoPlanFound(f"the upper bound did not converge ({res.return_status})")
-    period = float(np.sum(res.x[r.theta.size - 1 :]))
+    period = float(np.sum(res.x[r.theta.size - 1 :])) + case.standstill_s  # a hold's standstill comes on top
     return UpperBound(
         spm=60.0 / period,
         cycle_time_s=period,

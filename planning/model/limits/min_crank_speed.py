@@ -1,16 +1,19 @@
-"""The crank keeps turning forward, never slower than ``limits.min_crank_speed_rpm``."""
+"""The crank keeps turning forward, never slower than ``limits.min_crank_speed_rpm`` (but in a hold's planned stop)."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 from pydantic import Field
 
-from planning.model.limits.base import Draw, Row, Transcription
+from planning.model.limits.base import BoundMesh, Check, Dense, Draw, Row, Transcription
 from planning.model.limits.canonical import SpeedCap
 from planning.model.units import RPM, CrankSpeed
 from planning.tolerances import SAME_RELATIVE
+
+IN_A_HOLD = "crank speed (forward, stopping only in the hold)"  # the check's name in a case with a hold
 
 
 class MinCrankSpeedLimit(SpeedCap):
@@ -29,7 +32,7 @@ class MinCrankSpeedLimit(SpeedCap):
             Field(
                 1.0,
                 title="least crank speed [rpm]",
-                description="The crank never turns slower (never stops or reverses).",
+                description="The crank never turns slower (never stops or reverses; a hold's stop excepted).",
             ),
         ),
     }
@@ -42,6 +45,24 @@ class MinCrankSpeedLimit(SpeedCap):
     def refuse_draw_speed(self, draw: Draw, speed: float) -> str | None:
         lowest = draw.case.limits.min_crank_speed_rpm
         return f"is below {self.field} = {lowest:g}" if speed < lowest * RPM * (1 - SAME_RELATIVE) else None
+
+    def check(self, dense: Dense) -> list[Check]:
+        """The least crank speed over the cycle but the hold's planned stop (``Plan.in_planned_stop``): there
+        the crank brakes to rest, stands and rises again by design."""
+        stop = dense.plan.in_planned_stop(dense.theta)
+        if not stop.any():
+            return super().check(dense)
+        moving = ~stop
+        fields = ("t", "theta", "omega", "alpha", "jerk", "h", "v", "a", "slope")
+        kept = {f: getattr(dense, f)[moving] for f in fields if getattr(dense, f) is not None}
+        return [replace(c, name=IN_A_HOLD) for c in super().check(replace(dense, **kept))]
+
+    def bound_speeds(self, mesh: BoundMesh) -> tuple[np.ndarray | None, np.ndarray | None]:
+        """None with a hold (the crank stops there, and where its stop begins and ends is the plan's: the bounds
+        leave the least crank speed out, which only loosens them), else the cap's."""
+        if mesh.case.hold_angle is not None:
+            return None, None
+        return super().bound_speeds(mesh)
 
     def parameter_values(self, case: Any) -> dict[str, float]:
         return {"min_crank_speed": case.limits.min_crank_speed_rpm * RPM}

@@ -8,7 +8,7 @@ const ONE_HEIGHT_KEYS = ["process.safety_height_mm", "process.transfer_time_s"];
 // the press section's own keys belong to the crank-slider; a linkage's dimensions are in its subsection
 const CRANK_SLIDER_KEYS = ["press.crank_radius_mm", "press.rod_length_mm", "press.offset_mm", "drive.rod_mass_kg", "drive.rod_cg_from_crank_pin_mm"];
 const SECTION_TITLES = { robots: "robots", "robots.unloader": "unloader (takes the part out)", "robots.loader": "loader (brings the blank in)", press: "press", "press.link_drive": "link drive", "press.knuckle_joint": "knuckle joint", key_points: "key angles", process: "process", limits: "limits", drive: "drive", "drive.motor": "motor (all motors together)", planner: "planner" };
-const WINDOW_COLOUR = "#d9ecff", DRAW_COLOUR = "#e2f0d9"; // the robot's window, the draw
+const WINDOW_COLOUR = "#d9ecff", DRAW_COLOUR = "#e2f0d9", HOLD_COLOUR = "#c8b99a"; // the robot's window, the draw, a hold
 const KEY_LABELS = { closing: "θ1", draw_start: "θ2", draw_end: "θ3", opening: "θ4" };
 const TYPING_REST_MS = 120; // a pause this long in typing solves (a fast typist's keys come closer)
 const BOUND_REST_MS = 800;
@@ -668,7 +668,21 @@ function cycleShapes(r, x, axis, width) {
   if (draw.length * LABEL_PX < px(at("draw_start"), at("draw_end")) + 20) {
     annotations.push({ xref: "x", yref: "paper", x: (at("draw_start") + at("draw_end")) / 2, y: 1.0, xanchor: "center", yanchor: "bottom", text: draw, showarrow: false, font: { size: 11, color: "#3b6e22" } });
   }
+  if (r.hold) holdShape(r.hold, at("draw_end"), axis, shapes, annotations);
   return { shapes, annotations };
+}
+
+// a hold at the bottom: its standstill shaded against time (from the brake's end), a line at its angle
+function holdShape(hold, drawEnd, axis, shapes, annotations) {
+  const text = `hold ${hold.time_s} s`;
+  if (axis === "time") {
+    const x0 = drawEnd + hold.brake_s, x1 = x0 + hold.time_s;
+    shapes.push({ type: "rect", xref: "x", yref: "paper", x0, x1, y0: 0, y1: 1, fillcolor: HOLD_COLOUR, opacity: 0.35, line: { width: 0 }, layer: "below" });
+    annotations.push({ xref: "x", yref: "paper", x: (x0 + x1) / 2, y: 0.0, xanchor: "center", yanchor: "bottom", text, showarrow: false, font: { size: 11, color: "#6b5a3e" } });
+  } else {
+    shapes.push({ type: "line", xref: "x", yref: "paper", x0: hold.angle_deg, x1: hold.angle_deg, y0: 0, y1: 1, line: { width: 2, color: HOLD_COLOUR } });
+    annotations.push({ xref: "x", yref: "paper", x: hold.angle_deg, y: 0.0, xanchor: "left", yanchor: "bottom", text, showarrow: false, font: { size: 11, color: "#6b5a3e" } });
+  }
 }
 
 // each limit of the case on the panel of the quantity it bounds, dashed where it applies (the server's

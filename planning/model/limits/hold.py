@@ -1,0 +1,89 @@
+"""The slide stands at its hold height (``process.hold_height_mm``) for the hold time (``process.hold_time_s``).
+
+The plan holds it by its structure (``planning.model.cycle``: the crank brakes after the draw and stands at the
+hold's angle for the hold time); the dense check measures it on the re-simulated motion instead: the longest
+run of samples (the uniform grid and every knot) with the crank standing (``|omega| <=``
+:data:`~planning.tolerances.HOLD_STILL_RAD_S`) and the slide within :data:`~planning.tolerances.HOLD_STILL_MM` of
+the hold height, from its first sample to its last, must last at least the hold time. The crank's standstill,
+not the slide's height alone: near BDC the slide stays within a micrometre while the crank still creeps, which
+would count a shorter standstill as the hold.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from planning.model.limits.base import Check, Dense, Impossible, Limit
+from planning.tolerances import HOLD_STILL_MM, HOLD_STILL_RAD_S, TIME_TOL_S
+
+
+def longest_run_s(t: np.ndarray, inside: np.ndarray) -> tuple[float, float]:
+    """``(duration [s], start [s])`` of the longest run of consecutive samples at times ``t`` where ``inside``
+    holds (its first sample to its last; a run that ends the period continues into the run that starts it)."""
+    if not inside.any():
+        return 0.0, float(t[0])
+    period = t[-1] - t[0]
+    if inside.all():
+        return float(period), float(t[0])
+    k = int(np.argmin(inside))  # a sample outside: unroll the period from there
+    order = np.r_[np.arange(k, t.size), np.arange(1, k + 1)]  # t[-1] is t[0] a period on
+    times = np.r_[t[k:], t[1 : k + 1] + period]
+    flags = inside[order]
+    best, start, first = 0.0, float(t[0]), None
+    for i, flag in enumerate(flags):
+        if flag and first is None:
+            first = i
+        if first is not None and (not flag or i == flags.size - 1):
+            last = i if flag else i - 1
+            if times[last] - times[first] > best:
+                best, start = float(times[last] - times[first]), float(times[first] % period)
+            first = None
+    return best, start
+
+
+class HoldLimit(Limit):
+    """The hold at the bottom: the crank stands, the slide within a micrometre of its hold height, for the hold
+    time."""
+
+    id = "hold"
+    name = "crank standing, the slide at its hold height"
+    unit = "s"
+    field = "process.hold_time_s"
+    order = 115
+
+    def applies(self, case: Any) -> bool:
+        return case.process.hold_time_s is not None
+
+    def check(self, dense: Dense) -> list[Check]:
+        case = dense.case
+        at_height = np.abs(dense.h - case.hold_height_mm) <= HOLD_STILL_MM
+        inside = at_height & (np.abs(dense.omega) <= HOLD_STILL_RAD_S)
+        stood, start = longest_run_s(dense.t, inside)
+        limit = case.process.hold_time_s
+        check = Check.of(self.id, self.name, stood, limit, self.unit, "min", TIME_TOL_S)
+        theta = float(np.interp(start, dense.t, dense.theta))
+        return [check.located(np.array([start]), np.array([theta]), np.array([stood]), limit)]
+
+    def precheck(self, case: Any, given: float | None, lowest: float) -> Impossible | None:
+        """A given draw speed ``w`` [rad/s] the crank cannot brake from: any motion from ``w`` to rest over the
+        brake's angle ``theta_h - theta3`` reaches ``|alpha| >= w^2 / (2 (theta_h - theta3))`` (from
+        ``d(omega^2)/dtheta = 2 alpha``), above ``limits.crank_accel_rad_s2``."""
+        top = case.limits.crank_accel_rad_s2
+        if given is None or top is None:
+            return None
+        brake = case.hold_angle - float(case.key_angles[2])
+        needed = given**2 / (2 * brake)
+        if needed <= top:
+            return None
+        reason = (
+            f"limits.crank_accel_rad_s2 = {top:g} cannot brake the crank from the draw speed "
+            f"{case.process.draw_speed_rpm:g} rpm to the hold over the {math.degrees(brake):.2f} deg from theta3: "
+            f"that takes at least {needed:.4g} rad/s^2"
+        )
+        return Impossible(reason, "limits.crank_accel_rad_s2", top, needed)
+
+    def limit(self, case: Any) -> float:
+        return case.process.hold_time_s
