@@ -181,6 +181,13 @@ CORPUS: dict[str, tuple[str, str | bytes]] = {
         BASE.replace("  motion_law: improved-s-curve", "  motion_law: seven-segment\n  law_parameter: 1e300"),
     ),
     "angle_huge": ("key_points.closing_deg", field("key_points.closing_deg", "1e300")),
+    # a hold at the bottom (docs/modes.md): the published draw ends past BDC, where a hold at BDC cannot follow it
+    "hold_time_zero": ("process.hold_time_s", add("process.hold_time_s", "0")),
+    "hold_time_huge": ("process.hold_time_s", add("process.hold_time_s", "1e300")),
+    "hold_time_word": ("process.hold_time_s", add("process.hold_time_s", "long")),
+    "hold_after_the_draw_end": ("key_points.draw_end_deg", add("process.hold_time_s", "0.3")),
+    "hold_height_alone": ("process.hold_height_mm", add("process.hold_height_mm", "5")),
+    "hold_height_nan": ("process.hold_height_mm", add("process.hold_height_mm", ".nan")),
     "angle_inf": ("key_points.opening_deg", field("key_points.opening_deg", "-.inf")),
     # types an engineer might not mean
     "bool_number": ("press.crank_radius_mm", field("press.crank_radius_mm", "true")),
