@@ -11,7 +11,8 @@ angle in degrees; at a point the plan gives ``Y = theta``, ``V = dY/dX = omega /
   reproduces: the cam is the plan, to round-off (:func:`exact_in_poly5`).
 - :func:`fewest_xyva`: the fewest XYVA points whose quintics keep the slide within a tolerance of the plan
   (the quintic law's speed is of degree five, its angle six; the logistic and cycloidal laws are no
-  polynomials): from each point the farthest next one that holds, over the plan's dense samples.
+  polynomials): from each point the farthest next one that holds, over the plan's dense samples; a hold's
+  standstill starts and ends at a point.
 - :func:`table_cam`: ``n`` points equidistant in the master (a table for a controller that interpolates
   linearly or by a spline).
 """
@@ -24,6 +25,7 @@ from collections.abc import Callable
 import numpy as np
 
 from planning.model.cam import DEG, TURN_DEG, Cam, Interpolation, quintic_coefficients
+from planning.model.cycle import HOLD_SEGMENT
 from planning.model.plan import Plan
 from planning.model.profile import sample_times
 from planning.tolerances import CAM_POINT_GAP_DEG
@@ -95,9 +97,10 @@ def fewest_xyva(plan: Plan, height: Height, tolerance_mm: float) -> Cam:
     y, v, a = xyva(plan, master)
     h = height(y * DEG)
     chosen = [0]
-    last = master.size - 1
-    while chosen[-1] < last:
+    must = standstill_samples(plan, times)
+    while chosen[-1] < master.size - 1:
         i = chosen[-1]
+        last = next((k for k in must if k > i), master.size - 1)  # never past a standstill's end
         reach = 1
         while i + reach < last and _holds(i, i + 2 * reach, master, y, v, a, h, height, tolerance_mm):
             reach *= 2
@@ -112,6 +115,20 @@ def fewest_xyva(plan: Plan, height: Height, tolerance_mm: float) -> Cam:
     x = master[picked]
     x[0], x[-1] = 0.0, TURN_DEG
     return Cam(Interpolation.POLY5, x, y[picked], v[picked], a[picked])
+
+
+def standstill_samples(plan: Plan, times: np.ndarray) -> list[int]:
+    """The indices in ``times`` (the plan's samples, its knots among them) of where a hold's standstill starts
+    and ends: points of every cam, so that the crank stands still between them (a quintic from a point
+    before the standstill to one after it would move)."""
+    knots = plan.profile.knot_times
+    ends = [
+        t
+        for k, seg in enumerate(plan.profile.segments)
+        if seg.name == HOLD_SEGMENT
+        for t in (knots[k], knots[k + 1])
+    ]
+    return sorted(int(np.argmin(np.abs(times - t))) for t in ends)
 
 
 def _holds(

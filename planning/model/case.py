@@ -216,6 +216,10 @@ class KeyPointsModel(_Model):
     )
 
 
+HOLD_TURNS = 5  # with a hold, the longest cycle in turns at the least crank speed (Case.longest_cycle_s)
+MAX_HOLD_S = 600.0  # [s] the longest hold at the bottom (ten minutes: a cycle's times stay within the NLP's precision)
+
+
 class ProcessModel(_Model):
     """``safety_height_mm`` [mm above BDC], ``transfer_time_s`` [s] (both required without robots, refused with
     them), ``draw_speed_rpm`` [rpm] or None."""
@@ -249,12 +253,12 @@ class ProcessModel(_Model):
             "from θ2 to BDC. Needs a drive to matter."
         ),
     )  # [[height above BDC mm, force kN], ...], linear between points
-    hold_time_s: Seconds | None = Field(
+    hold_time_s: Annotated[float, Field(ge=1e-3, le=MAX_HOLD_S)] | None = Field(
         None,
         title="hold at the bottom [s]",
         description=(
             "The slide stands still this long after the draw (coining, calibrating), the crank stopped at "
-            "process.hold_height_mm; empty: no hold."
+            "process.hold_height_mm; at most 600 s; empty: no hold."
         ),
     )
     hold_height_mm: Height | None = Field(
@@ -586,6 +590,14 @@ class Case(_Model):
         return self.process.hold_height_mm or 0.0
 
     @property
+    def longest_cycle_s(self) -> float:
+        """[s] the longest cycle the least crank speed allows: a turn at it; with a hold the crank stops, and
+        the brake and the rise from rest each sweep less than a turn at an average speed of at least half the
+        least (a half from w to 0 sweeps D w / 2): at most :data:`HOLD_TURNS` turns at it and the hold's time."""
+        turn = 2 * math.pi / (self.limits.min_crank_speed_rpm * RPM)
+        return turn if self.hold_angle is None else HOLD_TURNS * turn + self.standstill_s
+
+    @property
     def standstill_s(self) -> float:
         """The hold's time [s] (``process.hold_time_s``), 0 without a hold: a bound adds it to the fastest
         motion that stops at the hold's angle."""
@@ -875,7 +887,8 @@ def _hold_checks(case: Case) -> None:
     process = case.process
     if process.hold_time_s is None:
         if process.hold_height_mm is not None:
-            raise CaseError("process.hold_height_mm", "needs process.hold_time_s (how long the slide stands)", True)
+            reason = "needs process.hold_time_s (how long the slide stands)"
+            raise CaseError("process.hold_height_mm", reason, process.hold_height_mm)
         return
     if not case.hold_height_mm < case.machine.stroke:
         reason = f"must lie below the stroke's top ({case.machine.stroke:.1f} mm above BDC)"

@@ -13,7 +13,7 @@ from planning.model.cycle import CycleParameters, cycle_segments
 from planning.model.free_profile import FreeProfileParameters, Layout, closed_jerks
 from planning.model.laws import DEFAULT_LAW
 from planning.model.profile import Profile, Segment, advance_segment, knot_states, split_segment
-from planning.tolerances import KNOT_TIME_S, TINY
+from planning.tolerances import ANGLE_TOL_RAD, KNOT_TIME_S, TIME_TOL_S, TINY
 
 
 @dataclass(frozen=True)
@@ -75,15 +75,27 @@ class Plan:
         share = (t - tk[k]) / max(tk[k + 1] - tk[k], TINY)
         return f"{segment_in_words(self.profile.segments[k].name)}, {100 * share:.0f} % in"
 
-    def in_planned_stop(self, theta: np.ndarray) -> np.ndarray:
+    def holds_as(self, case: Any) -> bool:
+        """Whether the plan holds at the bottom as ``case`` asks: no hold for a case without one, else the same
+        hold time (to :data:`~planning.tolerances.TIME_TOL_S`) at the same crank angle."""
+        p = self.parameters
+        planned = getattr(p, "has_hold", False)
+        if not planned or case.hold_angle is None:
+            return not planned and case.hold_angle is None
+        same_time = abs(float(p.hold_time) - case.standstill_s) <= TIME_TOL_S
+        return bool(same_time and abs(float(p.hold_angle) - case.hold_angle) <= ANGLE_TOL_RAD)
+
+    def in_planned_stop(self, theta: np.ndarray, case: Any) -> np.ndarray:
         """Whether each crank angle ``theta`` [rad] lies in the hold's planned stop: from theta3, where the crank
-        brakes, through the standstill to the end of the return's rise from rest (all False without a hold).
-        By angle, so that a cam's realised motion (its own segments and times) is read the same way."""
+        brakes, through the standstill to the end of the return's rise from rest; all False without a hold or
+        when the plan does not hold as ``case`` asks (:meth:`holds_as`: a stop the case did not ask for is no
+        planned stop). By angle, so that a cam's realised motion (its own segments and times) is read the same
+        way; an angle a turn on counts too (a rise that ends past TDC)."""
         stop = self.planned_stop()
-        if stop is None:
+        if stop is None or not self.holds_as(case):
             return np.zeros(np.shape(theta), dtype=bool)
         turn = np.mod(np.asarray(theta, dtype=float), 2 * math.pi)
-        return (turn >= stop[0]) & (turn <= stop[1])
+        return ((turn >= stop[0]) & (turn <= stop[1])) | (turn + 2 * math.pi <= stop[1])
 
     def planned_stop(self) -> tuple[float, float] | None:
         """``(from, to)`` [rad]: the crank angles of the hold's planned stop, theta3 to the end of the return's

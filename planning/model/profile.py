@@ -183,6 +183,10 @@ class Profile:
         if theta < knots[0, 0] or theta > knots[-1, 0]:
             raise ValueError("angle outside the profile")
         k = int(np.clip(np.searchsorted(knots[:, 0], theta, side="right") - 1, 0, len(self.segments) - 1))
+        if k > 0 and knots[k - 1, 0] == knots[k, 0] and abs(knots[k, 0] - theta) <= ANGLE_ROUND_OFF_RAD:
+            while k > 0 and knots[k - 1, 0] == knots[k, 0]:  # a standstill at theta: where it starts
+                k -= 1
+            return float(tk[k])
         lo, hi = 0.0, float(self.segments[k].duration)
         seg = self.segments[k]
         tau = 0.5 * (lo + hi)

@@ -101,7 +101,8 @@ def _check(check: Check) -> dict[str, Any]:
     }
 
 
-LIMIT_WORDS = {"motor_speed": "motor speed (on the crank)"}  # a draw-speed bound's words, by limit id
+# a draw-speed bound's words, by limit id
+LIMIT_WORDS = {"motor_speed": "motor speed (on the crank)", "hold": "braking to the hold"}
 
 
 def _rpm(value: float, given: str) -> str:

@@ -72,7 +72,8 @@ def planned_stop(result: dict[str, Any], columns: dict[str, np.ndarray]) -> np.n
     hold = result.get("hold")
     if not hold:
         return np.zeros(angle.shape, dtype=bool)
-    return (angle >= hold["stop_from_deg"]) & (angle <= hold["stop_to_deg"])
+    start, end = hold["stop_from_deg"], hold["stop_to_deg"]
+    return ((angle >= start) & (angle <= end)) | (angle + 360.0 <= end)  # a rise that ends past TDC
 
 
 def limit_lines(result: dict[str, Any], columns: dict[str, np.ndarray], axis: str) -> list[LimitLine]:

@@ -26,6 +26,7 @@ import time
 from dataclasses import dataclass
 
 from planning.model.case import Case
+from planning.model.errors import CaseError
 from planning.model.free_profile import PHASES, finer
 from planning.model.laws.optimal import OptimalLaw
 from planning.model.profile import max_abs_jerk
@@ -103,6 +104,9 @@ def bracket(case: Case, tolerance_pct: float = BRACKET_TOL_PCT) -> Bracket:
     """The bracket of ``case`` (module docstring); raises a :class:`PlanningError` when no verified motion
     or no upper bound is found."""
     t_start = time.perf_counter()
+    if case.hold_angle is not None:  # its verified side is the optimal law's plan
+        reason = "bound --bracket plans with the optimal law, which plans no hold yet (bound --certified does)"
+        raise CaseError("process.hold_time_s", reason, case.process.hold_time_s)
     allowance = None if case.limits.crank_jerk_rad_s3 is not None else jerk_allowance(case)
     planned = case.with_objective("max-spm")
     if allowance is not None:

@@ -104,12 +104,13 @@ def variable_scales(case: Case) -> np.ndarray:
     """Variable scales from the press's own characteristic time ``T* = sqrt(l / A)`` [s] and speed
     ``W* = sqrt(A / k)`` [rad/s] (A the slider-acceleration limit, l the mechanism's length unit, half the
     stroke, k its peak curvature ``max |d2h/dtheta2|``): speeds ~ W*, durations of the halves ~ T*, stage
-    times ~ 10 T*. The factors make the variables O(1) for a press cycle of the usual proportions; they
-    span orders of magnitude from a small fast press to a heavy slow one."""
+    times ~ 10 T* (and a hold's time). The factors make the variables O(1) for a press cycle of the usual
+    proportions; they span orders of magnitude from a small fast press to a heavy slow one."""
     m, A = case.machine, case.limits.slider_accel_mm_s2
     t_star = math.sqrt(m.length_scale / A)
     w_star = math.sqrt(A / m.peak_curvature)
-    unit = {"speed": 0.42 * w_star, "half": 1.12 * t_star, "time": 2.8 * t_star, "shape": 1.0}
+    time = 2.8 * t_star + case.standstill_s  # a hold's time is in every time after the draw's end
+    unit = {"speed": 0.42 * w_star, "half": 1.12 * t_star, "time": time, "shape": 1.0}
     return np.array([unit[kind] for _, kind in VARIABLES])
 
 

@@ -116,14 +116,16 @@ def solve_line(line: Line) -> LineSolution:
 
 def _check_slow_enough(line: Line, bottleneck: Bottleneck) -> None:
     """:class:`Infeasible` when a station cannot turn as slowly as the line's period asks: its minimum crank
-    speed makes a turn at most ``60 / min_crank_speed_rpm`` [s] long."""
+    speed makes a cycle at most ``Case.longest_cycle_s`` long (a turn at it, ``60 / min_crank_speed_rpm`` [s],
+    without a hold)."""
     for station in line.stations:
         slowest = station.case.limits.min_crank_speed_rpm
-        if slowest > 0 and bottleneck.period_s > 60.0 / slowest:
+        longest = station.case.longest_cycle_s
+        if bottleneck.period_s > longest:
             raise Infeasible(
                 f"the line's cycle {bottleneck.period_s:.4g} s (set by {bottleneck.kind} {bottleneck.name}) is "
                 f"longer than station {station.name} can take: at its limits.min_crank_speed_rpm = {slowest:g} a "
-                f"turn takes at most {60.0 / slowest:.4g} s",
+                f"cycle takes at most {longest:.4g} s",
                 limit=f"{station.name}.limits.min_crank_speed_rpm",
                 value=slowest,
             )

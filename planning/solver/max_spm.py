@@ -64,7 +64,9 @@ def _kinematic_first(search: Search, neighbour: Plan | None, ran: tuple[Ran, ...
         return False  # the motor limits the probe's plan: the drive NLP answers
     ran = tuple(r for r in ran if r.found is not None)  # a probe that found no plan: its start runs again here
     nlp = halves_nlp_for(search.case, drive=False)
-    kinematic = replace(search, nlp=nlp, parameters=nlp.layout.values(search.case), attempts=[], stop_on=MOTOR_LIMITS)
+    # its own bounds and scales (the probe's NLP may be the denser variant by now); the probe's work and plan kept
+    carried = {k: getattr(search, k) for k in ("t_start", "iterations", "starts", "best", "best_score")}
+    kinematic = replace(prepare(search.case, search.placement, nlp), **carried, stop_on=MOTOR_LIMITS)
     _multi_start(kinematic, neighbour, ran)
     search.iterations, search.starts = kinematic.iterations, kinematic.starts
     search.best, search.best_score = kinematic.best, kinematic.best_score

@@ -4,7 +4,7 @@ edit, a looser limit): whether it can answer this case, and whether its values c
 - It **answers** (:func:`can_answer`: a candidate, once its verification against this case passes) when it
   has this case's key angles (to ``SAME_ANGLE_RAD``), its motion law, a placement this case allows (a
   published-structure plan is also a free one) and a draw speed within this case's range (a case that
-  gives the draw speed takes no plan at another).
+  gives the draw speed takes no plan at another), and the case's hold at the bottom or none (``Plan.holds_as``).
 - It **starts** this case's NLP (:func:`can_start`) when it has the case's law (the NLP's variables are its
   law's), its NLP values, and a placement the case allows; its values start the NLP of its own placement.
 
@@ -37,7 +37,7 @@ def can_answer(plan: Plan, case: Case, placement: Placement, draw_speed_range: t
     same_angles = np.allclose(plan.key_angles, case.key_angles, rtol=0, atol=SAME_ANGLE_RAD)
     in_range = lo - SAME_SPEED_RAD_S <= w2 <= hi + SAME_SPEED_RAD_S
     same_law = plan.motion_law == case.planner.motion_law
-    return bool(same_angles and same_law and placement_allows(plan, placement) and in_range)
+    return bool(same_angles and same_law and placement_allows(plan, placement) and in_range and plan.holds_as(case))
 
 
 def can_start(plan: Plan | None, case: Case, placement: Placement) -> bool:

@@ -155,23 +155,35 @@ class ParameterLayout:
 
 def structure_values(case: Case) -> dict[str, float]:
     """The key angles, the die-height crossings (a crossing inside the draw is covered by the draw-speed
-    bound: its rows are switched off) and the mechanism's length unit."""
+    bound: its rows are switched off; a descending one in a hold's brake, after theta3, is held there: its
+    angle a turn back, as the NLP counts it from theta3) and the mechanism's length unit."""
     m = case.machine
     th1, th2, th3, th4 = case.key_angles
     down, up = (float(a) for a in m.angles_at_height(case.limits.die_height_mm))
+    braking = brake_crossing(case)
+    held = down < th2 or braking
     return {
         "theta1": th1,
         "theta2": th2,
         "theta3": th3,
         "theta4": th4,
-        "die_down_angle": down,
-        "die_down_slope": abs(float(m.derivatives(down)[0])) if down < th2 else 0.0,
-        "die_down_active": 1.0 if down < th2 else 0.0,
+        "die_down_angle": down - 2 * math.pi if braking else down,
+        "die_down_slope": abs(float(m.derivatives(down)[0])) if held else 0.0,
+        "die_down_active": 1.0 if held else 0.0,
         "die_up_angle": up,
         "die_up_slope": abs(float(m.derivatives(up)[0])) if up > th3 else 0.0,
         "die_up_active": 1.0 if up > th3 else 0.0,
         "length_unit": m.length_scale,
     }
+
+
+def brake_crossing(case: Case) -> bool:
+    """Whether the slide enters the die zone while the crank brakes to a hold (the descending die-height
+    crossing between theta3 and the hold's angle)."""
+    if case.hold_angle is None:
+        return False
+    down = float(case.machine.angles_at_height(case.limits.die_height_mm)[0])
+    return bool(case.key_angles[2] < down < case.hold_angle)
 
 
 def exit_values(case: Case) -> dict[str, float]:
@@ -252,10 +264,12 @@ def forming_values(case: Case) -> np.ndarray:
 
 
 def time_limit(case: Case) -> float:
-    """[s] the least upper bound on a time variable: every time of a cycle lies within one period, and the
-    crank never turns slower than the minimum crank speed, so the period is at most 2 pi / w_min; the bound
-    scales with the case, 600 s keeps the usual cases' numerics."""
-    return max(MAX_TIME_S, 1.01 * 2 * math.pi / (case.limits.min_crank_speed_rpm * RPM))
+    """[s] the least upper bound on a time variable: every time of a cycle lies within one period, at most the
+    longest the least crank speed allows (``Case.longest_cycle_s``); the bound scales with the case, 600 s
+    keeps the usual cases' numerics."""
+    if case.hold_angle is None:
+        return max(MAX_TIME_S, 1.01 * case.longest_cycle_s)
+    return max(MAX_TIME_S, 1.01 * (case.longest_cycle_s - case.standstill_s)) + case.standstill_s
 
 
 MAX_TIME_S = 600.0  # [s] least upper bound on a time variable (:func:`time_limit`)

@@ -17,6 +17,7 @@ from planning.model.laws import get_law
 from planning.model.laws import improved_scurve as sc
 from planning.model.limits import limits_of
 from planning.model.plan import Plan
+from planning.solver.parameters import brake_crossing
 
 
 def top_crank_speed(case: Case) -> float | None:
@@ -62,9 +63,18 @@ def guess(case: Case, w2: float, w1: float, peak_share: float, inside: float) ->
         "law_parameter": law.parameter.start if law.parameter else 0.0,
         "closing_time": t1,
         "opening_time": t4,
-        "die_down_time": 0.5 * (t1 + t_feed_end),
+        "die_down_time": braking_time(case, w2) if brake_crossing(case) else 0.5 * (t1 + t_feed_end),
         "die_up_time": 0.5 * (lead + t4),
     }
+
+
+def braking_time(case: Case, w2: float) -> float:
+    """[s from theta3] when the braking crank passes the descending die-height crossing (before a hold), as a
+    constant deceleration from ``w2`` to rest over the brake's angle would: a start for its time variable."""
+    th3 = float(case.key_angles[2])
+    down = float(case.machine.angles_at_height(case.limits.die_height_mm)[0])
+    share = (down - th3) / (case.hold_angle - th3)  # of the angle; the time's share is 1 - sqrt(1 - share)
+    return (1 - math.sqrt(1 - share)) * 2 * (case.hold_angle - th3) / w2
 
 
 def hold_lead(case: Case, w2: float) -> tuple[float, float, float]:

@@ -16,7 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from planning.model.limits.base import Check, Dense, Impossible, Limit
+from planning.model.laws import LAWS
+from planning.model.limits.base import Check, Dense, Draw, Impossible, Limit
 from planning.tolerances import HOLD_STILL_MM, HOLD_STILL_RAD_S, TIME_TOL_S
 
 
@@ -44,6 +45,20 @@ def longest_run_s(t: np.ndarray, inside: np.ndarray) -> tuple[float, float]:
     return best, start
 
 
+def least_rate(case: Any) -> float:
+    """The least peak acceleration of a half of ``case``'s law in units of ``|dv| / D``: at its fixed shape
+    parameter, else over :data:`RATE_GRID` values of the parameter's range."""
+    law = LAWS[case.planner.motion_law]
+    if law.parameter is None:
+        return float(law.peak_rate())
+    fixed = case.planner.law_parameter
+    values = [fixed] if fixed is not None else np.linspace(law.parameter.low, law.parameter.high, RATE_GRID)
+    return min(float(law.peak_rate(float(v))) for v in values)
+
+
+RATE_GRID = 101  # shape parameters over which a law's least peak acceleration is taken (least_rate)
+
+
 class HoldLimit(Limit):
     """The hold at the bottom: the crank stands, the slide within a micrometre of its hold height, for the hold
     time."""
@@ -66,6 +81,19 @@ class HoldLimit(Limit):
         check = Check.of(self.id, self.name, stood, limit, self.unit, "min", TIME_TOL_S)
         theta = float(np.interp(start, dense.t, dense.theta))
         return [check.located(np.array([start]), np.array([theta]), np.array([stood]), limit)]
+
+    def draw_speed_bound(self, draw: Draw) -> float | None:
+        """The highest draw speed [rad/s] the crank can brake from with the case's law under
+        ``limits.crank_accel_rad_s2`` = A: the brake is one half of the law from ``w`` to rest over
+        ``dtheta = theta_h - theta3`` (duration ``2 dtheta / w``), its peak acceleration ``rate w^2 / (2 dtheta)``
+        with the law's ``rate`` (the least over its shape parameter's range when the planner chooses it):
+        ``w <= sqrt(2 A dtheta / rate)``. None without a crank-acceleration limit."""
+        case = draw.case
+        top = case.limits.crank_accel_rad_s2
+        if top is None:
+            return None
+        brake = case.hold_angle - float(case.key_angles[2])
+        return math.sqrt(2 * top * brake / least_rate(case))
 
     def precheck(self, case: Any, given: float | None, lowest: float) -> Impossible | None:
         """A given draw speed ``w`` [rad/s] the crank cannot brake from: any motion from ``w`` to rest over the

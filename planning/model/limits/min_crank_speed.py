@@ -11,9 +11,10 @@ from pydantic import Field
 from planning.model.limits.base import BoundMesh, Check, Dense, Draw, Row, Transcription
 from planning.model.limits.canonical import SpeedCap
 from planning.model.units import RPM, CrankSpeed
-from planning.tolerances import SAME_RELATIVE
+from planning.tolerances import HOLD_STILL_RAD_S, SAME_RELATIVE
 
 IN_A_HOLD = "crank speed (forward, stopping only in the hold)"  # the check's name in a case with a hold
+IN_THE_STOP = "crank speed in the hold's stop (forward or standing)"  # and the stop's own
 
 
 class MinCrankSpeedLimit(SpeedCap):
@@ -48,14 +49,20 @@ class MinCrankSpeedLimit(SpeedCap):
 
     def check(self, dense: Dense) -> list[Check]:
         """The least crank speed over the cycle but the hold's planned stop (``Plan.in_planned_stop``): there
-        the crank brakes to rest, stands and rises again by design."""
-        stop = dense.plan.in_planned_stop(dense.theta)
+        the crank brakes to rest, stands and rises again by design, and only turns forward or stands (never
+        backwards beyond :data:`~planning.tolerances.HOLD_STILL_RAD_S`)."""
+        stop = dense.plan.in_planned_stop(dense.theta, dense.case)
         if not stop.any():
             return super().check(dense)
         moving = ~stop
         fields = ("t", "theta", "omega", "alpha", "jerk", "h", "v", "a", "slope")
         kept = {f: getattr(dense, f)[moving] for f in fields if getattr(dense, f) is not None}
-        return [replace(c, name=IN_A_HOLD) for c in super().check(replace(dense, **kept))]
+        out = [replace(c, name=IN_A_HOLD) for c in super().check(replace(dense, **kept))]
+        k = int(np.argmin(np.where(stop, dense.omega, np.inf)))
+        lowest = float(dense.omega[k]) / RPM
+        # at least "standing" (-HOLD_STILL_RAD_S): a standstill (0) is no binding limit of the strokes
+        forward = Check.of(self.id, IN_THE_STOP, lowest, -HOLD_STILL_RAD_S / RPM, self.unit, "min", 0.0)
+        return out + [forward.located(dense.t[k : k + 1], dense.theta[k : k + 1], np.array([lowest]), 1.0)]
 
     def bound_speeds(self, mesh: BoundMesh) -> tuple[np.ndarray | None, np.ndarray | None]:
         """None with a hold (the crank stops there, and where its stop begins and ends is the plan's: the bounds

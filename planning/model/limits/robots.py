@@ -103,7 +103,7 @@ def demands(case: Any, draw_speed: float) -> list[tuple[float, tuple[float, str]
     change)``: the shortest cycle (:func:`least_period_s`) within the longest; between the draws (from theta3 to
     theta2, the draw itself at ``draw_speed``) the robots' part there (:func:`between_draws_s`)."""
     w_min = case.limits.min_crank_speed_rpm * RPM
-    longest = 2 * np.pi / w_min
+    longest = case.longest_cycle_s
     _, th2, th3, _ = case.key_angles
     outside = longest - (th3 - th2) / draw_speed
     field = _slowest_field(case)
@@ -298,18 +298,23 @@ class RobotsLimit(Limit):
 
     def bound_rows(self, mesh: BoundMesh) -> list[tuple[Any, Any, Any]]:
         """For each height a tool needs: the intervals that reach it take at least the robots' time there;
-        the period at least the robots' shortest cycle (:func:`least_period_s`; module docstring)."""
+        the period at least the robots' shortest cycle (:func:`least_period_s`; module docstring). With a
+        hold the bounds cut its standstill out of the motion (``planning.solver.bound``): the standstill's
+        time counts towards the period and towards every height at or below the hold's, and the crank may
+        stop (no interval's time is capped by the least crank speed)."""
         case = mesh.case
         robots = robots_by_name(case)
         top = np.maximum(mesh.h[:-1], mesh.h[1:])  # an interval's highest slide position (h monotone on it)
-        rows = [(total(mesh.tau), least_period_s(case), np.inf)]
-        # the crank never slower than its minimum speed: each interval at most its angle at it (the robots'
-        # rows could otherwise stretch a cycle past the longest the limits allow)
-        w_min = case.limits.min_crank_speed_rpm * RPM
-        rows.append((mesh.tau - mesh.dtheta / w_min, -np.inf, 0.0))
+        stood = case.standstill_s
+        rows = [(total(mesh.tau), least_period_s(case) - stood, np.inf)]
+        if case.hold_angle is None:
+            # the crank never slower than its minimum speed: each interval at most its angle at it (the
+            # robots' rows could otherwise stretch a cycle past the longest the limits allow)
+            w_min = case.limits.min_crank_speed_rpm * RPM
+            rows.append((mesh.tau - mesh.dtheta / w_min, -np.inf, 0.0))
         for level in _levels(robots):
             above = np.flatnonzero(top >= level).tolist()
-            need = _time_needing(case, robots, level)
+            need = _time_needing(case, robots, level) - (stood if case.hold_height_mm >= level else 0.0)
             if need > 0 and above:  # (a level no node reaches: refused by the case's checks, above the stroke)
                 rows.append((total(mesh.tau[above]), need, np.inf))
         return rows
