@@ -133,6 +133,7 @@ def test_the_min_crank_speed_holds_everywhere_but_the_planned_stop():
     assert "min_crank_speed" in [c.id for c in evaluate(plan, stricter).verification.failures()]
 
 
+@pytest.mark.slow  # the certified bounds: about 10 s each
 def test_the_bounds_add_the_hold_and_stay_above_the_plan():
     """The time-optimal and the certified bound of the hold case, with a short and a long hold: above the
     verified plan (the hold's time added, the least crank speed left out)."""
@@ -321,6 +322,7 @@ def test_the_slide_entering_the_die_zone_while_braking_is_planned_there():
     assert solution.verification.check("die_speed").value <= case.limits.die_speed_mm_s * (1 + 1e-6)
 
 
+@pytest.mark.slow  # the certified bounds: about 10 s each
 def test_with_robots_the_certified_bound_counts_the_standstill():
     """The robots' loop binds a press with a 1 s hold: the certified upper bound is at least the verified plan
     (it counts the standstill's time in the robots' rows and lets the crank stop; a code review found it 9 %
