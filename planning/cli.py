@@ -661,7 +661,8 @@ def _bound(case, args) -> int:
     print(
         f"{case.name}: time-optimal bound {bound.spm:.3f} strokes/min, cycle {bound.cycle_time_s:.4f} s "
         f"({bound.points} intervals{_more_than_asked(bound.points, args.points)}; peak crank speed "
-        f"{data['peak_crank_speed_rpm']:.2f} rpm, draw {bound.draw_speed_rpm:.3f} rpm, "
+        f"{data['peak_crank_speed_rpm']:.2f} rpm, "
+        + (f"draw {bound.draw_speed_rpm:.3f} rpm, " if not case.free_draw else "the draw at its slide speed, ")
         + (f"idle time for the robots {bound.window_slack_s:.3f} s" if case.robots else "")
         + (f"idle time in the robot's window {bound.window_slack_s:.3f} s" if case.robots is None else "")
         + (f"; crank jerk <= {bound.crank_jerk_limit_rad_s3:g} rad/s^3" if bound.crank_jerk_limit_rad_s3 else "")

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 LIMIT_REL_TOL = 1e-6  # relative: a limit's dense check passes within this share of the limit (six digits:
 # more than any press's data has, far above the round-off of evaluating the closed forms)
+DRAW_SPEED_BAND = 1e-3  # relative: a draw at constant slide speed holds it within 0.1 % (the reports' band)
 HOLD_STILL_MM = 1e-3  # [mm] the slide stands at its hold height within a micrometre (the hold's check)
 HOLD_STILL_RAD_S = 1e-9  # [rad/s] the crank stands in a hold (a cam's standstill is still to round-off)
 TIME_TOL_S = 1e-6  # [s] a time limit (the robot's window, a target cycle time): a microsecond
@@ -98,6 +99,7 @@ AGREE_S = 1e-6  # [s] two starts whose best periods agree this closely have foun
 ACCEL_BACKOFF = 5e-4  # the NLPs hold |slider acceleration| <= (1 - this) x limit at their samples (the
 # acceleration peaks between samples by up to this much on the shipped cases)
 HARDER_BACKOFF = 5e-3  # the slider acceleration's back-off of a second round when no start verified
+DRAW_SPEED_BACKOFF = 1e-4  # the NLP holds a draw's set slide speed this much inside (within its 0.1 % band)
 SPEED_BACKOFF = 5e-4  # the NLPs hold |slider speed| <= (1 - this) x limit at their samples
 DRIVE_BACKOFF = 5e-5  # the NLPs hold the motor's peak and RMS torque this much inside (refined if exceeded)
 GRID_BACKOFF = 5e-5  # the NLPs hold the grid's peak this much inside (refined if exceeded)

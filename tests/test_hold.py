@@ -225,6 +225,7 @@ def _with_hold(seed: int) -> dict:
     return data
 
 
+@pytest.mark.slow  # twelve presses: the normal run keeps under 5 minutes
 @pytest.mark.parametrize("seed", range(12))
 def test_random_presses_with_a_hold_plan_it_or_say_why(seed):
     """Random crank-slider presses with a hold: a plan is verified and its re-sampled motion (every

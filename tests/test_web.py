@@ -815,3 +815,24 @@ def test_a_hold_is_shown_and_its_time_edited_with_the_mouse_and_keys(page) -> No
     assert page.locator("#spm").inner_text() == f"{solve(longer).plan.spm:.3f}"
     assert "stands 0.5000 s" in page.locator("#summary").inner_text()
     screenshot(page, "web-hold")
+
+
+@browser
+def test_a_draw_at_slide_speed_is_planned_and_its_speed_edited_with_the_mouse_and_keys(page) -> None:
+    """The cup drawn at 60 mm/s (the optimal law's free draw): the page's strokes are the CLI's and its summary
+    says where the slide holds its speed; the speed clicked, typed (45) and left with Tab gives the CLI's plan."""
+    pick_case(page, "cup-slide-speed-draw.yaml")
+    data = load_yaml((CASES / "cup-slide-speed-draw.yaml").read_text(encoding="utf-8"))
+    label = "cases/cup-slide-speed-draw.yaml"
+    assert page.locator("#spm").inner_text() == f"{solve(case_from_data(copy.deepcopy(data), label)).plan.spm:.3f}"
+    page.locator("#summary").locator("xpath=..").locator("summary").click()  # the summary unfolded
+    assert "draw at 60 mm/s slide speed: within 0.1 %" in page.locator("#summary").inner_text()
+    before = int(page.evaluate("document.body.dataset.rendered"))
+    page.locator('[data-field="process.draw_slide_speed_mm_s"]').click(click_count=3)
+    page.keyboard.type("45")
+    page.keyboard.press("Tab")
+    wait_rendered(page, before)
+    data["process"]["draw_slide_speed_mm_s"] = 45.0
+    assert page.locator("#spm").inner_text() == f"{solve(case_from_data(data, label)).plan.spm:.3f}"
+    assert "draw at 45 mm/s slide speed" in page.locator("#summary").inner_text()
+    screenshot(page, "web-slide-draw")

@@ -36,6 +36,7 @@ from planning.model.units import (
     Offset,
     Seconds,
     ShapeValue,
+    SliderSpeed,
     SourceDuration,
     SourceNumber,
     SourceSpeed,
@@ -253,6 +254,14 @@ class ProcessModel(_Model):
             "from θ2 to BDC. Needs a drive to matter."
         ),
     )  # [[height above BDC mm, force kN], ...], linear between points
+    draw_slide_speed_mm_s: SliderSpeed | None = Field(
+        None,
+        title="draw at slide speed [mm/s]",
+        description=(
+            "A draw at constant slide speed: the slide's speed from θ2 to θ3 held at this, as far as the crank's "
+            "limits allow near BDC (the optimal law; instead of draw_speed_rpm); empty: a constant crank speed."
+        ),
+    )
     hold_time_s: Annotated[float, Field(ge=1e-3, le=MAX_HOLD_S)] | None = Field(
         None,
         title="hold at the bottom [s]",
@@ -590,6 +599,12 @@ class Case(_Model):
         return self.process.hold_height_mm or 0.0
 
     @property
+    def free_draw(self) -> bool:
+        """The draw runs at a constant slide speed (``process.draw_slide_speed_mm_s``): the optimal law plans the
+        crank's speed through it, no constant draw speed."""
+        return self.process.draw_slide_speed_mm_s is not None
+
+    @property
     def longest_cycle_s(self) -> float:
         """[s] the longest cycle the least crank speed allows: a turn at it; with a hold the crank stops, and
         the brake and the rise from rest each sweep less than a turn at an average speed of at least half the
@@ -675,6 +690,7 @@ class Case(_Model):
         case = self.model_copy(update={"planner": planner})
         _law_checks(case)
         _hold_checks(case)
+        _slide_draw_checks(case)
         _objective_checks(case)
         return case
 
@@ -700,6 +716,7 @@ def cross_checks(case: Case) -> None:
             )
     _transfer_checks(case)
     _hold_checks(case)
+    _slide_draw_checks(case)
     for limit in LIMITS:
         limit.validate(case)
     fixed = case.planner.law_parameter
@@ -907,6 +924,28 @@ def _hold_checks(case: Case) -> None:
     if not hold_deg < k.opening_deg:
         reason = f"must lie after the hold at {hold_deg:.2f} deg (process.hold_height_mm = {case.hold_height_mm:g})"
         raise CaseError("key_points.opening_deg", reason, k.opening_deg)
+
+
+def _slide_draw_checks(case: Case) -> None:
+    """A draw at constant slide speed: planned by the optimal law (its draw a free profile; a law's halves end at
+    a constant crank speed), without a given draw speed, a hold or (not yet) a drive or robots."""
+    speed = case.process.draw_slide_speed_mm_s
+    if speed is None:
+        return
+    if LAWS[case.planner.motion_law].transcription == HALVES:
+        reason = (
+            "a draw at constant slide speed is planned by the optimal law (planner.motion_law: optimal, with "
+            "limits.crank_jerk_rad_s3); a law with halves draws at a constant crank speed"
+        )
+        raise CaseError("planner.motion_law", reason, case.planner.motion_law)
+    for key, what in (("draw_speed_rpm", "a constant crank speed"), ("hold_time_s", "a hold at the bottom")):
+        if getattr(case.process, key) is not None:
+            reason = f"and process.draw_slide_speed_mm_s ask for two draws: {what} or a constant slide speed"
+            raise CaseError(f"process.{key}", reason, getattr(case.process, key))
+    for section in ("drive", "robots"):
+        if getattr(case, section) is not None:
+            reason = f"a draw at constant slide speed is planned without a {section}: section yet"
+            raise CaseError(section, reason, "given")
 
 
 def _law_checks(case: Case) -> None:

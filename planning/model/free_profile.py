@@ -4,7 +4,9 @@ The cycle starts at theta3 with the draw speed w2 and zero acceleration and runs
 of segments of constant jerk ``j_k`` [rad/s^3]: the return (theta3 -> theta4, :data:`PHASES` gives the
 number of segments), the robot's window (theta4 -> theta1) and the feed (theta1 -> theta2), every
 segment of a phase lasting the phase's step ``h`` [s]; it arrives at theta2 + 2 pi with w2 and zero
-acceleration and draws at w2 to theta3.
+acceleration and draws at w2 to theta3. A draw at constant slide speed (``Case.free_draw``) is a fourth phase
+(:data:`DRAW_PHASE`, theta2 + 2 pi -> theta3 + 2 pi): the cycle then starts at theta3 with the speed ``w2`` and the
+acceleration ``draw_accel`` it returns to there (:data:`FREE_DRAW`).
 The acceleration is continuous everywhere (piecewise linear); the jerk steps at the knots. There are no
 halves, peaks or dwell: :class:`FreeProfileParameters` reports what a press engineer reads off any
 plan (speed at TDC, highest speed before and after the draw, peak acceleration and jerk).
@@ -22,6 +24,18 @@ from planning.model.profile import Profile, Segment, knot_states
 
 Layout = tuple[tuple[str, int], ...]  # (phase, segments) in the order theta3 -> theta4 -> theta1 -> theta2
 PHASES: Layout = (("return", 40), ("transfer", 24), ("feed", 40))  # the layout every solve starts with
+DRAW_PHASE = ("draw", 40)  # a draw at constant slide speed: the crank's speed planned through it too
+FREE_DRAW: Layout = (*PHASES, DRAW_PHASE)  # the first layout of a case whose draw is free (Case.free_draw)
+
+
+def first_layout(free_draw: bool) -> Layout:
+    """The layout a solve starts with: :data:`PHASES`, or :data:`FREE_DRAW` for a draw at constant slide speed."""
+    return FREE_DRAW if free_draw else PHASES
+
+
+def draws_freely(layout: Layout) -> bool:
+    """Whether ``layout`` plans the draw as a phase of its own (a draw at constant slide speed)."""
+    return any(phase == DRAW_PHASE[0] for phase, _ in layout)
 FINE_FACTOR = 2.5  # the finer layout: this many times the segments of each phase (finer)
 
 
@@ -37,11 +51,17 @@ def free_segments(durations, jerks, layout: Layout = PHASES) -> list[Segment]:  
 
 
 def closed_jerks(
-    durations: tuple[float, ...], jerks: tuple[float, ...], w2: float, ends: tuple[float, ...], layout: Layout
+    durations: tuple[float, ...],
+    jerks: tuple[float, ...],
+    w2: float,
+    ends: tuple[float, ...],
+    layout: Layout,
+    a0: float = 0.0,
 ) -> tuple[float, ...]:
     """The jerks [rad/s^3] nearest ``jerks`` (least squares) with which the profile from theta3 (speed ``w2``,
-    no acceleration) meets its ends exactly: each phase's end angle ``ends`` [rad] (theta4, theta1 + 2 pi,
-    theta2 + 2 pi, counted on from theta3's), and the speed ``w2`` with no acceleration at the last.
+    acceleration ``a0``: 0 but for a free draw) meets its ends exactly: each phase's end angle ``ends`` [rad]
+    (theta4, theta1 + 2 pi, theta2 + 2 pi, with a free draw theta3 + 2 pi, counted on from theta3's), and the
+    speed ``w2`` with the acceleration ``a0`` at the last.
 
     The NLP joins its shooting nodes to IPOPT's constraint tolerance, so the profile propagated through the
     segments' closed forms gathers their defects at its end (1e-9 rad/s of speed over 104 segments: more than
@@ -59,13 +79,14 @@ def closed_jerks(
         gain[:index] = T[:index] ** 3 / 6 + T[:index] ** 2 * after / 2 + T[:index] * after**2 / 2
         rows.append(gain)
         targets.append(target)
-        values.append(w2 * float(np.sum(T[:index])) + float(gain @ j))  # the angle past theta3 there
+        span = float(np.sum(T[:index]))
+        values.append(w2 * span + a0 * span**2 / 2 + float(gain @ j))  # the angle past theta3 there
         if end == len(cut) - 1:
             speed = np.zeros_like(T)
             speed[:index] = T[:index] ** 2 / 2 + T[:index] * after
             rows += [speed, np.where(np.arange(T.size) < index, T, 0.0)]
-            targets += [w2, 0.0]
-            values += [w2 + float(speed @ j), float(T[:index] @ j[:index])]
+            targets += [w2, a0]
+            values += [w2 + a0 * span + float(speed @ j), a0 + float(T[:index] @ j[:index])]
     A, residual = np.array(rows), np.array(values) - np.array(targets)
     correction = np.linalg.lstsq(A, residual, rcond=None)[0]  # the least-norm one (least squares if degenerate)
     return tuple((j - correction).tolist())
@@ -88,28 +109,37 @@ class FreeProfileParameters:
     transfer_dwell: float = 0.0
     law_parameter: float = 0.0
     layout: Layout = PHASES
+    draw_accel: float = 0.0  # [rad/s^2] at theta3: a free draw's (0 after a draw at constant crank speed)
 
     def segments(self) -> list[Segment]:
         return free_segments(self.durations, self.jerks, self.layout)
 
     @property
+    def free_draw(self) -> bool:
+        """The draw is a phase of the profile (a draw at constant slide speed), ``draw_speed`` the speed at
+        theta3."""
+        return draws_freely(self.layout)
+
+    @property
     def draw_time(self) -> float:
+        if self.free_draw:
+            return float(sum(self.durations[-dict(self.layout)[DRAW_PHASE[0]] :]))
         return (self.draw_end - self.draw_start) / self.draw_speed
 
     @property
     def period(self) -> float:
-        return float(sum(self.durations)) + self.draw_time
+        return float(sum(self.durations)) + (0.0 if self.free_draw else self.draw_time)
 
     def _knots(self) -> np.ndarray:
-        return np.array(knot_states(self.draw_end, self.draw_speed, 0.0, self.segments()), dtype=float)
+        return np.array(knot_states(self.draw_end, self.draw_speed, self.draw_accel, self.segments()), dtype=float)
 
     def _speeds(self) -> tuple[float, float, float]:
         """Speed at TDC, highest speed on the return side (theta3 -> TDC) and the feed side (TDC -> theta2)."""
-        profile = Profile(tuple(self.segments()), self.draw_end, self.draw_speed)
+        profile = Profile(tuple(self.segments()), self.draw_end, self.draw_speed, self.draw_accel)
         t = np.linspace(0.0, profile.duration, 4001)
         th, om, _, _ = profile.at_time(t)
         tdc = profile.time_at_angle(2 * math.pi)
-        return_side, feed_side = t <= tdc, t >= tdc
+        return_side, feed_side = t <= tdc, (t >= tdc) & (th <= self.draw_start + 2 * math.pi)  # not a free draw
         w_tdc = float(profile.at_time(tdc)[1])
         return w_tdc, float(np.max(om[return_side], initial=w_tdc)), float(np.max(om[feed_side], initial=w_tdc))
 

@@ -10,7 +10,7 @@ import numpy as np
 
 from planning.model.case import Placement
 from planning.model.cycle import CycleParameters, cycle_segments
-from planning.model.free_profile import FreeProfileParameters, Layout, closed_jerks
+from planning.model.free_profile import FreeProfileParameters, Layout, closed_jerks, draws_freely
 from planning.model.laws import DEFAULT_LAW
 from planning.model.profile import Profile, Segment, advance_segment, knot_states, split_segment
 from planning.tolerances import ANGLE_TOL_RAD, KNOT_TIME_S, TIME_TOL_S, TINY
@@ -123,10 +123,11 @@ def profile_from_tdc(params: CycleParameters) -> Profile:
     )
 
 
-def rotate_to_tdc(segs: list, th3: float, w2: float) -> Profile:
-    """The cycle of numeric segments ``segs`` laid out from theta3 [rad] at speed ``w2`` [rad/s] (zero
-    acceleration) as a profile from TDC over one period; the segment holding TDC is split."""
-    states = knot_states(th3, w2, 0.0, segs)
+def rotate_to_tdc(segs: list, th3: float, w2: float, a3: float = 0.0) -> Profile:
+    """The cycle of numeric segments ``segs`` laid out from theta3 [rad] at speed ``w2`` [rad/s] and
+    acceleration ``a3`` [rad/s^2] (0 but after a free draw) as a profile from TDC over one period; the segment
+    holding TDC is split."""
+    states = knot_states(th3, w2, a3, segs)
     two_pi = 2 * math.pi
     k = next(i for i in range(len(segs)) if states[i + 1][0] >= two_pi)
     probe = Profile((segs[k],), *states[k])
@@ -167,11 +168,16 @@ def plan_of(
             jerks += [values[f"{phase}_jerk_{k}"] for k in range(n)]
         # the phases' ends met exactly: the shooting's defects gathered at the end taken out (closed_jerks)
         ends = (th4 - th3, th1 + 2 * math.pi - th3, th2 + 2 * math.pi - th3)
-        jerks = closed_jerks(tuple(durations), tuple(jerks), values["draw_speed"], ends, layout)
-        params = FreeProfileParameters(tuple(durations), tuple(jerks), values["draw_speed"], th2, th3, layout=layout)
+        free = draws_freely(layout)  # a draw at constant slide speed: a phase of its own, from theta3's accel
+        a0 = values.get("draw_accel", 0.0) if free else 0.0
+        ends += (2 * math.pi,) if free else ()
+        jerks = closed_jerks(tuple(durations), tuple(jerks), values["draw_speed"], ends, layout, a0)
+        params = FreeProfileParameters(
+            tuple(durations), tuple(jerks), values["draw_speed"], th2, th3, layout=layout, draw_accel=a0
+        )
         segs = [seg for seg in params.segments() if seg.duration > 0]
-        draw = Segment("draw:constant", params.draw_time, 0.0, 0.0)
-        profile = rotate_to_tdc([*segs, draw], th3, params.draw_speed)
+        segs += [] if free else [Segment("draw:constant", params.draw_time, 0.0, 0.0)]
+        profile = rotate_to_tdc(segs, th3, params.draw_speed, a0)
     plan = Plan(params, profile, (th1, th2, th3, th4), placement, info, motion_law=params.motion_law)
     t = plan.key_times()
     structure = {"closing": plan.segment_at(float(t[0])), "opening": plan.segment_at(float(t[3]))}

@@ -13,8 +13,10 @@ from planning.model.limits.base import Check, Draw
 from planning.model.limits.robot_window import radians_hint
 from planning.model.plausibility import warnings_of
 from planning.model.units import rounded_down
-from planning.tolerances import SAME_SCORE
+from planning.tolerances import SAME_SCORE, TINY
 
+# the checks (limit ids) that take the draw at one crank speed: not for a draw at constant slide speed
+AT_CONSTANT_DRAW = ("die_speed", "slider_speed", "slider_accel")
 ROUND_OFF = SAME_SCORE  # relative: a check at the highest draw speed sits on its limit up to floating-point round-off
 
 
@@ -25,6 +27,8 @@ def check_case(case: Case) -> dict[str, Any]:
     bounds = draw_speed_bounds(case)
     w_max = min(bounds.values())
     w2 = case.process.draw_speed_rpm * RPM if case.process.draw_speed_rpm is not None else w_max
+    if case.free_draw:  # the crank's speed at theta2 where the slide enters the draw at its set speed
+        w2 = case.process.draw_slide_speed_mm_s / abs(float(m.derivatives(case.key_angles[1])[0]))
     th = case.key_angles
     h, v, _, _ = m.slider(th, w2)
     points = [
@@ -39,6 +43,8 @@ def check_case(case: Case) -> dict[str, Any]:
     ]
     draw = Draw.of(case)
     checks = [_check(c) for limit in limits_of(case) for c in limit.at_draw_speed(draw, w2)]
+    if case.free_draw:  # no constant draw speed: the checks that assume one left out (the slide's speed in it)
+        checks = [c for c in checks if c["id"] not in AT_CONSTANT_DRAW]
     bdc = math.degrees(m.bdc_angle)
     return {
         "case": case.name,
@@ -63,6 +69,23 @@ def check_case(case: Case) -> dict[str, Any]:
         "max_draw_speed_by_limit_rpm": {k: (b / RPM if math.isfinite(b) else None) for k, b in bounds.items()},
         "warnings": warnings(case),
         **({"hold": _hold(case)} if case.hold_angle is not None else {}),
+        **({"slide_draw": _slide_draw(case, draw)} if case.free_draw else {}),
+    }
+
+
+def _slide_draw(case: Case, draw: Draw) -> dict[str, Any]:
+    """A draw at constant slide speed v: the crank's speed it asks, ``v / |dh/dtheta|``, at theta2 and its
+    highest over the draw [rpm], and the first angle [deg] where that is above the crank's top speed (the
+    limits' lowest, ``Limit.top_crank_speed``), or None: from there the crank's limits cap the slide's speed."""
+    v = case.process.draw_slide_speed_mm_s
+    asked = v / np.maximum(np.abs(draw.d1), TINY)
+    tops = [t for limit in limits_of(case) if (t := limit.top_crank_speed(case)) is not None]
+    over = np.flatnonzero(asked > min(tops)) if tops else np.array([], dtype=int)
+    return {
+        "set_mm_s": v,
+        "crank_at_draw_start_rpm": float(asked[0]) / RPM,
+        "highest_asked_rpm": float(np.max(asked)) / RPM,
+        "capped_from_deg": float(math.degrees(draw.theta[over[0]])) if over.size else None,
     }
 
 
@@ -114,6 +137,8 @@ def _rpm(value: float, given: str) -> str:
 def check_text(report: dict[str, Any]) -> str:
     """Console table of a :func:`check_case` report."""
     given = "given" if report["draw_speed_given"] else "highest allowed"
+    if report.get("slide_draw"):
+        given = "the slide's set speed at theta2"
     p = report["press"]
     lines = [
         f"{report['case']}: key points at the draw speed {_rpm(report['draw_speed_rpm'], given)} rpm ({given})",
@@ -135,6 +160,17 @@ def check_text(report: dict[str, Any]) -> str:
             f"  hold: the slide stands {hold['time_s']:g} s at {hold['height_mm']:g} mm above BDC (crank at "
             f"{hold['angle_deg']:.2f} deg), the crank braking to it over {hold['brake_deg']:.2f} deg from theta3"
         )
+    slide = report.get("slide_draw")
+    if slide:
+        capped = (
+            f"; above the crank's top speed from {slide['capped_from_deg']:.2f} deg: its limits cap the slide there"
+            if slide["capped_from_deg"] is not None
+            else ""
+        )
+        lines.append(
+            f"  draw at {slide['set_mm_s']:g} mm/s slide speed: the crank at {slide['crank_at_draw_start_rpm']:.3f} rpm"
+            f" at theta2, asked up to {slide['highest_asked_rpm']:.4g} rpm in the draw{capped}"
+        )
     lines += ["", "  checks"]
     for c in report["checks"]:
         mark = "PASS" if c["passed"] else "FAIL"
@@ -146,6 +182,7 @@ def check_text(report: dict[str, Any]) -> str:
         for k, v in report["max_draw_speed_by_limit_rpm"].items()
         if v is not None
     )
-    lines += ["", f"  highest draw speed the limits allow: {rounded_down(report['max_draw_speed_rpm'])} rpm ({by})"]
+    if not slide:  # a draw at constant slide speed has no constant draw speed
+        lines += ["", f"  highest draw speed the limits allow: {rounded_down(report['max_draw_speed_rpm'])} rpm ({by})"]
     lines += [f"  WARNING: {w}" for w in report["warnings"]]
     return "\n".join(lines)

@@ -118,7 +118,10 @@ def compare_laws(case: Case, laws: tuple[str, ...] = tuple(LAWS)) -> tuple[dict[
             except (CaseError, CaseFileError) as exc:  # e.g. an objective at a rate, which it does not plan
                 variant, note = None, {"reason": str(exc)}
         else:
-            variant = case.with_law(law)
+            try:
+                variant = case.with_law(law)
+            except CaseError as exc:  # a law that cannot plan the case's draw (a draw at constant slide speed)
+                variant, note = None, {"reason": str(exc)}
         outcome, message = Outcome.VERIFIED, ""
         if variant is None:
             outcome, message = Outcome.BAD_INPUT, note.pop("reason")

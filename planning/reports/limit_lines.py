@@ -26,6 +26,7 @@ COLOURS = {  # by case field, the figures' and the page's; the curve a limit bou
     "limits.slider_speed_mm_s": "#2e8b57",
     "limits.draw_start_speed_mm_s": "#006400",
     "limits.slider_accel_mm_s2": "#cc5500",
+    "process.draw_slide_speed_mm_s": "#9acd32",  # a draw at constant slide speed
     "robots.unloader": "#d62728",  # matplotlib's tab:red and tab:green, as the interference figure's
     "robots.loader": "#2ca02c",
 }
@@ -120,6 +121,13 @@ def limit_lines(result: dict[str, Any], columns: dict[str, np.ndarray], axis: st
         value = lim.get(key)
         if value is not None:
             add(f"limits.{key}", f"limits.{key} = " + text.format(v=value), quantity, value, where, both)
+    v_draw = proc.get("draw_slide_speed_mm_s")
+    if v_draw is not None:  # a draw at constant slide speed: its set speed over theta2 ... theta3
+        keys = {k["name"]: k["angle_deg"] for k in result["key_points"]}
+        angle = np.mod(np.asarray(columns["crank_angle_deg"], dtype=float), 360.0)
+        drawing = (angle >= keys["draw_start"]) & (angle <= keys["draw_end"])
+        label = f"process.draw_slide_speed_mm_s = ±{v_draw:g} mm/s (θ2 → θ3)"
+        add("process.draw_slide_speed_mm_s", label, "slider_speed_mm_s", v_draw, drawing, both=True)
     v2 = lim.get("draw_start_speed_mm_s")
     if v2 is not None:
         keys = {k["name"]: k for k in result["key_points"]}

@@ -56,6 +56,7 @@ key_points:                          # crank angle from TDC [deg], in this order
     + "  # draw_speed_rpm: 6.7              # a fixed crank speed for the draw; leave out to let the planner choose\n"
     + "  # hold_time_s: 0.3                 # a hold at the bottom (coining): the slide stands this long after the\n"
     + "  # hold_height_mm: 0                #   draw, here at BDC (theta3 must lie before it: docs/modes.md)\n"
+    + "  # draw_slide_speed_mm_s: 60        # or the draw at a constant slide speed (planner.motion_law: optimal)\n"
     + _SIDE_PANEL_LIMITS
     + """\
   # crank_speed_rpm: 30              # optional: the crank's top speed, acceleration, jerk, the slide's top

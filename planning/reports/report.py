@@ -14,8 +14,9 @@ import numpy as np
 from planning.model.case import KEY_POINT_NAMES, RPM, Case
 from planning.model.cycle import HALVES
 from planning.model.laws.improved_scurve import ImprovedSCurve
-from planning.model.limits import draw_speed_bounds
+from planning.model.limits import draw_speed_bounds, field_of
 from planning.model.limits.capacity import curve, has_curve, tonnage_use, torque_capacity_kNm
+from planning.model.limits.draw_slide_speed import DrawSlideSpeedLimit, held_band
 from planning.model.limits.slider_accel import SliderAccelLimit
 from planning.model.outcome import Outcome
 from planning.model.plan import Plan
@@ -41,7 +42,8 @@ TRAJECTORY_COLUMNS = (
 )
 DRIVE_COLUMNS = ("crank_torque_Nm", "motor_speed_rpm", "motor_torque_Nm", "motor_power_kW")  # with a drive
 POWER_COLUMNS = ("copper_loss_kW", "bus_power_kW", "grid_power_kW", "storage_energy_kJ")  # drive.electrical
-HOLD_FIELDS = {"hold_time_s", "hold_height_mm"}  # result.json's process: without a hold, as before it had one
+# result.json's process: the motion modes' fields only where set (a rotary case's as before the modes)
+MODE_FIELDS = ("hold_time_s", "hold_height_mm", "draw_slide_speed_mm_s")
 MAX_ROWS = 200_000  # trajectory rows at most: a cycle longer than 200 s gets a step of period / MAX_ROWS
 
 
@@ -166,10 +168,11 @@ def result_dict(solution: Solution, case: Case) -> dict[str, Any]:
         "segment_count": len(plan.profile.segments),
         "transfer_dwell_s": float(p.transfer_dwell),
         **({"hold": hold_block(plan, case)} if getattr(p, "has_hold", False) else {}),
+        **({"draw_slide_speed": slide_draw_block(solution, case)} if case.free_draw else {}),
         "transfer_window_s": plan.transfer_window(),
         "max_abs_slider_accel_mm_s2": accel.value,
         "binding_constraints": binding(solution),
-        "process": case.process.model_dump(exclude=set() if case.hold_angle is not None else HOLD_FIELDS),
+        "process": case.process.model_dump(exclude={k for k in MODE_FIELDS if getattr(case.process, k) is None}),
         "limits": case.limits.model_dump(),
         "key_points": key_points(solution),
         "segments": segments(solution),
@@ -305,6 +308,21 @@ def _plan_lines(r: dict[str, Any]) -> list[str]:
         f"{r['transfer_window_s']:.4f} s; "
         f"max |slider accel| {r['max_abs_slider_accel_mm_s2']:.1f} mm/s^2",
         *_hold_lines(r),
+        *_slide_draw_lines(r),
+    ]
+
+
+def _slide_draw_lines(r: dict[str, Any]) -> list[str]:
+    """A draw at constant slide speed: where the plan holds it, and what caps it beyond (none without one)."""
+    d = r.get("draw_slide_speed")
+    if not d:
+        return []
+    if d["held_from_deg"] is None:
+        return [f"  draw at {d['set_mm_s']:g} mm/s slide speed: never within 0.1 % of it (the crank's limits)"]
+    capped = f"; beyond, {', '.join(d['capped_by'])} cap it" if d["capped_by"] else ""
+    return [
+        f"  draw at {d['set_mm_s']:g} mm/s slide speed: within 0.1 % from {d['held_from_deg']:.2f} to "
+        f"{d['held_to_deg']:.2f} deg ({d['held_share_pct']:.0f} % of the draw's angle){capped}"
     ]
 
 
@@ -342,8 +360,35 @@ def hold_block(plan: Plan, case: Case) -> dict[str, float]:
     }
 
 
+def slide_draw_block(solution: Any, case: Case) -> dict[str, Any]:
+    """``result.json``'s draw at constant slide speed: the set speed [mm/s], the longest stretch of the draw the
+    plan holds it within :data:`~planning.tolerances.DRAW_SPEED_BAND` (``held_from_deg`` ... ``held_to_deg``, its
+    share of the draw's angle) and the limits binding in the draw after it (the crank's, which cap it)."""
+    dense = solution.evaluation.samples
+    run = held_band(case, dense.theta, dense.v)
+    _, th2, th3, _ = case.key_angles
+    t3 = float(dense.key_times[2])
+    if run is None:
+        held, share, after = (None, None), 0.0, float(dense.key_times[1])
+    else:
+        ends = np.mod(dense.theta[list(run)], 2 * math.pi)
+        held, share, after = tuple(np.degrees(ends).tolist()), 100 * (ends[1] - ends[0]) / (th3 - th2), dense.t[run[1]]
+    binding = [c for c in solution.verification.binding() if c.id != DrawSlideSpeedLimit.id and c.peak is not None]
+    capping = {field_of(c.id) or c.name for c in binding if any(a <= t3 and b >= after for a, b in c.peak.spans)}
+    return {
+        "set_mm_s": case.process.draw_slide_speed_mm_s,
+        "held_from_deg": held[0],
+        "held_to_deg": held[1],
+        "held_share_pct": float(share),
+        "capped_by": sorted(capping),
+    }
+
+
 def _draw_words(r: dict[str, Any]) -> str:
-    """Whose the draw speed is: the case's, or the planner's choice up to the highest the limits allow."""
+    """Whose the draw speed is: the case's, or the planner's choice up to the highest the limits allow (a draw at
+    constant slide speed: the crank's speed at theta3)."""
+    if r.get("draw_slide_speed"):
+        return " (at theta3: the slide's speed is set)"
     if r.get("draw_speed_given", True):
         return " (given)"
     if r["draw_speed_rpm"] >= r["draw_speed_highest_rpm"] * (1 - BINDING_SHARE):

@@ -77,7 +77,7 @@ class Bound:
             "cycle_time_s": self.cycle_time_s,
             "points": self.points,
             "window_slack_s": self.window_slack_s,
-            "draw_speed_rpm": self.draw_speed_rpm,
+            "draw_speed_rpm": self.draw_speed_rpm if math.isfinite(self.draw_speed_rpm) else None,  # a free draw
             "peak_crank_speed_rpm": float(np.max(self.crank_speed_rpm)),
             "wall_time_s": self.wall_time_s,
             "crank_jerk_limit_rad_s3": self.crank_jerk_limit_rad_s3,
@@ -145,7 +145,7 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
     th1, th2, th3, th4 = case.key_angles
     limits = limits_of(case)
 
-    draw = np.flatnonzero((th[:-1] >= th2 - SAME_ANGLE_RAD) & (th[:-1] <= th3 + SAME_ANGLE_RAD))
+    draw = draw_nodes(case, th)
     window = th[:-1] >= th4 - SAME_ANGLE_RAD  # the grid starts at theta1: the robot window is [theta4, theta1 + 2 pi)
     mesh = BoundMesh(case, th, h, d1, d2, dth, window)
     lbx_s, ubx_s = node_speed_bounds(mesh, limits, draw, w2_lo, w2_hi)
@@ -199,6 +199,15 @@ def time_optimal_bound(case: Case, points: int = DEFAULT_POINTS) -> Bound:
         wall_time_s=time.perf_counter() - t_start,
         crank_jerk_limit_rad_s3=lim.crank_jerk_rad_s3,
     )
+
+
+def draw_nodes(case: Case, theta: np.ndarray) -> np.ndarray:
+    """The nodes of the grid ``theta`` [rad] in the draw at one constant speed, theta2 ... theta3; none for a
+    draw at constant slide speed (its speed free, under the slide's cap: ``planning.model.limits.
+    draw_slide_speed``)."""
+    _, th2, th3, _ = case.key_angles
+    nodes = np.flatnonzero((theta[:-1] >= th2 - SAME_ANGLE_RAD) & (theta[:-1] <= th3 + SAME_ANGLE_RAD))
+    return nodes[:0] if case.free_draw else nodes
 
 
 def node_speed_bounds(

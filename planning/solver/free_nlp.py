@@ -3,8 +3,10 @@
 Outside the constant-speed draw the crank follows segments of constant jerk ``|j_k| <= J`` (``J`` =
 ``limits.crank_jerk_rad_s3``, required for this law) in three phases
 (``planning.model.free_profile.PHASES``): the return theta3 -> theta4, the robot's window theta4 ->
-theta1 and the feed theta1 -> theta2, each of equal steps ``h`` [s] of its own. Multiple shooting: the
-state (angle, speed, acceleration) at every knot is a variable, and each segment's closed form ties
+theta1 and the feed theta1 -> theta2, each of equal steps ``h`` [s] of its own. A draw at constant slide speed
+is a fourth phase, theta2 -> theta3 (``free_profile.FREE_DRAW``): the speed and the acceleration at theta3 are
+variables the cycle closes on, the draw's samples (the last) hold the slide's speed and every limit. Multiple
+shooting: the state (angle, speed, acceleration) at every knot is a variable, and each segment's closed form ties
 it to the next, so the NLP is sparse and the acceleration continuous everywhere. Fixed: theta3, w2
 and zero acceleration at the start, theta4 and theta1 at the phase boundaries, theta2 + 2 pi, w2 and
 zero acceleration at the end. Minimised: the cycle time. The jerk limit is the bounds of the
@@ -25,8 +27,8 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-from planning.model.case import Case
-from planning.model.free_profile import PHASES, Layout
+from planning.model.case import RPM, Case
+from planning.model.free_profile import FREE_DRAW, PHASES, Layout, draws_freely
 from planning.model.limits.base import Extremes, Transcription
 from planning.model.plan import Plan, SolverInfo, plan_of
 from planning.model.profile import advance
@@ -50,7 +52,7 @@ from press.mechanism import Formula
 # the limits are held at every knot and at evenly spaced points inside each segment, this many per
 # segment (knot included) in each phase: the robot's window has the longest segments and the highest
 # speeds (around TDC, where the slider acceleration peaks), so it is sampled finer
-SAMPLES_PER_SEGMENT = {"return": 4, "transfer": 8, "feed": 4}
+SAMPLES_PER_SEGMENT = {"return": 4, "transfer": 8, "feed": 4, "draw": 4}
 STATES = ("angle", "speed", "accel")
 TOP_SPEED = 1e3  # [rad/s] upper bound of the crank speeds (far above any press)
 # a re-solve with a refined limit starts nearer the optimum than the laws' (about half the iterations
@@ -65,6 +67,7 @@ def variables_of(phases: Layout = PHASES, robots: bool = False) -> tuple[tuple[s
     # the die-height crossings outside the draw: going up in the return (time from theta3), going down in
     # the feed (time from theta1)
     out: list[tuple[str, str]] = [("draw_speed", "speed"), ("die_up_time", "time"), ("die_down_time", "time")]
+    out += [("draw_accel", "accel")] if draws_freely(phases) else []  # at theta3: a free draw's end and start
     for phase, n in phases:
         out.append((f"{phase}_step", "step"))
         out += [(f"{phase}_jerk_{k}", "jerk") for k in range(n)]
@@ -127,6 +130,9 @@ def variable_bounds(
         elif name.endswith("_start"):  # a robot's start: within a period either side of theta3
             lo[i], hi[i] = -longest, longest
     lo[index["draw_speed"]], hi[index["draw_speed"]] = w2_lo, w2_hi
+    if draws_freely(phases):  # the speed at theta3 of a free draw: any the limits allow at the samples
+        w_min = case.limits.min_crank_speed_rpm * RPM
+        lo[index["draw_speed"]], hi[index["draw_speed"]] = w_min, TOP_SPEED
     for k in ("die_down", "die_up"):
         i = index[f"{k}_time"]
         active = parameters[layout.index(f"{k}_active")] != 0.0
@@ -149,7 +155,8 @@ def _shooting(phases: Layout, physical: ca.MX, v: dict, unit: dict, q: dict, ind
     points inside each segment, in time order) and their times, the knot accelerations, the die-height
     crossings in closed form (clip), the last state and the time at the feed's end."""
     ends = {"return": q["theta4"], "transfer": q["theta1"] + 2 * np.pi, "feed": q["theta2"] + 2 * np.pi}
-    start = (q["theta3"], v["draw_speed"], ca.MX(0.0))
+    ends["draw"] = q["theta3"] + 2 * np.pi  # a free draw (a draw at constant slide speed)
+    start = (q["theta3"], v["draw_speed"], v.get("draw_accel", ca.MX(0.0)))
     t0 = ca.MX(0.0)
     shooting, boundary, samples, times, knot_accels, pieces = [], [], [], [], [], []
     crossings = {}
@@ -181,6 +188,8 @@ def _shooting(phases: Layout, physical: ca.MX, v: dict, unit: dict, q: dict, ind
         knot_accels.append(ca.vertcat(al0, end[2]))
         t0 = t0 + n * h
         start = end
+        if phase == "feed":
+            feed_end = t0  # theta2: the draw starts (a free draw's phase follows)
     return {
         "shooting": shooting,
         "boundary": boundary,
@@ -190,6 +199,7 @@ def _shooting(phases: Layout, physical: ca.MX, v: dict, unit: dict, q: dict, ind
         "crossings": crossings,
         "end": start,
         "t_end": t0,
+        "t_draw_start": feed_end,
         "pieces": pieces,
     }
 
@@ -200,7 +210,8 @@ def _structure_rows(rows: Rows, s: dict[str, Any], v: dict, unit: dict, q: dict)
     w2, start = v["draw_speed"], s["end"]
     rows.add("segments join (closed form)", ca.vertcat(*s["shooting"]), 0.0, 0.0, "planner.motion_law")
     rows.add("key angles", ca.vertcat(*s["boundary"][:2]), 0.0, 0.0, "key_points")
-    closes = ca.vertcat(s["boundary"][2], (start[1] - w2) / unit["draw_speed"], start[2] / unit["feed_accel_1"])
+    end_accel = start[2] - v["draw_accel"] if "draw_accel" in v else start[2]  # a free draw's at theta3, else 0
+    closes = ca.vertcat(*s["boundary"][2:], (start[1] - w2) / unit["draw_speed"], end_accel / unit["feed_accel_1"])
     rows.add("cycle closes", closes, 0.0, 0.0, "key_points")
     (thu, omu), t_up, span_up = s["crossings"]["return"]
     (thd, omd), t_down, span_down = s["crossings"]["feed"]
@@ -253,7 +264,7 @@ def _robot_terms(
 
     first = physical.shape[0] - len(ROBOT_VARIABLES)
     starts = {name.removesuffix("_start"): physical[first + k] for k, (name, _) in enumerate(ROBOT_VARIABLES)}
-    return {"height_at": height_at, "robot_starts": starts, "draw_start_time": shot["t_end"]}
+    return {"height_at": height_at, "robot_starts": starts, "draw_start_time": shot["t_draw_start"]}
 
 
 def _build(
@@ -277,9 +288,9 @@ def _build(
     shot = _shooting(phases, physical, v, unit, q, index)
     omu, omd = _structure_rows(rows, shot, v, unit, q)
     states, t_all, count, speeds = _all_samples(shot, q, w2, drive)
-    draw_time = (q["theta3"] - q["theta2"]) / w2
+    free = draws_freely(phases)  # the draw a phase (sampled: its samples the last) or at the constant w2
     samples, _, lift = sample_states(formula, layout, q, p_case, states, t_all, count)
-    period = shot["t_end"] + draw_time
+    period = shot["t_end"] if free else shot["t_end"] + (q["theta3"] - q["theta2"]) / w2
     nlp = Transcription(
         **samples,
         **_robot_terms(shot, period, w2, physical, robots, layout, q),
@@ -292,13 +303,15 @@ def _build(
         crossings=[(omu, q["die_up_slope"]), (omd, q["die_down_slope"])],
         zone=True,
         rate=False,
+        free_draw_count=dict(phases).get("draw", 0) * SAMPLES_PER_SEGMENT["draw"],
         speed_unit=unit["draw_speed"],
     )
     refinable = add_limit_rows(rows, nlp, layout)
 
     problem = {"x": x, "p": ca.vertcat(p_case, p_scale), "f": nlp.period, "g": ca.vertcat(*rows.g)}
     options = {**CYCLE_OPTIONS, **DRIVE_OPTIONS}  # MUMPS's AMD ordering: the same iterations, 5-10 % faster here
-    name = "press_cycle_optimal" + ("_fine" if phases != PHASES else "") + ("_drive" if drive else "")
+    fine = phases not in (PHASES, FREE_DRAW)
+    name = "press_cycle_optimal" + ("_fine" if fine else "") + ("_slide" if free else "") + ("_drive" if drive else "")
     program = NLPSolver(name, problem, options, None, WARM_OPTIONS, lift)
     return CycleNLP(
         program,

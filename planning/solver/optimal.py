@@ -18,9 +18,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from planning.model.case import Case
-from planning.model.free_profile import PHASES, Layout, finer
+from planning.model.case import RPM, Case
+from planning.model.free_profile import PHASES, Layout, draws_freely, finer, first_layout
 from planning.model.laws.optimal import OptimalLaw
+from planning.model.limits import Draw, draw_speed_bounds
 from planning.model.plan import Plan
 from planning.solver.free_nlp import free_nlp_for
 from planning.solver.max_spm import converged_plan, solve_max_spm
@@ -42,7 +43,10 @@ def seed_values(seed: Plan, phases: Layout = PHASES) -> dict[str, float]:
     prof, period = seed.profile, seed.period
     t1, t2, t3, t4 = (float(t) for t in seed.key_times())
     spans = {"return": (t3, t4), "transfer": (t4, t1 + period), "feed": (t1 + period, t2 + period)}
+    spans["draw"] = (t2 + period, t3 + period)  # a free draw's phase (a draw at constant slide speed)
     values = {"draw_speed": float(seed.parameters.draw_speed), "die_up_time": seed.nlp_values["die_up_time"]}
+    if draws_freely(phases):  # the speed at theta3 and the acceleration there
+        values["draw_speed"], values["draw_accel"] = (float(x) for x in prof.at_time(t3)[1:3])
     if seed.motion_law == OptimalLaw.name:  # the descending crossing's time counts from theta1 already
         values["die_down_time"] = seed.nlp_values["die_down_time"]
     else:
@@ -53,7 +57,7 @@ def seed_values(seed: Plan, phases: Layout = PHASES) -> dict[str, float]:
         t = a + h * np.arange(n + 1)
         wrapped = t >= period
         th, om, al, _ = prof.at_time(np.where(wrapped, t - period, t))
-        th = th + np.where(wrapped | (phase == "feed"), 2 * np.pi, 0.0)
+        th = th + np.where(wrapped | (phase in ("feed", "draw")), 2 * np.pi, 0.0)
         values[f"{phase}_step"] = h
         for k in range(n):
             values[f"{phase}_jerk_{k}"] = float((al[k + 1] - al[k]) / h)
@@ -66,23 +70,42 @@ def seed_values(seed: Plan, phases: Layout = PHASES) -> dict[str, float]:
     return values
 
 
+def seed_case(case: Case) -> Case:
+    """The case the seed law plans the start of: ``case`` under :data:`SEED_LAW`; a draw at constant slide
+    speed v drawn instead at the constant crank speed at which the slide reaches v where the draw's ``|h'|`` is
+    largest (never faster than v; at least the least crank speed, at most the highest the limits allow)."""
+    if not case.free_draw:
+        return case.with_law(SEED_LAW)
+    draw = Draw.of(case)
+    speed = case.process.draw_slide_speed_mm_s / float(np.max(np.abs(draw.d1)))
+    highest = min(draw_speed_bounds(case).values(), default=speed)
+    speed = max(min(speed, highest), case.limits.min_crank_speed_rpm * RPM)
+    process = case.process.model_copy(update={"draw_slide_speed_mm_s": None, "draw_speed_rpm": speed / RPM})
+    planner = case.planner.model_copy(update={"motion_law": SEED_LAW, "law_parameter": None})
+    return case.model_copy(update={"process": process, "planner": planner})
+
+
 def from_neighbour_optimal(case: Case, neighbour: Plan | Solution) -> Solution | None:
     """The answer from ``neighbour`` alone (its plan when it holds here, one start from its values), or
     None: fast, not confirmed (``planning.solver.optimize.solve``)."""
     _require_jerk_limit(case)
-    search = _search(case, _layout_of(plan_of(neighbour)))
+    search = _search(case, _layout_of(plan_of(neighbour), case))
     return search.answer() if _from(search, neighbour) else None
 
 
-def _layout_of(plan: Plan) -> Layout:
-    """The phases' layout of an optimal plan (the first layout for a plan of another law)."""
-    return getattr(plan.parameters, "layout", PHASES) if plan.motion_law == OptimalLaw.name else PHASES
+def _layout_of(plan: Plan, case: Case) -> Layout:
+    """The phases' layout of an optimal plan that draws as ``case`` does (freely or at a constant crank speed);
+    else (a plan of another law, or of the other draw) ``case``'s first layout."""
+    layout = getattr(plan.parameters, "layout", None) if plan.motion_law == OptimalLaw.name else None
+    if layout is None or draws_freely(layout) != case.free_draw:
+        return first_layout(case.free_draw)
+    return layout
 
 
-def _search(case: Case, phases: Layout = PHASES) -> Search:
-    """The optimal law's search on the phases' ``layout``: prechecks, parameters, bounds, scales; the minimum
-    crank speed backed off."""
-    search = prepare(case, "free", free_nlp_for(case, phases))
+def _search(case: Case, phases: Layout | None = None) -> Search:
+    """The optimal law's search on the phases' ``layout`` (the case's first by default): prechecks, parameters,
+    bounds, scales; the minimum crank speed backed off."""
+    search = prepare(case, "free", free_nlp_for(case, phases or first_layout(case.free_draw)))
     search.parameters = search.parameters.copy()
     search.parameters[search.parameter("min_crank_speed")] *= 1 + MIN_SPEED_BACKOFF
     return search
@@ -92,7 +115,8 @@ def _from(search: Search, neighbour: Plan | Solution) -> bool:
     """A neighbouring case's optimal plan: a candidate when it answers this case and holds here, and a start
     (``planning.solver.neighbour``); whether either verified."""
     case, plan = search.case, plan_of(neighbour)
-    if not can_start(plan, case, "free"):
+    same_draw = draws_freely(getattr(plan.parameters, "layout", PHASES)) == case.free_draw
+    if not can_start(plan, case, "free") or not same_draw:
         return False
     if can_answer(plan, case, "free", search.draw_speed_range):
         evaluation = known_evaluation(neighbour, case) or evaluate(plan, case)
@@ -118,7 +142,7 @@ def solve_optimal(case: Case, neighbour: Plan | Solution | None = None) -> Solut
     _require_jerk_limit(case)
     spent = (0, 0)  # a neighbour's search that found nothing: its iterations and starts still count
     if neighbour is not None:
-        search = _search(case, _layout_of(plan_of(neighbour)))
+        search = _search(case, _layout_of(plan_of(neighbour), case))
         if _from(search, neighbour):
             return _on_the_finer_layout(case, search)
         spent = (search.iterations, search.starts)
@@ -126,11 +150,11 @@ def solve_optimal(case: Case, neighbour: Plan | Solution | None = None) -> Solut
     search = _search(case)
     search.t_start = t_start or search.t_start
     search.iterations, search.starts = spent
-    seeded = case.with_law(SEED_LAW)
+    seeded = seed_case(case)
     seed = converged_plan(seeded) or solve_max_spm(seeded, "free").plan
     search.iterations += seed.solver.iterations
     search.starts += seed.solver.starts
-    search.multi_start([seed_values(seed)], "free", confirm=False)
+    search.multi_start([seed_values(seed, first_layout(case.free_draw))], "free", confirm=False)
     return _on_the_finer_layout(case, search)
 
 
@@ -139,9 +163,9 @@ def _on_the_finer_layout(case: Case, search: Search) -> Solution:
     the jerk limit (the layout held it back, not the limit), the faster of it and the finer layout's plan
     started from it."""
     answer = search.answer()
-    fine_layout = finer(PHASES)
+    fine_layout = finer(first_layout(case.free_draw))
     used = answer.plan.parameters.peak_jerks()[0]
-    if _layout_of(answer.plan) == fine_layout or used >= FINE_JERK_SHARE * case.limits.crank_jerk_rad_s3:
+    if _layout_of(answer.plan, case) == fine_layout or used >= FINE_JERK_SHARE * case.limits.crank_jerk_rad_s3:
         return answer
     return on_layout(case, answer, fine_layout, search)
 

@@ -8,6 +8,8 @@ speed the lowest. A case whose range is empty, or whose limits fail their own pr
 
 from __future__ import annotations
 
+import math
+
 from planning.model.case import RPM, Case
 from planning.model.limits import BY_ID, draw_speed_bounds, limits_of
 from planning.solver.outcomes import Infeasible
@@ -28,6 +30,8 @@ def precheck(case: Case) -> tuple[float, float]:
             )
     if given is not None:
         return given, given
+    if case.free_draw:  # a draw at constant slide speed: no constant draw speed to bound (the NLP's samples hold it)
+        return w_min, math.inf
     if highest < w_min:
         key = min(bounds, key=bounds.get)
         raise Infeasible(

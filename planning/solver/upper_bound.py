@@ -58,7 +58,7 @@ import numpy as np
 from planning.model.case import RPM, Case
 from planning.model.limits import limits_of
 from planning.model.limits.base import BoundMesh, Envelope, RelaxedMesh
-from planning.solver.bound import BOUND_OPTIONS, angle_mesh, node_speed_bounds
+from planning.solver.bound import BOUND_OPTIONS, angle_mesh, draw_nodes, node_speed_bounds
 from planning.solver.ipopt import NLPSolver
 from planning.solver.outcomes import NoPlanFound
 from planning.solver.precheck import precheck
@@ -221,7 +221,7 @@ def relaxation(case: Case, points: int = UPPER_POINTS, pieces: int = UPPER_PIECE
     h, d1, d2, _ = m.jets(th)
     _, th2, th3, th4 = case.key_angles
     limits = limits_of(case)
-    draw = np.flatnonzero((th[:-1] >= th2 - SAME_ANGLE_RAD) & (th[:-1] <= th3 + SAME_ANGLE_RAD))
+    draw = draw_nodes(case, th)
     window = th[:-1] >= th4 - SAME_ANGLE_RAD
     lbx_s, ubx_s = node_speed_bounds(BoundMesh(case, th, h, d1, d2, dth, window), limits, draw, w2_lo, w2_hi)
 

@@ -249,13 +249,15 @@ def _closure_checks(d: Dense) -> list[Check]:
 
 def _law_checks(d: Dense) -> list[Check]:
     """The law's own: continuous at every knot, the key angles reached at their times, the draw at constant
-    speed."""
+    speed (but a draw at constant slide speed, which ``planning.model.limits.draw_slide_speed`` checks)."""
     prof = d.plan.profile
     checks = _continuity(prof)
     th_key = prof.at_time(d.key_times)[0]
     err = float(np.max(np.abs(th_key - np.array(d.plan.key_angles))))
     tol = math.degrees(ANGLE_TOL_RAD)
     checks.append(Check.of(CheckId.KEY_ANGLES, "key angles reached", math.degrees(err), 0.0, "deg", "equal", tol))
+    if getattr(d.plan.parameters, "free_draw", False):  # a draw at constant slide speed: its own limit checks it
+        return checks
     _, t2, t3, _ = d.key_times
     draw = (d.t >= t2) & (d.t <= t3)
     w2 = float(d.plan.parameters.draw_speed)

@@ -166,7 +166,8 @@ class Transcription:
     ``motor_torque`` [N m], ``motor_speed`` [rad/s] and ``crank_torque`` [N m] at the samples in a drive
     NLP, else None. ``param(name)``: a case parameter's symbol. With robots (``planning.model.limits.robots``):
     ``height_at(times)`` the slide's height [mm] at any times [s from theta3] (periodic), ``robot_starts`` their
-    start variables, ``draw_start_time`` [s from theta3] when the next draw starts.
+    start variables, ``draw_start_time`` [s from theta3] when the next draw starts. The optimal law's free draw (a
+    draw at constant slide speed) is sampled like its other phases, its samples the last ``free_draw_count``.
     """
 
     theta: Any
@@ -196,6 +197,11 @@ class Transcription:
     height_at: Callable[[list], Any] | None = None  # the slide's height [mm] at NLP times [s from theta3], any
     robot_starts: dict[str, Any] = field(default_factory=dict)  # each robot's start [s from theta3] (variables)
     draw_start_time: Any = None  # [s from theta3] the next draw's start, theta2 (the end of the cycle outside it)
+    free_draw_count: int = 0  # a free draw's samples (a draw at constant slide speed): the last of the samples
+
+    def in_free_draw(self, values: Any) -> Any:
+        """The entries of a sample vector in a free draw (its last :attr:`free_draw_count`)."""
+        return values[values.shape[0] - self.free_draw_count :]
 
     def outside_draw(self, values: Any) -> Any:
         """The entries of a sample vector before the draw's."""

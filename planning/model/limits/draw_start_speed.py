@@ -3,18 +3,19 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from pydantic import Field
 
-from planning.model.limits.base import Check, Dense, Draw, Limit
+from planning.model.limits.base import Check, Dense, Draw, Limit, Row, Transcription
 from planning.model.units import SliderSpeed
 from planning.tolerances import LIMIT_REL_TOL
 
 
 class DrawStartSpeedLimit(Limit):
     """|slide speed| at theta2 <= the limit. The draw runs at constant crank speed, so this bounds the draw
-    speed alone (the NLPs hold it through the draw speed's bounds)."""
+    speed alone (the NLPs hold it through the draw speed's bounds); a free draw's NLP holds it at theta2."""
 
     id = "draw_start_speed"
     name = "slider speed at the draw start"
@@ -36,6 +37,19 @@ class DrawStartSpeedLimit(Limit):
     def draw_speed_bound(self, draw: Draw) -> float:
         slope = abs(float(draw.d1[0]))  # the draw's first angle is theta2
         return draw.case.limits.draw_start_speed_mm_s / slope if slope > 0 else math.inf
+
+    parameters = ("draw_start_speed",)
+
+    def parameter_values(self, case: Any) -> dict[str, float]:
+        return {"draw_start_speed": case.limits.draw_start_speed_mm_s}
+
+    def rows(self, nlp: Transcription) -> list[Row]:
+        """A free draw (a draw at constant slide speed) starts at its first sample, theta2: the slide's speed
+        there (the draw speed's bounds hold it otherwise)."""
+        if not nlp.free_draw_count:
+            return []
+        first = nlp.in_free_draw(nlp.slope * nlp.omega)[0]
+        return [Row("slider speed at the draw start", first / nlp.param("draw_start_speed"), -1.0, 1.0)]
 
     def at_draw_speed(self, draw: Draw, speed: float) -> list[Check]:
         limit = draw.case.limits.draw_start_speed_mm_s

@@ -1,0 +1,94 @@
+"""A draw at constant slide speed (``process.draw_slide_speed_mm_s`` = v): from theta2 to theta3 the slide moves
+no faster than v, ``|dh/dtheta omega| <= v``, and the optimal law, planning for the most strokes, drives it at v
+wherever the crank's own limits let it (near BDC ``dh/dtheta -> 0`` asks ``omega = v / |dh/dtheta| -> inf``: the
+crank's speed, acceleration and jerk limits cap it there).
+
+A speed cap ``k = h'`` over the draw's crank angles (not a height zone): the NLP's rows at the free draw's samples
+(refined against the dense check, like the slider's speed), the dense check over theta2 ... theta3, the bound's
+cap ``(v / |h'|)^2`` at the draw's nodes. How far the plan holds v (within :data:`~planning.tolerances.
+DRAW_SPEED_BAND`) is the reports' (:func:`held_band`), not a limit: the crank's limits decide it.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from planning.model.limits.base import BoundMesh, Check, Dense, Limit, Row, Transcription
+from planning.tolerances import DRAW_SPEED_BACKOFF, DRAW_SPEED_BAND, LIMIT_REL_TOL
+
+
+def in_draw(case: Any, theta: np.ndarray) -> np.ndarray:
+    """Whether each crank angle ``theta`` [rad] (any turn) lies in the draw, theta2 ... theta3."""
+    _, th2, th3, _ = case.key_angles
+    turn = np.mod(np.asarray(theta, dtype=float), 2 * math.pi)
+    return (turn >= th2) & (turn <= th3)
+
+
+def held_band(case: Any, theta: np.ndarray, speed: np.ndarray) -> tuple[int, int] | None:
+    """``(first, last)``: the indices of the longest run of samples in the draw (at the crank angles ``theta``, in
+    time order) whose ``|speed|`` [mm/s] stays within :data:`~planning.tolerances.DRAW_SPEED_BAND` of the set
+    slide speed; None where none does."""
+    v = case.process.draw_slide_speed_mm_s
+    held = in_draw(case, theta) & (np.abs(speed) >= v * (1 - DRAW_SPEED_BAND))
+    best, run, first = 0, None, None
+    for i, flag in enumerate(np.append(held, False)):
+        if flag and first is None:
+            first = i
+        elif not flag and first is not None:
+            if i - first > best:
+                best, run = i - first, (first, i - 1)
+            first = None
+    return run
+
+
+class DrawSlideSpeedLimit(Limit):
+    """``|dh/dtheta omega| <= v`` over the draw (module docstring)."""
+
+    id = "draw_slide_speed"
+    name = "slide speed in the draw"
+    unit = "mm/s"
+    field = "process.draw_slide_speed_mm_s"
+    order = 46
+    parameters = ("draw_slide_speed",)
+    refined = "draw_slide_speed"
+    backoff = DRAW_SPEED_BACKOFF
+
+    def applies(self, case: Any) -> bool:
+        return case.process.draw_slide_speed_mm_s is not None
+
+    def limit(self, case: Any) -> float:
+        return case.process.draw_slide_speed_mm_s
+
+    def parameter_values(self, case: Any) -> dict[str, float]:
+        return {"draw_slide_speed": case.process.draw_slide_speed_mm_s * (1 - self.backoff)}
+
+    def rows(self, nlp: Transcription) -> list[Row]:
+        if not nlp.free_draw_count:
+            return []
+        speed = nlp.in_free_draw(nlp.slope * nlp.omega)
+        return [Row("slide speed in the draw", speed / nlp.param("draw_slide_speed"), -1.0, 1.0, sampled=True)]
+
+    def check(self, dense: Dense) -> list[Check]:
+        case = dense.case
+        inside = in_draw(case, dense.theta)
+        speed = np.abs(dense.v[inside])
+        limit = self.limit(case)
+        value = float(np.max(speed)) if speed.size else 0.0
+        check = Check.of(self.id, self.name, value, limit, self.unit, "max", LIMIT_REL_TOL * limit)
+        return [check.located(dense.t[inside], dense.theta[inside], speed, limit)]
+
+    def bound_speeds(self, mesh: BoundMesh) -> tuple[np.ndarray | None, np.ndarray | None]:
+        """``(v / |h'|)^2`` at the draw's nodes where the slide moves."""
+        n = mesh.dtheta.size
+        k = np.abs(mesh.d1[:-1])
+        inside = in_draw(mesh.case, mesh.theta[:-1]) & (k > 0)
+        upper = np.full(n, np.inf)
+        upper[inside] = (self.limit(mesh.case) / k[inside]) ** 2
+        return None, upper
+
+    def relaxed_rows(self, mesh: Any) -> list[tuple[Any, Any, Any]] | None:
+        """Left out of the certified upper bound (which stays an upper bound, looser)."""
+        return None
