@@ -110,6 +110,7 @@ def test_the_outside_trials_link_drive_solves_cold_to_its_sweeps_plan():
     assert fixed.plan.spm >= 13.6
 
 
+@pytest.mark.slow  # 7-13 s: the normal run keeps under 5 minutes (its kind runs there too)
 def test_a_crank_jerk_limit_near_zero_still_plans_under_the_improved_s_curve():
     """At 0.01 rad/s^3 the improved S-curve's NLP cannot move; the crank at constant speed (zero jerk, a motion
     of every law with halves) is its plan: 6.700 strokes/min at the draw speed."""

@@ -230,6 +230,7 @@ def test_the_certified_bound_falls_as_the_grid_refines_towards_the_optimum(case)
     assert values[0] > values[1] > values[2] > INDEPENDENT_VERIFIED_NO_JERK_SPM
 
 
+@pytest.mark.slow  # 4-7 s a case: the normal run keeps under 5 minutes (CI runs the slow tier)
 def test_the_bracket_of_the_published_case_is_within_its_tolerance(case):
     """Issue 28's bracket: a motion that passes the dense verification below a certified upper bound in
     [13.0405, 13.05], their gap within the default 0.05 % (the optimal law refined to 6 x its first layout

@@ -143,6 +143,7 @@ def test_case_file_is_never_written(tmp_path):
     assert PUBLISHED_CASE.read_bytes() == before
 
 
+@pytest.mark.slow  # 7-13 s: the normal run keeps under 5 minutes (its kind runs there too)
 def test_solver_success_but_failed_verification_is_exit_3(monkeypatch, tmp_path, capsys):
     """No false successes: when every plan fails the dense check, nothing is written and exit is 3."""
     import planning.solver.verify as verify

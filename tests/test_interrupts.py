@@ -51,6 +51,7 @@ def state(folder: Path) -> tuple:
     return names, tuple(sorted(digest.items()))
 
 
+@pytest.mark.slow  # 4-7 s a case: the normal run keeps under 5 minutes (CI runs the slow tier)
 @pytest.mark.skipif(sys.platform != "linux", reason="the kill test drives Linux processes")
 @pytest.mark.parametrize("seed", [2026, 2027], ids=["kills 1-5", "kills 6-10"])  # the two workers share them
 def test_killed_solve_leaves_the_folder_entirely_old_or_entirely_new(tmp_path, seed):

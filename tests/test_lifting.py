@@ -16,6 +16,7 @@ from .conftest import ROOT
 AGREEMENT = 1e-9  # relative to each function's largest entry: the chain rule is exact, round-off remains
 
 
+@pytest.mark.slow  # 4-7 s a case: the normal run keeps under 5 minutes (CI runs the slow tier)
 @pytest.mark.parametrize("name", ["link-drive-side-panel", "knuckle-joint-coining"])
 def test_lifted_derivatives_are_the_composed_problems(name):
     case = read_case(ROOT / "cases" / f"{name}.yaml")

@@ -86,6 +86,7 @@ def test_at_the_fastest_rate_the_plan_is_the_fastest() -> None:
 @pytest.mark.parametrize(
     ("path", "objective", "start"), [(SIDE_PANEL, "min-rms-torque", 5.0), (CUP, "min-energy", 20.0)]
 )
+@pytest.mark.slow  # 4-7 s a case: the normal run keeps under 5 minutes (CI runs the slow tier)
 def test_tradeoff_never_worse_than_the_baseline(path: Path, objective: str, start: float) -> None:
     """7 rates up to the fastest: every plan verified at its rate, its exact objective <= the baseline's,
     and the optimiser beats the baseline at most rates below the fastest."""

@@ -63,6 +63,7 @@ def test_the_bound_lies_above_the_plan(offset_solution):
     assert time_optimal_bound(case).spm >= sol.plan.spm
 
 
+@pytest.mark.slow  # 7-13 s: the normal run keeps under 5 minutes (its kind runs there too)
 def test_laws_sweep_tradeoff_and_compare_run(tmp_path, capsys):
     assert main(["laws", str(OFFSET_CASE), "--out", str(tmp_path / "laws")]) == 0
     laws = json.loads((tmp_path / "laws" / "laws.json").read_text())

@@ -101,6 +101,7 @@ def test_two_field_sweep_heat_map(tmp_path):
     assert (out / "sweep_spm.png").exists()
 
 
+@pytest.mark.slow  # 7-13 s: the normal run keeps under 5 minutes (its kind runs there too)
 def test_interrupted_sweep_resumes_without_redoing_points(tmp_path):
     out = tmp_path / "resume"
     cmd = [
