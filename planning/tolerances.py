@@ -20,6 +20,7 @@ from __future__ import annotations
 
 LIMIT_REL_TOL = 1e-6  # relative: a limit's dense check passes within this share of the limit (six digits:
 # more than any press's data has, far above the round-off of evaluating the closed forms)
+CAP_SHARE = 1e-3  # relative: a limit this close to its value where a draw falls below its slide speed caps it
 DRAW_SPEED_BAND = 1e-3  # relative: a draw at constant slide speed holds it within 0.1 % (the reports' band)
 HOLD_STILL_MM = 1e-3  # [mm] the slide stands at its hold height within a micrometre (the hold's check)
 HOLD_STILL_RAD_S = 1e-9  # [rad/s] the crank stands in a hold (a cam's standstill is still to round-off)

@@ -188,8 +188,8 @@ CORPUS: dict[str, tuple[str, str | bytes]] = {
     "hold_after_the_draw_end": ("key_points.draw_end_deg", add("process.hold_time_s", "0.3")),
     "hold_height_alone": ("process.hold_height_mm", add("process.hold_height_mm", "5")),
     "hold_height_nan": ("process.hold_height_mm", add("process.hold_height_mm", ".nan")),
-    # a draw at constant slide speed: the optimal law's (the published case draws under the improved S-curve)
-    "slide_speed_with_halves": ("planner.motion_law", add("process.draw_slide_speed_mm_s", "60")),
+    # a draw at constant slide speed: the published case gives a constant draw speed too
+    "slide_speed_with_draw_speed": ("process.draw_speed_rpm", add("process.draw_slide_speed_mm_s", "60")),
     "slide_speed_negative": ("process.draw_slide_speed_mm_s", add("process.draw_slide_speed_mm_s", "-60")),
     "angle_inf": ("key_points.opening_deg", field("key_points.opening_deg", "-.inf")),
     # types an engineer might not mean

@@ -67,6 +67,7 @@ def test_follow_alone_may_stop_at_another_optimum_and_the_full_solve_does_not():
     assert fast.plan.spm < solve(case).plan.spm * (1 - SAME)
 
 
+@pytest.mark.slow  # 6 s: the normal run keeps under 5 minutes (CI runs the slow tier)
 def test_a_sweep_point_is_its_cold_solve_or_better(tmp_path, capsys):
     from planning.cli import main
 

@@ -21,6 +21,8 @@ CASES = sorted((Path(__file__).resolve().parent.parent / "cases").glob("*.yaml")
 
 def case_path(name: str) -> Path:
     return Path(__file__).resolve().parent.parent / "cases" / f"{name}.yaml"
+
+
 JERK_SHARE = 0.98  # the issue's target: at least this share of the jerk-limited bound at every limit
 SAME_JERK = 1e-6  # relative: a law's peak crank jerk "not higher" than the reference within round-off
 
@@ -37,7 +39,12 @@ def with_jerk(case, jerk: float, law: str = "optimal"):  # noqa: ANN001, ANN201 
 # a case with a hold at the bottom is not the optimal law's (it plans no hold yet: tests/test_hold.py), a draw at
 # constant slide speed not the laws' with halves (tests/test_slide_draw.py): neither compares the two
 WITHOUT_HOLD = [p for p in CASES if read_case(p).process.hold_time_s is None and not read_case(p).free_draw]
-BEATEN = [pytest.param(p, marks=pytest.mark.slow) if "robots" in p.stem else p for p in WITHOUT_HOLD]
+# the robots' case (about 30 s) and the linkages (about 6 s each) in the slow tier
+SLOW_BEATEN = ("robots", "link-drive", "knuckle-joint")
+BEATEN = [
+    pytest.param(p, marks=pytest.mark.slow) if p.stem.startswith(SLOW_BEATEN) or "robots" in p.stem else p
+    for p in WITHOUT_HOLD
+]
 
 
 @pytest.mark.parametrize("path", BEATEN, ids=lambda p: p.stem)

@@ -689,8 +689,8 @@ class Case(_Model):
         planner = self.planner.model_copy(update={"motion_law": law, "law_parameter": None})
         case = self.model_copy(update={"planner": planner})
         _law_checks(case)
-        _hold_checks(case)
         _slide_draw_checks(case)
+        _hold_checks(case)
         _objective_checks(case)
         return case
 
@@ -715,8 +715,8 @@ def cross_checks(case: Case) -> None:
                 angles[i],
             )
     _transfer_checks(case)
-    _hold_checks(case)
     _slide_draw_checks(case)
+    _hold_checks(case)
     for limit in LIMITS:
         limit.validate(case)
     fixed = case.planner.law_parameter
@@ -932,16 +932,16 @@ def _slide_draw_checks(case: Case) -> None:
     speed = case.process.draw_slide_speed_mm_s
     if speed is None:
         return
+    for key, what in (("draw_speed_rpm", "a constant crank speed"), ("hold_time_s", "a hold at the bottom")):
+        if getattr(case.process, key) is not None:
+            reason = f"and process.draw_slide_speed_mm_s ask for two draws: {what} or a constant slide speed"
+            raise CaseError(f"process.{key}", reason, getattr(case.process, key))
     if LAWS[case.planner.motion_law].transcription == HALVES:
         reason = (
             "a draw at constant slide speed is planned by the optimal law (planner.motion_law: optimal, with "
             "limits.crank_jerk_rad_s3); a law with halves draws at a constant crank speed"
         )
         raise CaseError("planner.motion_law", reason, case.planner.motion_law)
-    for key, what in (("draw_speed_rpm", "a constant crank speed"), ("hold_time_s", "a hold at the bottom")):
-        if getattr(case.process, key) is not None:
-            reason = f"and process.draw_slide_speed_mm_s ask for two draws: {what} or a constant slide speed"
-            raise CaseError(f"process.{key}", reason, getattr(case.process, key))
     for section in ("drive", "robots"):
         if getattr(case, section) is not None:
             reason = f"a draw at constant slide speed is planned without a {section}: section yet"

@@ -14,9 +14,9 @@ import numpy as np
 from planning.model.case import KEY_POINT_NAMES, RPM, Case
 from planning.model.cycle import HALVES
 from planning.model.laws.improved_scurve import ImprovedSCurve
-from planning.model.limits import draw_speed_bounds, field_of
+from planning.model.limits import draw_speed_bounds
 from planning.model.limits.capacity import curve, has_curve, tonnage_use, torque_capacity_kNm
-from planning.model.limits.draw_slide_speed import DrawSlideSpeedLimit, held_band
+from planning.model.limits.draw_slide_speed import held_band
 from planning.model.limits.slider_accel import SliderAccelLimit
 from planning.model.outcome import Outcome
 from planning.model.plan import Plan
@@ -27,7 +27,7 @@ from planning.reports.source_solution import paper_solution
 from planning.reports.stages import stage_table
 from planning.solver.solution import ENERGY, GRID_PEAK, Solution
 from planning.solver.verify import Evaluation
-from planning.tolerances import BINDING_SHARE, KNOT_TIME_S, SAME_RELATIVE
+from planning.tolerances import BINDING_SHARE, CAP_SHARE, KNOT_TIME_S, SAME_RELATIVE
 from press.mechanism import Mechanism
 
 TRAJECTORY_COLUMNS = (
@@ -373,15 +373,32 @@ def slide_draw_block(solution: Any, case: Case) -> dict[str, Any]:
     else:
         ends = np.mod(dense.theta[list(run)], 2 * math.pi)
         held, share, after = tuple(np.degrees(ends).tolist()), 100 * (ends[1] - ends[0]) / (th3 - th2), dense.t[run[1]]
-    binding = [c for c in solution.verification.binding() if c.id != DrawSlideSpeedLimit.id and c.peak is not None]
-    capping = {field_of(c.id) or c.name for c in binding if any(a <= t3 and b >= after for a, b in c.peak.spans)}
     return {
         "set_mm_s": case.process.draw_slide_speed_mm_s,
         "held_from_deg": held[0],
         "held_to_deg": held[1],
         "held_share_pct": float(share),
-        "capped_by": sorted(capping),
+        "capped_by": capping(dense, case, after, t3),
     }
+
+
+def capping(dense: Any, case: Case, start_s: float, end_s: float) -> list[str]:
+    """The crank's and the slide's limits (case fields) within :data:`~planning.tolerances.CAP_SHARE` of their
+    value somewhere from ``start_s`` to ``end_s`` [s from TDC]: what caps a draw at constant slide speed."""
+    lim = case.limits
+    window = (dense.t >= start_s) & (dense.t <= end_s)
+    figures = (
+        ("limits.crank_speed_rpm", np.abs(dense.omega) / RPM, lim.crank_speed_rpm),
+        ("limits.crank_accel_rad_s2", np.abs(dense.alpha), lim.crank_accel_rad_s2),
+        ("limits.crank_jerk_rad_s3", np.abs(dense.jerk), lim.crank_jerk_rad_s3),
+        ("limits.slider_accel_mm_s2", np.abs(dense.a), lim.slider_accel_mm_s2),
+        ("limits.die_speed_mm_s", np.where(dense.h <= lim.die_height_mm, np.abs(dense.v), 0.0), lim.die_speed_mm_s),
+    )
+    return [
+        name
+        for name, values, limit in figures
+        if limit is not None and window.any() and np.max(values[window]) >= limit * (1 - CAP_SHARE)
+    ]
 
 
 def _draw_words(r: dict[str, Any]) -> str:

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 from planning.model.case import Case
 from planning.model.errors import CaseError
-from planning.model.free_profile import PHASES, finer
+from planning.model.free_profile import finer, first_layout
 from planning.model.laws.optimal import OptimalLaw
 from planning.model.profile import max_abs_jerk
 from planning.solver.optimal import on_layout, solve_optimal
@@ -119,7 +119,7 @@ def bracket(case: Case, tolerance_pct: float = BRACKET_TOL_PCT) -> Bracket:
     rounds = [BracketRound(verified.plan.spm, upper.spm, gap_pct(verified.plan.spm, upper.spm))]
     # with robots the verified motion stays on the first layout: their rows tie every segment of the profile
     # (the slide's height at a robot's time sums them all), so a finer layout's NLP grows with its square
-    layouts = [finer(PHASES, f) for f in LAYOUT_FACTORS] if case.robots is None else []
+    layouts = [finer(first_layout(case.free_draw), f) for f in LAYOUT_FACTORS] if case.robots is None else []
     meshes = list(UPPER_MESHES[1:])
     turn = 0
     while rounds[-1].gap_pct > tolerance_pct and (layouts or meshes):

@@ -52,7 +52,7 @@ from press.mechanism import Formula
 # the limits are held at every knot and at evenly spaced points inside each segment, this many per
 # segment (knot included) in each phase: the robot's window has the longest segments and the highest
 # speeds (around TDC, where the slider acceleration peaks), so it is sampled finer
-SAMPLES_PER_SEGMENT = {"return": 4, "transfer": 8, "feed": 4, "draw": 4}
+SAMPLES_PER_SEGMENT = {"return": 4, "transfer": 8, "feed": 4, "draw": 8}
 STATES = ("angle", "speed", "accel")
 TOP_SPEED = 1e3  # [rad/s] upper bound of the crank speeds (far above any press)
 # a re-solve with a refined limit starts nearer the optimum than the laws' (about half the iterations
@@ -199,6 +199,7 @@ def _shooting(phases: Layout, physical: ca.MX, v: dict, unit: dict, q: dict, ind
         "crossings": crossings,
         "end": start,
         "t_end": t0,
+        "free_draw": draws_freely(phases),
         "t_draw_start": feed_end,
         "pieces": pieces,
     }
@@ -232,6 +233,9 @@ def _all_samples(s: dict[str, Any], q: dict, w2: ca.MX, drive: bool) -> tuple[tu
     om = ca.vertcat(*[sm[1] for sm in s["samples"]])
     al = ca.vertcat(*[sm[2] for sm in s["samples"]])
     states, t_all, count = (th, om, al), ca.vertcat(*s["times"]), 0
+    if s["free_draw"]:  # a free draw's end, theta3 (a turn on), is a sample too: the last
+        end = s["end"]
+        states, t_all = tuple(ca.vertcat(x, e) for x, e in zip(states, end, strict=True)), ca.vertcat(t_all, s["t_end"])
     if drive:
         count = DRAW_SAMPLES_DRIVE + 1
         th_d, om_d, al_d, since = draw_states(q, w2, ca.DM(np.linspace(0.0, 1.0, count)))
@@ -303,7 +307,7 @@ def _build(
         crossings=[(omu, q["die_up_slope"]), (omd, q["die_down_slope"])],
         zone=True,
         rate=False,
-        free_draw_count=dict(phases).get("draw", 0) * SAMPLES_PER_SEGMENT["draw"],
+        free_draw_count=dict(phases).get("draw", 0) * SAMPLES_PER_SEGMENT["draw"] + int(free),  # and its end
         speed_unit=unit["draw_speed"],
     )
     refinable = add_limit_rows(rows, nlp, layout)

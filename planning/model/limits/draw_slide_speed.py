@@ -16,15 +16,16 @@ from typing import Any
 
 import numpy as np
 
-from planning.model.limits.base import BoundMesh, Check, Dense, Limit, Row, Transcription
-from planning.tolerances import DRAW_SPEED_BACKOFF, DRAW_SPEED_BAND, LIMIT_REL_TOL
+from planning.model.limits.base import BoundMesh, Check, Dense, Draw, Impossible, Limit, Row, Transcription
+from planning.tolerances import ANGLE_TOL_RAD, DRAW_SPEED_BACKOFF, DRAW_SPEED_BAND, LIMIT_REL_TOL
 
 
 def in_draw(case: Any, theta: np.ndarray) -> np.ndarray:
-    """Whether each crank angle ``theta`` [rad] (any turn) lies in the draw, theta2 ... theta3."""
+    """Whether each crank angle ``theta`` [rad] (any turn) lies in the draw, theta2 ... theta3, its ends included
+    to :data:`~planning.tolerances.ANGLE_TOL_RAD` (the sample at a key point's time lies on it to round-off)."""
     _, th2, th3, _ = case.key_angles
     turn = np.mod(np.asarray(theta, dtype=float), 2 * math.pi)
-    return (turn >= th2) & (turn <= th3)
+    return (turn >= th2 - ANGLE_TOL_RAD) & (turn <= th3 + ANGLE_TOL_RAD)
 
 
 def held_band(case: Any, theta: np.ndarray, speed: np.ndarray) -> tuple[int, int] | None:
@@ -33,7 +34,7 @@ def held_band(case: Any, theta: np.ndarray, speed: np.ndarray) -> tuple[int, int
     slide speed; None where none does."""
     v = case.process.draw_slide_speed_mm_s
     held = in_draw(case, theta) & (np.abs(speed) >= v * (1 - DRAW_SPEED_BAND))
-    best, run, first = 0, None, None
+    best, run, first = 1, None, None  # a run of one sample is no stretch
     for i, flag in enumerate(np.append(held, False)):
         if flag and first is None:
             first = i
@@ -88,6 +89,22 @@ class DrawSlideSpeedLimit(Limit):
         upper = np.full(n, np.inf)
         upper[inside] = (self.limit(mesh.case) / k[inside]) ** 2
         return None, upper
+
+    def precheck(self, case: Any, given: float | None, lowest: float) -> Impossible | None:
+        """The crank never slower than its least speed: the slide then moves at least ``w_min |h'|``, which
+        must stay within v where the draw's ``|h'|`` is largest."""
+        draw = Draw.of(case)
+        k = int(np.argmax(np.abs(draw.d1)))
+        slowest = lowest * abs(float(draw.d1[k]))
+        v = self.limit(case)
+        if slowest <= v:
+            return None
+        reason = (
+            f"{self.field} = {v:g} is below the {slowest:.4g} mm/s the slide moves at "
+            f"{math.degrees(draw.theta[k]):.2f} deg with the crank at limits.min_crank_speed_rpm = "
+            f"{case.limits.min_crank_speed_rpm:g}"
+        )
+        return Impossible(reason, self.field, v, slowest, math.degrees(draw.theta[k]))
 
     def relaxed_rows(self, mesh: Any) -> list[tuple[Any, Any, Any]] | None:
         """Left out of the certified upper bound (which stays an upper bound, looser)."""
