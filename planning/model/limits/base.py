@@ -119,11 +119,16 @@ class Peak(NamedTuple):
     spans: tuple[tuple[float, float], ...]
 
 
+def runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """The runs of consecutive True entries of ``mask`` as ``(first, last)`` index pairs, in order."""
+    edges = np.diff(np.concatenate([[0], np.asarray(mask).astype(np.int8), [0]]))
+    starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
+    return [(int(a), int(b)) for a, b in zip(starts, ends, strict=True)]
+
+
 def spans(t: np.ndarray, mask: np.ndarray) -> tuple[tuple[float, float], ...]:
     """The runs of ``mask`` over the times ``t`` as ``(first, last)`` time pairs [s]."""
-    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
-    starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
-    return tuple((float(t[a]), float(t[b])) for a, b in zip(starts, ends, strict=True))
+    return tuple((float(t[a]), float(t[b])) for a, b in runs(mask))
 
 
 class Row(NamedTuple):

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from planning.model.limits.base import BoundMesh, Check, Dense, Draw, Impossible, Limit, Row, Transcription
+from planning.model.limits.base import BoundMesh, Check, Dense, Draw, Impossible, Limit, Row, Transcription, runs
 from planning.tolerances import ANGLE_TOL_RAD, DRAW_SPEED_BACKOFF, DRAW_SPEED_BAND, LIMIT_REL_TOL
 
 
@@ -34,15 +34,8 @@ def held_band(case: Any, theta: np.ndarray, speed: np.ndarray) -> tuple[int, int
     slide speed; None where none does."""
     v = case.process.draw_slide_speed_mm_s
     held = in_draw(case, theta) & (np.abs(speed) >= v * (1 - DRAW_SPEED_BAND))
-    best, run, first = 1, None, None  # a run of one sample is no stretch
-    for i, flag in enumerate(np.append(held, False)):
-        if flag and first is None:
-            first = i
-        elif not flag and first is not None:
-            if i - first > best:
-                best, run = i - first, (first, i - 1)
-            first = None
-    return run
+    stretches = [run for run in runs(held) if run[1] > run[0]]  # a run of one sample is no stretch
+    return max(stretches, key=lambda run: run[1] - run[0]) if stretches else None
 
 
 class DrawSlideSpeedLimit(Limit):

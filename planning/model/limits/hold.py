@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from planning.model.laws import LAWS
-from planning.model.limits.base import Check, Dense, Draw, Impossible, Limit
+from planning.model.limits.base import Check, Dense, Draw, Impossible, Limit, runs
 from planning.tolerances import HOLD_STILL_MM, HOLD_STILL_RAD_S, TIME_TOL_S
 
 
@@ -32,17 +32,8 @@ def longest_run_s(t: np.ndarray, inside: np.ndarray) -> tuple[float, float]:
     k = int(np.argmin(inside))  # a sample outside: unroll the period from there
     order = np.r_[np.arange(k, t.size), np.arange(1, k + 1)]  # t[-1] is t[0] a period on
     times = np.r_[t[k:], t[1 : k + 1] + period]
-    flags = inside[order]
-    best, start, first = 0.0, float(t[0]), None
-    for i, flag in enumerate(flags):
-        if flag and first is None:
-            first = i
-        if first is not None and (not flag or i == flags.size - 1):
-            last = i if flag else i - 1
-            if times[last] - times[first] > best:
-                best, start = float(times[last] - times[first]), float(times[first] % period)
-            first = None
-    return best, start
+    first, last = max(runs(inside[order]), key=lambda run: times[run[1]] - times[run[0]])
+    return float(times[last] - times[first]), float(times[first] % period)
 
 
 def least_rate(case: Any) -> float:
