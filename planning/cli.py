@@ -330,13 +330,24 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         if args.command in ("plot", "serve", "new", "cam", "line"):
             return command(args)
-        return command(_read(args), args)
+        case = _read(args)
+        if case.pendulum and args.command not in PENDULUM_COMMANDS:
+            raise CommandError(
+                f"{args.case}: planner.mode: pendulum: pressplan {args.command} plans rotary strokes only (yet); "
+                f"{', '.join(sorted(PENDULUM_COMMANDS))} take a pendulum stroke"
+            )
+        return command(case, args)
     except Exception as exc:
         named = getattr(args, "case", None) or getattr(args, "source", None) or getattr(args, "line", None)
         known = _exit_code(exc, named)
         if known is None:
             raise
         return _fail(*known)
+
+
+PENDULUM_COMMANDS = frozenset(
+    {"check", "solve", "bound", "sweep", "laws"}
+)  # the commands that take planner.mode: pendulum
 
 
 def _read(args: argparse.Namespace):  # noqa: ANN202 - a Case (its module loads on use)
@@ -387,6 +398,8 @@ def _solve(case, args) -> int:
     from planning.solver.optimize import solve
 
     case = _with_objective(_with_law(case, args), args)
+    if case.pendulum:
+        return _solve_pendulum(case, args)
     out = _output_folder(case, args, owned_files())
     solution = solve(case, args.placement)
     figures = not args.no_plots
@@ -400,6 +413,31 @@ def _solve(case, args) -> int:
 
         text += "\n\n" + "\n".join(proof_lines(written.cam))
     return _write_and_report(out, writers, written.result, text, args, owned_files())
+
+
+def _solve_pendulum(case, args) -> int:
+    """``pressplan solve`` of a pendulum stroke (``planning.reports.pendulum``): its own files, no cams yet."""
+    from planning.reports.outputs import options as outputs_taking
+    from planning.reports.pendulum import PENDULUM_FILES, pendulum_result, pendulum_summary, pendulum_writers
+    from planning.solver.pendulum import solve_pendulum
+
+    given = [
+        o.flag
+        for o in outputs_taking()
+        if o.kwargs["dest"] not in ("no_plots", "plot_format")  # the figures' own: the swing's figure takes them
+        and getattr(args, o.kwargs["dest"]) not in (None, False, o.kwargs.get("default"))
+    ]
+    if given or args.placement == "published":
+        flag = given[0] if given else "--placement published"
+        raise CommandError(f"{args.case}: {flag}: not with planner.mode: pendulum (a swing's files are its own)")
+    out = _output_folder(case, args, PENDULUM_FILES)
+    solution = solve_pendulum(case)
+    figures = not args.no_plots
+    if figures:
+        _load_plots()
+    writers = pendulum_writers(solution, case, args.plot_format if figures else None)
+    result = pendulum_result(solution, case)
+    return _write_and_report(out, writers, result, pendulum_summary(result), args, PENDULUM_FILES)
 
 
 def _cam(args) -> int:
@@ -421,6 +459,8 @@ def _cam(args) -> int:
 
         args.case = args.source
         case = _read(args)
+        if case.pendulum:  # a swing's cam is not monotonic in the crank angle: on a time master, not yet
+            raise CommandError(f"{args.case}: planner.mode: pendulum: pressplan cam exports rotary strokes only (yet)")
         out = _output_folder(case, args, ())
         solution = solve(case)
     options = {o.kwargs["dest"]: getattr(args, o.kwargs["dest"]) for o in OPTIONS}
@@ -636,6 +676,8 @@ def _tradeoff(case, args) -> int:
 
 
 def _bound(case, args) -> int:
+    if case.pendulum:
+        return _pendulum_bound(case, args)
     from planning.solver.bound import time_optimal_bound
     from planning.solver.bracket import BRACKET_TOL_PCT, bracket
 
@@ -681,6 +723,31 @@ def _bound(case, args) -> int:
     return EXIT_OK
 
 
+def _pendulum_bound(case, args) -> int:
+    """``pressplan bound`` of a pendulum stroke: its certified upper bound (``planning.solver.pendulum_bound``);
+    with ``--bracket`` the plan beside it."""
+    from planning.solver.pendulum_bound import pendulum_bound
+
+    bound = pendulum_bound(case)
+    data = {"case": case.name, "mode": "pendulum", "upper_bound_spm": bound.spm, "cycle_time_s": bound.cycle_time_s}
+    data["arc_times_s"] = dict(zip(("forward", "backward"), bound.arc_times_s, strict=True))
+    lines = [
+        f"{case.name}: certified upper bound {bound.spm:.3f} strokes/min in pendulum strokes, two swings at least "
+        f"{bound.cycle_time_s:.4f} s: no swing within the limits makes more (two robot's windows of "
+        f"{case.process.transfer_time_s:g} s and theta1 .. theta4 at least {bound.arc_times_s[0]:.4f} s forward, "
+        f"{bound.arc_times_s[1]:.4f} s backward; the jerk limit and the turns left out)"
+    ]
+    if args.bracket or args.tolerance is not None:
+        from planning.solver.pendulum import solve_pendulum
+
+        plan = solve_pendulum(case, compare=False).plan
+        gap = 100 * (bound.spm / plan.spm - 1)
+        data["bracket"] = {"lower_spm": plan.spm, "upper_spm": bound.spm, "gap_pct": gap}
+        lines.append(f"  the verified plan {plan.spm:.3f} strokes/min: no swing makes more than {gap:.2f} % more")
+    print(json.dumps(data, indent=2) if args.json else "\n".join(lines))
+    return EXIT_OK
+
+
 def bracket_text(result) -> str:  # noqa: ANN001 - a Bracket
     """The bracket in two lines: between what, how wide, and whether the tolerance was met."""
     d = result.as_dict()
@@ -718,6 +785,12 @@ def _laws(case, args) -> int:
     from planning.reports.report import TRAJECTORY_COLUMNS
 
     out = _output_folder(case, args, LAWS_FILES)
+    if case.pendulum:
+        from planning.reports.pendulum import pendulum_laws, pendulum_laws_text
+
+        data = pendulum_laws(case)
+        writers = {"laws.json": lambda p: write_json(p, data)}
+        return _write_and_report(out, writers, data, pendulum_laws_text(data), args, LAWS_FILES)
     data, tables = compare_laws(case)
     if not tables:  # each law's own reason, on the one line
         reasons = "; ".join(f"{r['law']}: {r['message']}" for r in data["laws"])

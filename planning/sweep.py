@@ -144,6 +144,9 @@ def solve_block(
         t, started = time.perf_counter(), time.time()
         try:
             case = case_from_data(point_data(base, fields, values), f"{label}[{index}]")
+            if case.pendulum:  # a swing's cold multi-start (no neighbour's start yet: nothing to repair from)
+                row.update(_pendulum_row(case), case=case)
+                continue
             sol = solve(case, placement, neighbour=previous)
             previous = sol.plan
             row.update(_solved_row(sol, case), plan=sol.plan, case=case)
@@ -153,10 +156,26 @@ def solve_block(
             row.update(status=exc.outcome, message=exc.reason)
         except Exception as exc:  # noqa: BLE001 - one failing point never stops the sweep
             row.update(status=Outcome.ERROR, message=f"{type(exc).__name__}: {exc}")
-        row["solve_time_s"] = time.perf_counter() - t
-        stamp(row, started)
-        rows.append(row)
+        finally:
+            row["solve_time_s"] = time.perf_counter() - t
+            stamp(row, started)
+            rows.append(row)
     return rows
+
+
+def _pendulum_row(case: Case) -> dict[str, Any]:
+    """A pendulum point's row: its verified plan's figures (``planning.solver.pendulum``)."""
+    from planning.solver.pendulum import solve_pendulum
+
+    sol = solve_pendulum(case, compare=False)
+    binding = [c.name for c in sol.evaluation.verification.binding()]
+    return {
+        "spm": sol.plan.spm,
+        "cycle_time_s": sol.plan.period,
+        "status": Outcome.VERIFIED,
+        "binding": ";".join(binding),
+        "message": "",
+    }
 
 
 def _solved_row(sol, case) -> dict[str, Any]:  # noqa: ANN001 - a Solution and its Case

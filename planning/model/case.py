@@ -51,6 +51,7 @@ from press.robot import InterferenceCurve, MoveLimits, Robot
 
 Placement = Literal["free", "published"]  # where theta1 / theta4 may fall (the paper's Fig. 6, or anywhere)
 Objective = Literal["max-spm", "min-rms-torque", "min-energy", "min-grid-peak"]  # what the planner optimises
+Mode = Literal["rotary", "pendulum"]  # the crank turns round, or swings through BDC and back (planning.model.pendulum)
 OBJECTIVES: tuple[str, ...] = Objective.__args__
 __all__ = ["RPM", "Case", "CaseError", "show_value"]  # RPM and CaseError: where the model's users find them
 
@@ -458,6 +459,14 @@ class PlannerModel(_Model):
         title="target rate [strokes/min]",
         description="The line's rate for min-rms-torque, min-energy and min-grid-peak.",
     )
+    mode: Mode = Field(
+        "rotary",
+        title="stroke mode",
+        description=(
+            "rotary: the crank turns round through TDC; pendulum: it swings through BDC and back, each swing a "
+            "stroke, turning where the planner decides after the slide has passed the safety height."
+        ),
+    )
 
 
 class PublishedKeyPoint(_Model):
@@ -499,7 +508,6 @@ class PublishedModel(_Model):
     spm: Annotated[float, Field(gt=0, le=1e4)] | None = None
     key_points: PublishedKeyPoints | None = None
     solution: PublishedSolution | None = None
-
 
 
 MAX_CURVE_POINTS = 16  # points of an interference curve (its crossings are rows of the NLP: a fixed share)
@@ -599,6 +607,11 @@ class Case(_Model):
         return self.process.hold_height_mm or 0.0
 
     @property
+    def pendulum(self) -> bool:
+        """The crank swings through BDC and back (``planner.mode: pendulum``, ``planning.model.pendulum``)."""
+        return self.planner.mode == "pendulum"
+
+    @property
     def free_draw(self) -> bool:
         """The draw runs at a constant slide speed (``process.draw_slide_speed_mm_s``): the optimal law plans the
         crank's speed through it, no constant draw speed."""
@@ -692,6 +705,7 @@ class Case(_Model):
         _slide_draw_checks(case)
         _hold_checks(case)
         _objective_checks(case)
+        _pendulum_checks(case)
         return case
 
 
@@ -715,6 +729,7 @@ def cross_checks(case: Case) -> None:
                 angles[i],
             )
     _transfer_checks(case)
+    _pendulum_checks(case)
     _slide_draw_checks(case)
     _hold_checks(case)
     for limit in LIMITS:
@@ -924,6 +939,46 @@ def _hold_checks(case: Case) -> None:
     if not hold_deg < k.opening_deg:
         reason = f"must lie after the hold at {hold_deg:.2f} deg (process.hold_height_mm = {case.hold_height_mm:g})"
         raise CaseError("key_points.opening_deg", reason, k.opening_deg)
+
+
+PENDULUM_NOT_WITH = (  # what a pendulum stroke does not plan with yet: (field, its value when set, why)
+    (
+        "planner.motion_law",
+        lambda c: c.planner.motion_law if c.planner.motion_law == "optimal" else None,
+        "a law with halves plans the swings",
+    ),
+    (
+        "planner.placement",
+        lambda c: c.planner.placement if c.planner.placement == "published" else None,
+        "the paper's structure is a rotary cycle's",
+    ),
+    (
+        "planner.objective",
+        lambda c: c.planner.objective if c.planner.objective != "max-spm" else None,
+        "a swing plans the most strokes",
+    ),
+    ("planner.target_spm", lambda c: c.planner.target_spm, "a swing plans the most strokes"),
+    ("process.hold_time_s", lambda c: c.process.hold_time_s, "no hold in a swing yet"),
+    ("process.draw_slide_speed_mm_s", lambda c: c.process.draw_slide_speed_mm_s, "a swing draws at a crank speed"),
+    ("drive", lambda c: "a drive" if c.drive is not None else None, "no drive model for the swings yet"),
+    (
+        "robots",
+        lambda c: "robots" if c.robots is not None else None,
+        "a swing turns above the safety height, no curves yet",
+    ),
+)
+
+
+def _pendulum_checks(case: Case) -> None:
+    """A pendulum stroke (``planner.mode: pendulum``) plans with a law with halves, at the most strokes, against
+    the safety height and the transfer time; what it does not plan with yet is refused naming the field."""
+    if not case.pendulum:
+        return
+    for name, value_of, why in PENDULUM_NOT_WITH:
+        value = value_of(case)
+        if value is not None:
+            section = name in ("drive", "robots")
+            raise CaseError(name, f"not with planner.mode: pendulum ({why})", None if section else value, not section)
 
 
 def _slide_draw_checks(case: Case) -> None:

@@ -45,6 +45,8 @@ def check_case(case: Case) -> dict[str, Any]:
     checks = [_check(c) for limit in limits_of(case) for c in limit.at_draw_speed(draw, w2)]
     if case.free_draw:  # no constant draw speed: the checks that assume one left out (the slide's speed in it)
         checks = [c for c in checks if c["id"] not in AT_CONSTANT_DRAW]
+    if case.pendulum:  # no window through TDC: the swings turn before it
+        checks = [c for c in checks if c["id"] != "safety_height"]
     bdc = math.degrees(m.bdc_angle)
     return {
         "case": case.name,
@@ -70,6 +72,21 @@ def check_case(case: Case) -> dict[str, Any]:
         "warnings": warnings(case),
         **({"hold": _hold(case)} if case.hold_angle is not None else {}),
         **({"slide_draw": _slide_draw(case, draw)} if case.free_draw else {}),
+        **({"pendulum": _pendulum(case)} if case.pendulum else {}),
+    }
+
+
+def _pendulum(case: Case) -> dict[str, Any]:
+    """A pendulum stroke: where the swings may turn [deg] and each swing's key angles and highest draw speed."""
+    from planning.model.pendulum import backward_key_angles, swing_bounds, swing_setups
+
+    (s_lo, s_hi), (e_lo, e_hi) = swing_bounds(case)
+    forward, backward = swing_setups(case, {})  # the case's own limits
+    return {
+        "turn_start_deg": [math.degrees(s_lo), math.degrees(s_hi)],
+        "turn_end_deg": [math.degrees(e_lo), math.degrees(e_hi)],
+        "backward_key_angles_deg": [math.degrees(a) for a in backward_key_angles(case)],
+        "max_draw_speed_rpm": {"forward": forward.draw_speed_bound / RPM, "backward": backward.draw_speed_bound / RPM},
     }
 
 
@@ -171,6 +188,20 @@ def check_text(report: dict[str, Any]) -> str:
             f"  draw at {slide['set_mm_s']:g} mm/s slide speed: the crank at {slide['crank_at_draw_start_rpm']:.3f} rpm"
             f" at theta2, asked up to {slide['highest_asked_rpm']:.4g} rpm in the draw{capped}"
         )
+    swing = report.get("pendulum")
+    if swing:
+        back = ", ".join(
+            f"{name} {a:.2f}" for name, a in zip(KEY_POINT_NAMES, swing["backward_key_angles_deg"], strict=True)
+        )
+        top = swing["max_draw_speed_rpm"]
+        lines += [
+            f"  pendulum: the forward swing starts at rest between {swing['turn_start_deg'][0]:.2f} and "
+            f"{swing['turn_start_deg'][1]:.2f} deg and turns between {swing['turn_end_deg'][0]:.2f} and "
+            f"{swing['turn_end_deg'][1]:.2f} deg (the planner decides)",
+            f"  the backward swing's key angles [deg]: {back}",
+            f"  highest draw speed of each swing: forward {rounded_down(top['forward'])} rpm, backward "
+            f"{rounded_down(top['backward'])} rpm",
+        ]
     lines += ["", "  checks"]
     for c in report["checks"]:
         mark = "PASS" if c["passed"] else "FAIL"

@@ -719,3 +719,42 @@ def line_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
         ax.grid(alpha=0.3)
         ax.set_xlim(0.0, period)
     return fig
+
+
+def swing_figure(result: dict[str, Any], traj: dict[str, np.ndarray], safety_mm: float, die_mm: float) -> Figure:
+    """A pendulum plan (``planning.reports.pendulum``): the crank angle, its signed speed and the slide against
+    time (the robot's windows through the turns shaded), and the slide against crank angle for each swing."""
+    fig = Figure(figsize=(11, 7.5), layout="constrained")
+    FigureCanvasAgg(fig)
+    ax = fig.subplots(2, 2)
+    t, theta, h = traj["time_s"], traj["crank_angle_deg"], traj["slider_height_mm"]
+    f, b = result["swings"]["forward"]["key_points"], result["swings"]["backward"]["key_points"]
+    period = result["cycle_time_s"]
+    windows = [(f[3]["time_s"], b[0]["time_s"]), (b[3]["time_s"], period), (0.0, f[0]["time_s"])]
+    ax[0, 0].plot(t, theta, color="C0")
+    ax[0, 0].set(xlabel="time [s]", ylabel="crank angle [deg from TDC]", title="the crank swings through BDC")
+    ax[0, 1].plot(t, traj["crank_speed_rpm"], color="C1")
+    ax[0, 1].axhline(0.0, color="0.6", lw=0.8)
+    ax[0, 1].set(xlabel="time [s]", ylabel="crank speed [rpm] (negative: backward)", title="crank speed")
+    ax[1, 0].plot(t, h, color="C2", label="slide")
+    ax[1, 0].set(xlabel="time [s]", ylabel="slide height above BDC [mm]", title="slide: two strokes a cycle")
+    for a in (ax[0, 0], ax[0, 1], ax[1, 0]):
+        for k, (lo, hi) in enumerate(windows):
+            a.axvspan(lo, hi, color="0.85", zorder=0, label="robot's window" if (k == 0 and a is ax[1, 0]) else None)
+    forward = t <= result["swings"]["forward"]["time_s"]
+    ax[1, 1].plot(theta[forward], h[forward], color="C0", label="forward swing")
+    ax[1, 1].plot(theta[~forward], h[~forward], color="C3", ls="--", label="backward swing")
+    for a in (ax[1, 0], ax[1, 1]):
+        a.axhline(safety_mm, color="C4", lw=1, ls=":", label="safety height")
+        a.axhline(die_mm, color="C5", lw=1, ls=":", label="die height")
+    for key in f + b:
+        ax[1, 1].plot(key["angle_deg"], key["height_mm"], "k.", ms=5)
+    ax[1, 1].set(
+        xlabel="crank angle [deg from TDC]", ylabel="slide height above BDC [mm]", title="slide against crank angle"
+    )
+    ax[1, 0].legend(loc="upper right", fontsize=8)
+    ax[1, 1].legend(loc="upper center", fontsize=8)
+    fig.suptitle(
+        f"{result['case']}: {result['spm']:.3f} strokes/min in pendulum strokes ({result['status']})", fontsize=11
+    )
+    return fig

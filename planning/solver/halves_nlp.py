@@ -189,7 +189,7 @@ def make_plan(case: Case, values: dict[str, float], placement: Placement, info: 
     return plan_of(case, values, placement, info)
 
 
-def _angle_at(t: ca.SX, starts: list, states: list, segs: list[Segment]) -> tuple[ca.SX, ca.SX]:
+def angle_at(t: ca.SX, starts: list, states: list, segs: list[Segment]) -> tuple[ca.SX, ca.SX]:
     """Closed-form crank angle and speed at time ``t`` [s] over the segments (clip formulation): the
     linear-jerk parts as one vector, the shape terms of shaped segments added one by one."""
     T = ca.vertcat(*[seg.duration for seg in segs])
@@ -287,8 +287,8 @@ def _key_point_rows(rows: Rows, c: _Cycle) -> tuple[int, tuple[ca.SX, ca.SX]]:
     die-height crossings at their angles; the published rows' place and the crossings' speeds."""
     v, q, params = c.v, c.q, c.params
     t4, t1 = v["opening_time"], v["closing_time"]
-    th4, _ = _angle_at(t4, *c.before)
-    th1, _ = _angle_at(t1, *c.before)
+    th4, _ = angle_at(t4, *c.before)
+    th1, _ = angle_at(t1, *c.before)
     rows.add("key angles", ca.vertcat(th4 - q["theta4"], th1 - (q["theta1"] + 2 * np.pi)), 0.0, 0.0, "key_points")
     t_end = c.starts[c.n_before]
     order = ca.vertcat(t4, t1 - t4, t_end - t1, t_end - v["die_down_time"], t_end - v["die_up_time"])
@@ -305,8 +305,8 @@ def _key_point_rows(rows: Rows, c: _Cycle) -> tuple[int, tuple[ca.SX, ca.SX]]:
     )
     published_rows = rows.add("key angles (published placement)", published, -np.inf, np.inf, "planner.placement")
     # the die-height crossings outside the draw (a crossing inside it: its row switched off, its time fixed)
-    thd, omd = _angle_at(v["die_down_time"], *c.before)
-    thu, omu = _angle_at(v["die_up_time"], *c.before)
+    thd, omd = angle_at(v["die_down_time"], *c.before)
+    thu, omu = angle_at(v["die_up_time"], *c.before)
     crossing = ca.vertcat(
         q["die_down_active"] * (thd - (q["die_down_angle"] + 2 * np.pi)),
         q["die_up_active"] * (thu - q["die_up_angle"]),
@@ -322,7 +322,7 @@ def _exit_rows(rows: Rows, c: _Cycle, first: int) -> list[tuple[ca.SX, ca.SX]]:
     q = c.q
     out, angles = [], []
     for k in range(EXIT_SAMPLES):
-        theta, omega = _angle_at(c.x[first + k] * c.p_scale[first + k], *c.before)
+        theta, omega = angle_at(c.x[first + k] * c.p_scale[first + k], *c.before)
         angles.append(q["die_exit_active"] * (theta - q[f"die_exit_angle_{k}"]))
         out.append((omega, q[f"die_exit_slope_{k}"]))
     rows.add("die exit angles", ca.vertcat(*angles), 0.0, 0.0, "limits.die_height_mm")
@@ -418,7 +418,7 @@ def _robot_terms(c: _Cycle) -> dict:
 
     def height_at(times: list) -> ca.SX:
         wrapped = [t - period * ca.floor(t / period) for t in times]
-        theta = ca.vertcat(*[_angle_at(t, c.starts, c.states[:-1], c.segs)[0] for t in wrapped])
+        theta = ca.vertcat(*[angle_at(t, c.starts, c.states[:-1], c.segs)[0] for t in wrapped])
         return c.formula.jets(theta, geometry)[0]
 
     starts = {name.removesuffix("_start"): c.x[first + k] * c.p_scale[first + k] for k, name in enumerate(names)}

@@ -251,7 +251,7 @@ def _law_checks(d: Dense) -> list[Check]:
     """The law's own: continuous at every knot, the key angles reached at their times, the draw at constant
     speed (but a draw at constant slide speed, which ``planning.model.limits.draw_slide_speed`` checks)."""
     prof = d.plan.profile
-    checks = _continuity(prof)
+    checks = continuity_checks(prof)
     th_key = prof.at_time(d.key_times)[0]
     err = float(np.max(np.abs(th_key - np.array(d.plan.key_angles))))
     tol = math.degrees(ANGLE_TOL_RAD)
@@ -267,7 +267,7 @@ def _law_checks(d: Dense) -> list[Check]:
     return checks
 
 
-def _continuity(prof) -> list[Check]:  # noqa: ANN001 - a Profile
+def continuity_checks(prof) -> list[Check]:  # noqa: ANN001 - a Profile
     """Across a knot t_k, omega(t_k + e) - omega(t_k - e) = 2 e alpha + O(e^2 |jerk|) and
     alpha(t_k + e) - alpha(t_k - e) = e (j_left + j_right) + O(e^2 |dj/dt|); a jump would add its full
     size. e stays within both neighbouring segments; the remainders are bounded from their jerks."""

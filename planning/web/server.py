@@ -62,6 +62,9 @@ from planning.web.cams import (
 )
 
 STATIC = Path(__file__).resolve().parent / "static"
+PENDULUM_ON_THE_PAGE = (
+    "planner.mode: pendulum: the page plans rotary strokes only (yet); pressplan solve, check and bound plan the swings"
+)
 MAX_REQUEST_BYTES = 2 * MAX_BYTES  # a case as JSON, with the page's own fields
 MAX_SESSIONS = 64
 CHART_POINTS = 600  # samples of a plan's curves sent to the page (the files keep the full 1 ms step)
@@ -593,6 +596,8 @@ def solve_case(data: Any, label: str, session: Session, confirm: bool = True) ->
         case = case_from_data(data, label)
     except CaseFileError as exc:
         return {"status": Outcome.BAD_INPUT, "message": str(exc), "field": exc.field}
+    if case.pendulum:
+        return {"status": Outcome.BAD_INPUT, "message": f"{label}: {PENDULUM_ON_THE_PAGE}", "field": "planner.mode"}
     try:
         solution = None
         if not confirm and session.plan is not None:
@@ -731,6 +736,8 @@ def bound_of(data: Any, label: str) -> dict[str, Any]:
 
     try:
         case = case_from_data(data, label)
+        if case.pendulum:
+            return {"message": f"{label}: {PENDULUM_ON_THE_PAGE}"}
         upper = upper_bound(case, LAWS_UPPER_POINTS, LAWS_UPPER_PIECES)
         grid = time_optimal_bound(case)
     except (CaseFileError, PlanningError) as exc:

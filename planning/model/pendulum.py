@@ -1,0 +1,358 @@
+"""The pendulum (swing) stroke: the crank swings through BDC and back, never passing TDC; each swing a stroke.
+
+A cycle is two swings. The forward swing starts at rest at theta_s (before theta1), turns forward through
+the case's key angles theta1 .. theta4 and comes to rest at theta_e (after theta4); the crank stands there
+``turn_end_s`` [s]; the backward swing turns back through BDC to rest at theta_s, where it stands
+``turn_start_s`` [s]. On the way back the slide passes the key heights in the other order of crank angle:
+the backward swing's key angles are where the slide is at the same heights on the other side of BDC
+(:func:`backward_key_angles`; on an in-line crank-slider ``2 pi - theta_k``).
+
+Each swing is laid out on its own path coordinate ``u`` that grows as the swing goes (a swing is then a
+forward motion with speeds >= 0, as a rotary cycle's): ``u = theta`` on the forward swing and
+``u = 2 pi - theta`` on the backward one. On the backward swing the mechanism reads ``h_b(u) = h(2 pi -
+u)``, so ``h_b' = -h'``, ``h_b'' = h''``: the slide's speed ``h' dtheta/dt = h_b' du/dt`` and acceleration
+``h'' (dtheta/dt)^2 + h' d2theta/dt2 = h_b'' (du/dt)^2 + h_b' d2u/dt2`` read the same in either
+coordinate, and so do |crank speed|, |acceleration| and |jerk| (the crank's own signs flip). A swing runs,
+as a rotary cycle does from the transfer: the feed, one half of the law from rest to the peak wm1 and one
+down to the draw speed w2 (at theta2); the draw at constant w2 to theta3; the return, one half up to the
+peak wm2 and one down to rest at the swing's end. Every half follows the case's motion law
+(``planning.model.laws``). Strokes per minute count swings: ``120 / period``.
+
+Sign conventions: the crank angle [rad] from TDC, the crank speed positive forward (negative on the backward
+swing), the slide's height above BDC, its speed positive upward. Time 0 of a pendulum plan is the forward
+swing's start (the crank at rest at theta_s, at the end of its standstill there).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from planning.model.laws import get_law
+from planning.model.limits import limits_of
+from planning.model.limits.base import DRAW_GRID, Draw
+from planning.model.profile import Profile, Segment
+from planning.model.units import RPM
+from planning.tolerances import ANGLE_ROUND_OFF_RAD, SAME_TIME_S, TINY
+
+TWO_PI = 2 * math.pi
+SWINGS = ("forward", "backward")
+STROKES_PER_CYCLE = 2  # a pendulum cycle is two swings, each a stroke
+TURN_SEGMENT = "turn:standstill"  # the crank standing at a swing's end
+SWING_HALVES = ("feed_accel", "feed_decel", "return_accel", "return_decel")
+DRAW_BOUND_LIMITS = ("crank_speed", "slider_accel", "slider_speed", "draw_start_speed")  # their own draw bounds
+BISECTIONS = 60  # halvings of a bracket to find where the draw crosses the die height
+
+
+@dataclass(frozen=True)
+class SwingParameters:
+    """One swing on its path coordinate u [rad] (module docstring): ``draw_speed`` w2, ``feed_peak_speed`` wm1,
+    ``return_peak_speed`` wm2 [rad/s, >= 0]; the four halves' durations [s]; ``start``, ``draw_start``,
+    ``draw_end``, ``end``: u at the swing's start, theta2, theta3 and its end [rad]; the ``motion_law`` and its
+    ``law_parameter`` (0 when it has none)."""
+
+    draw_speed: Any
+    feed_peak_speed: Any
+    return_peak_speed: Any
+    feed_accel_duration: Any
+    feed_decel_duration: Any
+    return_accel_duration: Any
+    return_decel_duration: Any
+    start: Any
+    draw_start: Any
+    draw_end: Any
+    end: Any
+    motion_law: str
+    law_parameter: Any = 0.0
+
+    def half(self, name: str) -> tuple[Any, Any]:
+        """``(duration [s], speed change [rad/s])`` of the half ``name`` (:data:`SWING_HALVES`)."""
+        w2, wm1, wm2 = self.draw_speed, self.feed_peak_speed, self.return_peak_speed
+        dv = {"feed_accel": wm1, "feed_decel": w2 - wm1, "return_accel": wm2 - w2, "return_decel": -wm2}
+        return getattr(self, f"{name}_duration"), dv[name]
+
+    @property
+    def draw_time(self) -> Any:
+        """Duration [s] of the draw at constant w2."""
+        return (self.draw_end - self.draw_start) / self.draw_speed
+
+    @property
+    def feed_time(self) -> Any:
+        """Duration [s] from the swing's start to theta2."""
+        return self.feed_accel_duration + self.feed_decel_duration
+
+    @property
+    def return_time(self) -> Any:
+        """Duration [s] from theta3 to the swing's end."""
+        return self.return_accel_duration + self.return_decel_duration
+
+    @property
+    def duration(self) -> Any:
+        """The swing's time [s] from rest to rest."""
+        return self.feed_time + self.draw_time + self.return_time
+
+    def feed_segments(self) -> list[Segment]:
+        """The feed's segments on u, from rest at the start to w2 at theta2."""
+        law = get_law(self.motion_law)
+        out: list[Segment] = []
+        for name in SWING_HALVES[:2]:
+            out += law.half(name.replace("_", ":"), *self.half(name), self.law_parameter)
+        return out
+
+    def return_segments(self) -> list[Segment]:
+        """The return's segments on u, from w2 at theta3 to rest at the end."""
+        law = get_law(self.motion_law)
+        out: list[Segment] = []
+        for name in SWING_HALVES[2:]:
+            out += law.half(name.replace("_", ":"), *self.half(name), self.law_parameter)
+        return out
+
+    def segments(self) -> list[Segment]:
+        """The whole swing's segments on u: feed, draw, return."""
+        draw = Segment("draw:constant", self.draw_time, 0.0, 0.0)
+        return self.feed_segments() + [draw] + self.return_segments()
+
+    def speed_changes(self) -> list[Any]:
+        """|speed change| [rad/s] of each half as the halves are monotone (the peaks at or above the speeds they
+        join, which the NLP holds): wm1, wm1 - w2, wm2 - w2, wm2."""
+        w2, wm1, wm2 = self.draw_speed, self.feed_peak_speed, self.return_peak_speed
+        return [wm1, wm1 - w2, wm2 - w2, wm2]
+
+    def peak_accelerations(self) -> list[Any]:
+        """Peak |crank acceleration| [rad/s^2] of each half (the law's closed form)."""
+        rate = get_law(self.motion_law).peak_rate(self.law_parameter)
+        durations = [self.half(n)[0] for n in SWING_HALVES]
+        return [rate * dv / D for D, dv in zip(durations, self.speed_changes(), strict=True)]
+
+    def peak_jerks(self) -> list[Any]:
+        """Peak |crank jerk| [rad/s^3] of each half (the law's closed form)."""
+        jerk = get_law(self.motion_law).peak_jerk(self.law_parameter)
+        durations = [self.half(n)[0] for n in SWING_HALVES]
+        return [jerk * dv / D**2 for D, dv in zip(durations, self.speed_changes(), strict=True)]
+
+
+@dataclass(frozen=True)
+class PendulumParameters:
+    """A pendulum cycle: the ``forward`` and ``backward`` swings (:class:`SwingParameters`, each on its own
+    u), the standstills ``turn_end_s`` at theta_e and ``turn_start_s`` at theta_s [s]."""
+
+    forward: SwingParameters
+    backward: SwingParameters
+    turn_end_s: Any
+    turn_start_s: Any
+
+    @property
+    def swing_start(self) -> Any:
+        """theta_s [rad]: where the forward swing starts and the backward one ends."""
+        return self.forward.start
+
+    @property
+    def swing_end(self) -> Any:
+        """theta_e [rad]: where the forward swing ends and the backward one starts."""
+        return self.forward.end
+
+    @property
+    def period(self) -> Any:
+        """The cycle time [s]: both swings and both standstills."""
+        return self.forward.duration + self.turn_end_s + self.backward.duration + self.turn_start_s
+
+    @property
+    def motion_law(self) -> str:
+        return self.forward.motion_law
+
+    def segments(self) -> list[Segment]:
+        """The cycle's segments in the crank's own angle (the backward swing's jerks and speed changes negated):
+        forward swing, standstill at theta_e, backward swing, standstill at theta_s."""
+        back = [_reversed(s) for s in self.backward.segments()]
+        return [
+            *[_named("forward", s) for s in self.forward.segments()],
+            Segment(TURN_SEGMENT, self.turn_end_s, 0.0, 0.0),
+            *[_named("backward", s) for s in back],
+            Segment(TURN_SEGMENT, self.turn_start_s, 0.0, 0.0),
+        ]
+
+
+def _reversed(seg: Segment) -> Segment:
+    """A segment of the backward swing on u as the crank turns it: every jerk and speed change negated."""
+    return seg._replace(j0=-seg.j0, j1=-seg.j1, dv=-seg.dv)
+
+
+def _named(swing: str, seg: Segment) -> Segment:
+    return seg._replace(name=f"{swing} {seg.name}")
+
+
+def swing_of(name: str) -> str:
+    """The swing a segment ``name`` belongs to (``forward``, ``backward`` or ``turn``)."""
+    return name.split(" ", 1)[0] if " " in name else "turn"
+
+
+def other_side(machine: Any, theta: float) -> float:
+    """The crank angle [rad] on the other side of BDC where the slide is at the height it has at ``theta``."""
+    bdc = float(machine.bdc_angle)
+    if abs(theta - bdc) <= ANGLE_ROUND_OFF_RAD:
+        return bdc
+    down, up = (float(a) for a in machine.angles_at_height(float(machine.height(theta))))
+    return up if theta < bdc else down
+
+
+def backward_key_angles(case: Any) -> tuple[float, float, float, float]:
+    """The backward swing's key angles [rad, the crank's own]: where the slide passes the heights of theta1 ..
+    theta4 on the way back (theta1 and theta2 on the far side of BDC, theta3 and theta4 as the draw's end and the
+    opening fall); decreasing in order."""
+    m = case.machine
+    return tuple(other_side(m, float(a)) for a in case.key_angles)  # type: ignore[return-value]
+
+
+def swing_bounds(case: Any) -> tuple[tuple[float, float], tuple[float, float]]:
+    """``((lowest, highest) theta_s, (lowest, highest) theta_e)`` [rad]: theta_s at or before theta1 and the
+    backward swing's opening, theta_e at or after theta4 and the backward swing's closing (the slide reaches
+    the robot's heights on every swing), neither past TDC."""
+    th1, _, _, th4 = (float(a) for a in case.key_angles)
+    b1, _, _, b4 = backward_key_angles(case)
+    return (0.0, min(th1, b4)), (max(th4, b1), TWO_PI)
+
+
+def mirrored_jets(machine: Any, u: Any) -> tuple[Any, Any, Any, Any]:
+    """The mechanism on the backward swing's coordinate ``u = 2 pi - theta``: ``(h, h_b', h_b'', h_b''')``."""
+    h, d1, d2, d3 = machine.jets(TWO_PI - u)
+    return h, -d1, d2, -d3
+
+
+def profile_of(params: PendulumParameters) -> Profile:
+    """The cycle as a profile in the crank's own angle from the forward swing's start (at rest at theta_s)."""
+    segs = tuple(s for s in params.segments() if float(s.duration) > 0)
+    return Profile(segs, float(params.swing_start), 0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class PendulumPlan:
+    """A solved pendulum cycle: its ``parameters``, the ``profile`` (time 0 at the forward swing's start), the
+    key angles of each swing [rad, the crank's own] (``forward_keys``, ``backward_keys``), the ``solver``'s
+    report (``planning.model.plan.SolverInfo``) and the NLP's variable values."""
+
+    parameters: PendulumParameters
+    profile: Profile
+    forward_keys: tuple[float, float, float, float]
+    backward_keys: tuple[float, float, float, float]
+    solver: Any
+    nlp_values: dict[str, float]
+
+    @property
+    def period(self) -> float:
+        return self.profile.duration
+
+    @property
+    def spm(self) -> float:
+        """Strokes per minute: swings per minute."""
+        return STROKES_PER_CYCLE * 60.0 / self.period
+
+    @property
+    def motion_law(self) -> str:
+        return self.parameters.motion_law
+
+    def swing_spans(self) -> dict[str, tuple[float, float]]:
+        """``name -> (start, end)`` [s] of each swing's motion (the standstills between)."""
+        f, b = self.parameters.forward, self.parameters.backward
+        tf = float(f.duration)
+        tb0 = tf + float(self.parameters.turn_end_s)
+        return {"forward": (0.0, tf), "backward": (tb0, tb0 + float(b.duration))}
+
+    def key_times(self, swing: str) -> np.ndarray:
+        """Times [s from the forward swing's start] at which ``swing`` passes its four key angles."""
+        keys = self.forward_keys if swing == "forward" else self.backward_keys
+        lo, hi = self.swing_spans()[swing]
+        return np.array([time_at(self.profile, float(a), lo, hi) for a in keys])
+
+
+def time_at(profile: Profile, theta: float, lo: float, hi: float) -> float:
+    """The time [s] in ``lo .. hi`` (one swing: the angle monotone there) at which the crank is at ``theta``."""
+    th_lo = float(profile.at_time(np.array([lo]))[0][0])
+    th_hi = float(profile.at_time(np.array([hi]))[0][0])
+    rising = th_hi >= th_lo
+    if not min(th_lo, th_hi) - ANGLE_ROUND_OFF_RAD <= theta <= max(th_lo, th_hi) + ANGLE_ROUND_OFF_RAD:
+        raise ValueError("angle outside the swing")
+    a, b = lo, hi
+    for _ in range(200):
+        mid = 0.5 * (a + b)
+        th = float(profile.at_time(np.array([mid]))[0][0])
+        if (th < theta) == rising:
+            a = mid
+        else:
+            b = mid
+        if b - a <= SAME_TIME_S:
+            break
+    return 0.5 * (a + b)
+
+
+@dataclass(frozen=True)
+class SwingSetup:
+    """What one swing's NLP needs before solving: its ``name``; its key angles ``keys`` on u [rad]; ``jets(u)``
+    (the mechanism on u: h, h', h'', h'''); ``die_exit``: u [rad] where the slide leaves the die zone after
+    theta3 (None when the draw ends above the die height); ``draw_speed_bound`` [rad/s]: the highest constant
+    draw speed the limits allow in its draw."""
+
+    name: str
+    keys: tuple[float, float, float, float]
+    jets: Any
+    die_exit: float | None
+    draw_speed_bound: float
+
+
+def swing_setups(case: Any, limits: dict[str, float]) -> tuple[SwingSetup, SwingSetup]:
+    """Both swings' :class:`SwingSetup` (``limits``: the refined values of the sampled limits, by id)."""
+    m = case.machine
+    fwd = tuple(float(a) for a in case.key_angles)
+    back = tuple(TWO_PI - a for a in backward_key_angles(case))
+    out = []
+    for name, keys in zip(SWINGS, (fwd, back), strict=True):
+        jets = m.jets if name == "forward" else (lambda u: mirrored_jets(m, u))  # noqa: E731 - one line each
+        out.append(
+            SwingSetup(name, keys, jets, _die_exit(case, name, keys), draw_speed_bound(case, keys, jets, limits))
+        )
+    return out[0], out[1]
+
+
+def _die_exit(case: Any, swing: str, keys: tuple[float, ...]) -> float | None:
+    """u [rad] where the slide rises through the die height after theta3 (None: the draw ends above it)."""
+    m, die = case.machine, case.limits.die_height_mm
+    u3 = keys[2]
+    theta3 = u3 if swing == "forward" else TWO_PI - u3
+    if float(m.height(theta3)) > die:
+        return None
+    down, up = (float(a) for a in m.angles_at_height(min(die, m.stroke)))
+    return up if swing == "forward" else TWO_PI - down
+
+
+def draw_speed_bound(case: Any, keys: tuple[float, ...], jets: Any, limits: dict[str, float]) -> float:
+    """The highest constant draw speed [rad/s] in a swing's draw (``keys`` on u, ``jets`` the mechanism on u):
+    each limit's own bound on the draw (``Limit.draw_speed_bound``) and the die speed's over the draw's part at
+    or below the die height and where the draw crosses it."""
+    theta = np.linspace(keys[1], keys[2], DRAW_GRID)
+    h, d1, d2, _ = jets(theta)
+    draw = Draw(case, theta, np.asarray(h), np.asarray(d1), np.asarray(d2))
+    bounds = [case.limits.crank_speed_rpm * RPM if case.limits.crank_speed_rpm else math.inf]
+    for limit in limits_of(case):
+        if limit.id in DRAW_BOUND_LIMITS:
+            b = limit.draw_speed_bound(draw)
+            bounds.append(math.inf if b is None else b)
+    die, v_die = case.limits.die_height_mm, limits.get("die_speed", case.limits.die_speed_mm_s)
+    slopes = list(np.abs(d1[h <= die]))
+    inside = np.flatnonzero(np.diff(np.sign(h - die)) != 0)
+    for k in inside:  # where the draw crosses the die height: the slope there, by bisection on u
+        a, b = theta[k], theta[k + 1]
+        for _ in range(BISECTIONS):
+            mid = 0.5 * (a + b)
+            if (float(jets(mid)[0]) - die) * (float(jets(a)[0]) - die) <= 0:
+                b = mid
+            else:
+                a = mid
+        slopes.append(abs(float(jets(0.5 * (a + b))[1])))
+    steepest = max(slopes, default=0.0)
+    bounds.append(v_die / steepest if steepest > 0 else math.inf)
+    accel = limits.get("slider_accel")
+    if accel is not None:  # the refined acceleration limit in the draw too
+        bounds.append(math.sqrt(accel / max(float(np.max(np.abs(d2))), TINY)))
+    return min(bounds)

@@ -1,0 +1,187 @@
+"""The files of a pendulum plan (``planner.mode: pendulum``): ``result.json``, ``summary.txt``,
+``trajectory.csv`` (the crank's own angle and its signed speed, time 0 at the forward swing's start) and the
+figure ``swing.png`` (or ``--format``'s) (the swings against time and against crank angle)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from planning.model.case import RPM, Case
+from planning.model.pendulum import SWINGS
+from planning.reports.folder import write_json, write_table
+from planning.reports.report import MAX_ROWS, columns_at, trajectory_columns
+from planning.solver.pendulum import PendulumSolution
+
+KEY_NAMES = ("closing", "draw_start", "draw_end", "opening")
+PENDULUM_FILES = ("result.json", "summary.txt", "trajectory.csv", "swing.*")  # what a pendulum solve owns
+
+
+def pendulum_result(solution: PendulumSolution, case: Case) -> dict[str, Any]:
+    """``result.json``'s data: the rate, the swing's ends and standstills, each swing's speeds and key points,
+    the rotary stroke's rate under the same limits and the gain, every check."""
+    plan, verification = solution.plan, solution.evaluation.verification
+    p = plan.parameters
+    swings = {}
+    for name, params in zip(SWINGS, (p.forward, p.backward), strict=True):
+        keys = plan.forward_keys if name == "forward" else plan.backward_keys
+        times = plan.key_times(name)
+        h = case.machine.height(np.array(keys))
+        swings[name] = {
+            "time_s": float(params.duration),
+            "draw_speed_rpm": float(params.draw_speed) / RPM,
+            "feed_peak_rpm": float(params.feed_peak_speed) / RPM,
+            "return_peak_rpm": float(params.return_peak_speed) / RPM,
+            "key_points": [
+                {"name": k, "angle_deg": math.degrees(a), "time_s": float(t), "height_mm": float(hh)}
+                for k, a, t, hh in zip(KEY_NAMES, keys, times, h, strict=True)
+            ],
+        }
+    rotary = {"spm": solution.rotary_spm, "gain_percent": None if solution.gain is None else 100 * solution.gain}
+    if solution.rotary_spm is None:
+        rotary["reason"] = solution.rotary_reason
+    return {
+        "case": case.name,
+        "title": case.title,
+        "mode": "pendulum",
+        "motion_law": plan.motion_law,
+        "status": "verified" if verification.passed else "unverified",
+        "spm": plan.spm,
+        "cycle_time_s": plan.period,
+        "strokes_per_cycle": 2,
+        "swing": {
+            "start_deg": math.degrees(float(p.swing_start)),
+            "end_deg": math.degrees(float(p.swing_end)),
+            "turn_end_s": float(p.turn_end_s),
+            "turn_start_s": float(p.turn_start_s),
+        },
+        "swings": swings,
+        "rotary": rotary,
+        "verification": {
+            "passed": verification.passed,
+            "samples": verification.samples,
+            "step_s": verification.step_s,
+            "binding": [c.name for c in verification.binding()],
+            "checks": [c.as_dict() for c in verification.checks],
+        },
+        "solver": {
+            "iterations": plan.solver.iterations,
+            "starts": plan.solver.starts,
+            "wall_time_s": plan.solver.wall_time_s,
+        },
+    }
+
+
+def pendulum_summary(r: dict[str, Any]) -> str:
+    """The summary ``pressplan solve`` prints for a pendulum plan."""
+    s, f, b = r["swing"], r["swings"]["forward"], r["swings"]["backward"]
+    lines = [
+        f"{r['case']}: {r['spm']:.3f} strokes/min in pendulum strokes, two swings in {r['cycle_time_s']:.4f} s "
+        f"({r['motion_law']}, {r['status']})",
+        f"  the crank swings from {s['start_deg']:.2f} deg through BDC to {s['end_deg']:.2f} deg and back "
+        f"({s['end_deg'] - s['start_deg']:.2f} deg), standing {s['turn_end_s']:.4f} s and {s['turn_start_s']:.4f} s "
+        "at the ends",
+    ]
+    for name, sw in (("forward", f), ("backward", b)):
+        keys = ", ".join(f"{k['name']} {k['angle_deg']:.2f} deg" for k in sw["key_points"])
+        lines.append(
+            f"  {name} swing {sw['time_s']:.4f} s: draw {sw['draw_speed_rpm']:.3f} rpm, peaks "
+            f"{sw['feed_peak_rpm']:.3f} / {sw['return_peak_rpm']:.3f} rpm; {keys}"
+        )
+    rot = r["rotary"]
+    if rot["spm"] is not None:
+        lines.append(
+            f"  the rotary stroke under the same limits: {rot['spm']:.3f} strokes/min; the swing makes "
+            f"{abs(rot['gain_percent']):.1f} % {'more' if rot['gain_percent'] >= 0 else 'fewer'} strokes"
+        )
+    else:
+        lines.append(f"  the rotary stroke under the same limits: no plan ({rot['reason']})")
+    v = r["verification"]
+    lines.append(f"  binding: {', '.join(v['binding']) or 'none'}")
+    failed = [c for c in v["checks"] if not c["passed"]]
+    lines.append(
+        f"  verified on {v['samples']} points (step {1e3 * v['step_s']:.3f} ms): "
+        + ("all checks pass" if not failed else f"{len(failed)} checks fail: " + ", ".join(c["name"] for c in failed))
+    )
+    sv = r["solver"]
+    lines.append(f"  solver: {sv['iterations']} iterations, {sv['starts']} starts, {sv['wall_time_s']:.3f} s")
+    return "\n".join(lines)
+
+
+def pendulum_columns(solution: PendulumSolution, case: Case) -> dict[str, np.ndarray]:
+    """``trajectory.csv``'s columns: the crank's own angle and signed speed over one cycle of two swings."""
+    evaluation = solution.evaluation
+    return columns_at(evaluation, case, evaluation.rows(MAX_ROWS))
+
+
+def pendulum_writers(solution: PendulumSolution, case: Case, figure_format: str | None) -> dict[str, Any]:
+    """The pendulum plan's files: name -> writer; the figure ``swing.<figure_format>`` (None: no figure)."""
+    result = pendulum_result(solution, case)
+    columns = pendulum_columns(solution, case)
+    table = np.column_stack(list(columns.values()))
+    writers = {
+        "result.json": lambda p: write_json(p, result),
+        "summary.txt": lambda p: p.write_text(pendulum_summary(result) + "\n", encoding="utf-8"),
+        "trajectory.csv": lambda p: write_table(p, table, trajectory_columns(case)),
+    }
+    if figure_format is not None:
+        writers[f"swing.{figure_format}"] = lambda p: _save_swing(result, columns, case, p)
+    return writers
+
+
+def _save_swing(result: dict[str, Any], columns: dict[str, np.ndarray], case: Case, path: Path) -> None:
+    from planning.reports.plots import save, swing_figure
+
+    save(swing_figure(result, columns, case.process.safety_height_mm, case.limits.die_height_mm), path)
+
+
+def pendulum_laws(case: Case) -> dict[str, Any]:
+    """``pressplan laws`` of a pendulum case: each law with halves plans the swings (the optimal law says why not);
+    per law the strokes, the cycle, the peak crank jerk and what binds, or why there is no plan."""
+    from planning.model.case import CaseError
+    from planning.model.laws import LAWS
+    from planning.solver.outcomes import PlanningError
+    from planning.solver.pendulum import solve_pendulum
+
+    rows = []
+    for law in LAWS:
+        try:
+            solution = solve_pendulum(case.with_law(law), compare=False)
+        except (CaseError, PlanningError) as exc:
+            reason = exc.message if isinstance(exc, CaseError) else exc.reason
+            rows.append({"law": law, "status": "no plan", "message": reason})
+            continue
+        jerk = (
+            next(c.value for c in solution.evaluation.verification.checks if c.id == "crank_jerk")
+            if any(c.id == "crank_jerk" for c in solution.evaluation.verification.checks)
+            else None
+        )
+        rows.append(
+            {
+                "law": law,
+                "status": "verified",
+                "spm": solution.plan.spm,
+                "cycle_time_s": solution.plan.period,
+                "peak_crank_jerk_rad_s3": jerk,
+                "binding": [c.name for c in solution.evaluation.verification.binding()],
+            }
+        )
+    return {"case": case.name, "mode": "pendulum", "laws": rows}
+
+
+def pendulum_laws_text(data: dict[str, Any]) -> str:
+    """The laws' table of a pendulum case."""
+    lines = [
+        f"{data['case']}: pendulum strokes under each motion law",
+        "",
+        f"  {'law':<18} {'strokes/min':>11}  binding",
+    ]
+    for r in data["laws"]:
+        if r["status"] != "verified":
+            lines.append(f"  {r['law']:<18} {'-':>11}  {r['message']}")
+            continue
+        lines.append(f"  {r['law']:<18} {r['spm']:11.3f}  {', '.join(r['binding']) or '-'}")
+    return "\n".join(lines)

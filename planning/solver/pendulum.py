@@ -1,0 +1,98 @@
+"""Solve a pendulum stroke: the NLP from several starts, the dense verification, the sampled limits refined.
+
+Each start of :func:`~planning.solver.pendulum_nlp.starts` is solved; every converged plan is verified
+densely (``planning.solver.pendulum_check``); the answer is the verified plan with the most strokes. When none
+verifies and the failures are of limits the NLP holds at samples only (the slide's acceleration and speed, the
+die zone), those limits are lowered by their overshoot and the NLP built again, at most
+:data:`REFINE_ROUNDS` times, each round also starting from the last round's best plan. For comparison the
+same case is solved as a rotary stroke (``rotary``): the gain of the swing is stated beside its plan.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+from planning.model.case import Case
+from planning.model.pendulum import PendulumPlan
+from planning.solver.outcomes import NoPlanFound, PlanningError, Unverified
+from planning.solver.pendulum_check import evaluate_pendulum
+from planning.solver.pendulum_nlp import (
+    build,
+    elapsed_info,
+    plan_of_values,
+    refined,
+    sampled_limit_values,
+    solve_once,
+    starts,
+)
+from planning.solver.verify import Evaluation
+
+REFINE_ROUNDS = 4  # the NLP built again with the sampled limits lowered, at most this often
+
+
+@dataclass(frozen=True)
+class PendulumSolution:
+    """A verified pendulum plan: the ``plan``, its ``evaluation``; ``rotary_spm``: the same case as a rotary
+    stroke (None when that has no verified plan, ``rotary_reason`` says why)."""
+
+    plan: PendulumPlan
+    evaluation: Evaluation
+    rotary_spm: float | None = None
+    rotary_reason: str = ""
+
+    @property
+    def gain(self) -> float | None:
+        """Strokes per minute over the rotary stroke's, as a share (0.25: a quarter more)."""
+        return None if self.rotary_spm is None else self.plan.spm / self.rotary_spm - 1
+
+
+def solve_pendulum(case: Case, compare: bool = True) -> PendulumSolution:
+    """The verified pendulum plan of ``case`` with the most strokes (module docstring); ``compare``: solve the
+    rotary stroke too. Raises :class:`~planning.solver.outcomes.PlanningError` without one."""
+    t0 = time.perf_counter()
+    limits = sampled_limit_values(case)
+    tried, iterations, previous = 0, 0, None
+    failure = None
+    for _ in range(REFINE_ROUNDS + 1):
+        nlp = build(case, limits)
+        best, best_failed = None, None
+        for start in starts(case, nlp) + ([previous] if previous else []):
+            values, res = solve_once(case, nlp, start)
+            tried, iterations = tried + 1, iterations + res.iterations
+            if values is None:
+                continue
+            plan = plan_of_values(case, values, elapsed_info(t0, iterations, tried, res.return_status))
+            evaluation = evaluate_pendulum(plan, case)
+            if evaluation.verification.passed:
+                if best is None or plan.spm > best[0].spm:
+                    best = (plan, evaluation)
+            elif best_failed is None or plan.spm > best_failed[0].spm:
+                best_failed = (plan, evaluation)
+        if best is not None:
+            return _with_rotary(case, best, t0, iterations, tried, compare)
+        if best_failed is None:
+            raise NoPlanFound(f"no start of the pendulum NLP converged ({tried} tried)")
+        failure = best_failed[1].verification.failures()
+        limits = refined(limits, failure)
+        previous = best_failed[0].nlp_values
+        if limits is None:
+            break
+    check = failure[0]
+    raise Unverified(f"unverified: {check.name} = {check.value:.6g} {check.unit} (limit {check.limit:.6g})", check)
+
+
+def _with_rotary(case: Case, best: tuple, t0: float, iterations: int, tried: int, compare: bool) -> PendulumSolution:
+    plan, evaluation = best
+    info = elapsed_info(t0, iterations, tried, plan.solver.status)
+    plan = PendulumPlan(plan.parameters, plan.profile, plan.forward_keys, plan.backward_keys, info, plan.nlp_values)
+    evaluation = evaluate_pendulum(plan, case)
+    if not compare:
+        return PendulumSolution(plan, evaluation)
+    from planning.solver.optimize import solve
+
+    rotary = case.model_copy(update={"planner": case.planner.model_copy(update={"mode": "rotary"})})
+    try:
+        return PendulumSolution(plan, evaluation, solve(rotary).plan.spm)
+    except PlanningError as exc:
+        return PendulumSolution(plan, evaluation, None, exc.reason)

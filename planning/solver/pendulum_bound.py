@@ -1,0 +1,127 @@
+"""An upper bound on a pendulum stroke's strokes/min that no swing meeting the case's limits can exceed.
+
+A pendulum cycle (``planning.model.pendulum``) is two robot's windows, each at least the transfer time T, and
+two passes through the work: the forward swing from theta1 to theta4 and the backward swing from its theta1 to
+its theta4 (each monotone, on its path coordinate u). So every cycle lasts at least ``2 T + t_f + t_b``, where
+``t_k`` is the least time any motion meeting the limits takes over swing k's arc theta1 .. theta4, whatever its
+speeds at the arc's ends. ``t_k`` is bounded below on a fine grid of the arc (the key angles, the die-height
+crossings, the dead centres and the inflection points of h among its nodes, so that |h'| is monotone on every
+interval) by the crank speed squared ``s`` any such motion can have at the nodes:
+
+- at most every speed cap there (the top crank speed; a slide-speed cap ``(v / h')^2``: the slider speed, the
+  die speed at or below the die height, the draw start speed at theta2), and on the draw the draw speed's
+  bound, one value over the whole draw (the draw runs at one crank speed);
+- the crank acceleration limit A_c: ``|s_(i+1) - s_i| <= 2 A_c dtheta`` (``d(omega^2)/dtheta = 2 alpha``);
+- the slider acceleration limit A: ``|h'_(i+1)^2 s_(i+1) - h'_i^2 s_i| <= 2 A |h_(i+1) - h_i|`` (``d(v^2)/dtheta
+  = 2 h' a``, h monotone on the interval);
+
+propagated forward and backward over the arc until nothing changes: the largest ``s`` any motion can have at
+each node. Within an interval the speed squared is at most the largest cap at its ends (|h'| monotone) and at
+most either end's envelope plus the crank acceleration's reach, so the interval takes at least ``dtheta /
+sqrt(that)``. The bound is ``120 / (2 T + t_f + t_b)`` (two strokes a cycle). It leaves out the jerk limit, the
+turns (the crank at rest there) and the windows' own motion, so it is loose: an upper bound, not an estimate.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from planning.model.case import RPM, Case
+from planning.model.limits import limits_of
+from planning.model.limits.canonical import SpeedCap
+from planning.model.pendulum import STROKES_PER_CYCLE, SwingSetup, swing_setups
+from planning.solver.upper_bound import inflections, slope_zeros
+from planning.tolerances import SAME_NODE_RAD, TINY
+
+ARC_INTERVALS = 20_000  # intervals over each swing's arc theta1 .. theta4
+MAX_PASSES = 50  # forward and backward passes at most (the envelope settles in a few)
+
+
+@dataclass(frozen=True)
+class PendulumBound:
+    """``spm``: no pendulum motion meeting the limits makes more; ``cycle_time_s`` [s]: no cycle is shorter;
+    ``arc_times_s``: the least time over each swing's theta1 .. theta4 [s] (forward, backward)."""
+
+    spm: float
+    cycle_time_s: float
+    arc_times_s: tuple[float, float]
+
+
+def pendulum_bound(case: Case) -> PendulumBound:
+    """The upper bound of a pendulum case (module docstring)."""
+    setups = swing_setups(case, {})  # the case's own limits
+    times = tuple(_least_arc_time(case, setup) for setup in setups)
+    cycle = 2 * case.process.transfer_time_s + sum(times)
+    return PendulumBound(STROKES_PER_CYCLE * 60.0 / cycle, cycle, times)  # type: ignore[arg-type]
+
+
+def _nodes(case: Case, setup: SwingSetup) -> np.ndarray:
+    """The arc's nodes on u: the key angles, die-height crossings, dead centres and inflections among them."""
+    u1, u2, u3, u4 = setup.keys
+    m = case.machine
+    real = [m.bdc_angle, *slope_zeros(case), *inflections(case), *m.angles_at_height(case.limits.die_height_mm)]
+    on_u = [float(a) if setup.name == "forward" else 2 * math.pi - float(a) for a in real]
+    breaks = sorted({u1, u2, u3, u4, *(a for a in on_u if u1 + SAME_NODE_RAD < a < u4 - SAME_NODE_RAD)})
+    spans = np.diff(breaks)
+    counts = np.maximum(4, np.round(ARC_INTERVALS * spans / spans.sum()).astype(int))
+    parts = [np.linspace(a, b, n + 1)[:-1] for a, b, n in zip(breaks[:-1], breaks[1:], counts, strict=True)]
+    return np.concatenate([*parts, [u4]])
+
+
+def _caps(case: Case, setup: SwingSetup, u: np.ndarray, h: np.ndarray, d1: np.ndarray) -> np.ndarray:
+    """The largest crank speed squared each speed cap allows at the nodes [rad^2/s^2]."""
+    top = case.limits.crank_speed_rpm * RPM if case.limits.crank_speed_rpm else math.inf
+    caps = np.full(u.size, top**2)
+    for limit in limits_of(case):
+        if isinstance(limit, SpeedCap) and not limit.lower and limit.id != "crank_speed":
+            inside = limit.where(case, h, bound=True)
+            inside = np.ones(u.size, dtype=bool) if inside is None else inside
+            moving = inside & (np.abs(d1) > 0)
+            caps[moving] = np.minimum(caps[moving], (limit.top(case) / d1[moving]) ** 2)
+    u2, u3 = setup.keys[1], setup.keys[2]
+    draw = (u >= u2 - SAME_NODE_RAD) & (u <= u3 + SAME_NODE_RAD)
+    caps[draw] = min(float(np.min(caps[draw])), setup.draw_speed_bound**2)
+    at2 = int(np.argmin(np.abs(u - u2)))
+    if abs(d1[at2]) > 0:
+        caps[at2] = min(caps[at2], (case.limits.draw_start_speed_mm_s / d1[at2]) ** 2)
+    return caps
+
+
+def _least_arc_time(case: Case, setup: SwingSetup) -> float:
+    """The least time [s] any motion meeting the limits takes over the swing's theta1 .. theta4."""
+    u = _nodes(case, setup)
+    h, d1, _, _ = setup.jets(u)
+    h, d1 = np.asarray(h), np.asarray(d1)
+    caps = _caps(case, setup, u, h, d1)
+    s = _envelope(case, caps, np.diff(u), h, d1)
+    reach = 2 * (case.limits.crank_accel_rad_s2 or math.inf) * np.diff(u)
+    inside = np.minimum(np.maximum(caps[:-1], caps[1:]), np.minimum(s[:-1], s[1:]) + reach)
+    return float(np.sum(np.diff(u) / np.sqrt(np.maximum(inside, TINY))))
+
+
+def _envelope(case: Case, caps: np.ndarray, du: np.ndarray, h: np.ndarray, d1: np.ndarray) -> np.ndarray:
+    """The largest crank speed squared at the nodes under the caps and both accelerations' reach."""
+    A_c = case.limits.crank_accel_rad_s2 or math.inf
+    A = case.limits.slider_accel_mm_s2
+    slope2 = d1**2
+    rise = 2 * A * np.abs(np.diff(h))
+    s = caps.copy()
+    for _ in range(MAX_PASSES):
+        before = s.copy()
+        for i in range(s.size - 1):  # forward
+            s[i + 1] = min(s[i + 1], s[i] + 2 * A_c * du[i], _slide(slope2[i], s[i], rise[i], slope2[i + 1]))
+        for i in range(s.size - 2, -1, -1):  # backward
+            s[i] = min(s[i], s[i + 1] + 2 * A_c * du[i], _slide(slope2[i + 1], s[i + 1], rise[i], slope2[i]))
+        if np.array_equal(before, s):
+            break
+    return s
+
+
+def _slide(slope2_from: float, s_from: float, rise: float, slope2_to: float) -> float:
+    """The largest crank speed squared at a node the slide's acceleration allows from its neighbour's."""
+    if slope2_to <= 0:
+        return math.inf
+    return (slope2_from * s_from + rise) / slope2_to

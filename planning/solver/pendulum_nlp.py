@@ -1,0 +1,388 @@
+"""The NLP of a pendulum stroke (``planning.model.pendulum``) under a law with halves, built per case.
+
+Both swings in one NLP, each on its own path coordinate u (the forward swing's u is the crank angle, the
+backward swing's ``2 pi - theta``, its mechanism ``h_b(u) = h(2 pi - u)``), each a forward motion with
+speeds >= 0. Variables (scaled to O(1) like the halves NLP's, ``planning.solver.halves_nlp.variable_scales``):
+per swing w2, wm1, wm2, the four halves' durations, the times ``t1`` (from the swing's start to theta1) and
+``t4`` (from theta3 to theta4), ``tx`` (from theta3 to where the slide leaves the die zone, when the draw ends
+inside it); the swing's ends theta_s and theta_e (bounded by :func:`~planning.model.pendulum.swing_bounds`),
+the standstills there, the law's shape parameter.
+
+Rows per swing: the feed reaches theta2 and the return the swing's end (the halves' closed forms from rest and
+from theta3), the peaks at or above the speeds they join (each half monotone), one jerk per S-curve where the
+law says so (Eq. 14), t1 and t4 (and tx) at their angles, the peak acceleration and jerk of each half (closed
+form), the slide's acceleration and speed at ``law.samples`` points of every segment of the halves (held
+``ACCEL_BACKOFF`` inside; the search lowers a limit the dense check finds exceeded between samples), the die
+zone at the return's samples and its exit. In the draw the crank turns at the constant w2, so each limit
+there is a bound on w2 (:func:`draw_speed_bound`), a variable bound. Across the swings: the robot's two
+windows (theta4 through the turn at theta_e to the backward swing's theta1, and the backward swing's theta4
+through theta_s to theta1) each at least the transfer time. The objective: the cycle time (both swings and
+both standstills).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from planning.model.case import RPM, Case
+from planning.model.laws import get_law
+from planning.model.pendulum import (
+    SWINGS,
+    TWO_PI,
+    PendulumParameters,
+    PendulumPlan,
+    SwingParameters,
+    SwingSetup,
+    backward_key_angles,
+    profile_of,
+    swing_bounds,
+    swing_setups,
+)
+from planning.model.plan import SolverInfo
+from planning.model.profile import Profile, advance_segment, knot_states
+from planning.solver.halves_nlp import MIN_HALF_S, TOP_SPEED, VARIABLE_INDEX, angle_at, variable_scales
+from planning.solver.ipopt import NLPSolver
+from planning.tolerances import ACCEL_BACKOFF, IPOPT_CONSTR_VIOL_TOL
+
+SWING_VARIABLES = (  # per swing, prefixed ``forward_`` / ``backward_``: (name, scale kind of the halves NLP)
+    ("draw_speed", "draw_speed"),
+    ("feed_peak_speed", "draw_speed"),
+    ("return_peak_speed", "draw_speed"),
+    ("feed_accel_duration", "feed_accel_duration"),
+    ("feed_decel_duration", "feed_accel_duration"),
+    ("return_accel_duration", "feed_accel_duration"),
+    ("return_decel_duration", "feed_accel_duration"),
+    ("closing_time", "closing_time"),
+    ("opening_time", "closing_time"),
+    ("die_exit_time", "closing_time"),
+)
+SHARED_VARIABLES = (
+    ("swing_start", None),  # theta_s [rad]
+    ("swing_end", None),  # theta_e [rad]
+    ("turn_end_s", "closing_time"),
+    ("turn_start_s", "closing_time"),
+    ("law_parameter", "law_parameter"),
+)
+SAMPLED_LIMITS = ("slider_accel", "slider_speed", "die_speed")  # held at samples: refined on a dense failure
+OPTIONS = {"ipopt.constr_viol_tol": IPOPT_CONSTR_VIOL_TOL, "ipopt.max_iter": 600}
+
+
+@dataclass
+class _Swing:
+    """One swing's symbols: its parameters, the feed's and the return's segments (``(starts, states, segments)``
+    as :func:`~planning.solver.halves_nlp.angle_at` takes them) and the states at their ends."""
+
+    setup: SwingSetup
+    params: SwingParameters
+    v: dict[str, Any]
+    feed: tuple[list, list, list]
+    ret: tuple[list, list, list]
+    feed_end: tuple[Any, Any, Any]
+    return_end: tuple[Any, Any, Any]
+
+
+def _segments_from(segs: list, theta0: Any, omega0: Any) -> tuple[tuple[list, list, list], tuple[Any, Any, Any]]:
+    states = knot_states(theta0, omega0, 0.0, segs)
+    starts = [0.0]
+    for seg in segs[:-1]:
+        starts.append(starts[-1] + seg.duration)
+    return (starts, states[:-1], segs), states[-1]
+
+
+def _swing(setup: SwingSetup, v: dict[str, Any], ends: tuple[Any, Any], law_name: str, law_parameter: Any) -> _Swing:
+    p = SwingParameters(
+        v["draw_speed"],
+        v["feed_peak_speed"],
+        v["return_peak_speed"],
+        v["feed_accel_duration"],
+        v["feed_decel_duration"],
+        v["return_accel_duration"],
+        v["return_decel_duration"],
+        ends[0],
+        setup.keys[1],
+        setup.keys[2],
+        ends[1],
+        law_name,
+        law_parameter,
+    )
+    feed, feed_end = _segments_from(p.feed_segments(), ends[0], 0.0)
+    ret, return_end = _segments_from(p.return_segments(), setup.keys[2], p.draw_speed)
+    return _Swing(setup, p, v, feed, ret, feed_end, return_end)
+
+
+class _Rows:
+    def __init__(self) -> None:
+        self.g: list = []
+        self.lb: list[float] = []
+        self.ub: list[float] = []
+
+    def add(self, expr: Any, lo: float, hi: float) -> None:
+        expr = ca.vec(expr)
+        self.g.append(expr)
+        self.lb += [lo] * expr.shape[0]
+        self.ub += [hi] * expr.shape[0]
+
+
+def _swing_rows(rows: _Rows, s: _Swing, case: Case, limits: dict[str, float], units: dict[str, float]) -> None:
+    """One swing's rows (module docstring)."""
+    p, v, keys = s.params, s.v, s.setup.keys
+    law = get_law(p.motion_law)
+    w_unit, t_unit = units["speed"], units["half"]
+    end_feed, end_return = s.feed_end, s.return_end
+    rows.add(ca.vertcat(end_feed[0] - keys[1], end_return[0] - p.end), 0.0, 0.0)  # theta2 and the end reached
+    # (the speeds at theta2 and at the end are w2 and 0 by construction: the halves' changes add up)
+    w2, wm1, wm2 = p.draw_speed, p.feed_peak_speed, p.return_peak_speed
+    rows.add(ca.vertcat(wm1 - w2, wm2 - w2) / w_unit, 0.0, math.inf)
+    if law.one_jerk_per_curve:  # Eq. 14: one jerk for both halves of each S-curve
+        d_fa, d_fd, d_ra, d_rd = (p.half(n)[0] for n in ("feed_accel", "feed_decel", "return_accel", "return_decel"))
+        one = ca.vertcat(wm1 * d_fd**2 - (wm1 - w2) * d_fa**2, (wm2 - w2) * d_rd**2 - wm2 * d_ra**2)
+        rows.add(one / (t_unit**2 * w_unit), 0.0, 0.0)
+    th1, _ = angle_at(v["closing_time"], *s.feed)
+    th4, _ = angle_at(v["opening_time"], *s.ret)
+    rows.add(ca.vertcat(th1 - keys[0], th4 - keys[3]), 0.0, 0.0)
+    order = ca.vertcat(p.feed_time - v["closing_time"], p.return_time - v["opening_time"]) / t_unit
+    rows.add(order, 0.0, math.inf)
+    if case.limits.crank_accel_rad_s2 is not None:
+        rows.add(ca.vertcat(*p.peak_accelerations()) / case.limits.crank_accel_rad_s2, -math.inf, 1.0)
+    if case.limits.crank_jerk_rad_s3 is not None:
+        rows.add(ca.vertcat(*p.peak_jerks()) / case.limits.crank_jerk_rad_s3, -math.inf, 1.0)
+    _sampled_rows(rows, s, case, limits)
+
+
+def _sampled_rows(rows: _Rows, s: _Swing, case: Case, limits: dict[str, float]) -> None:
+    """The slide's acceleration (and speed) at samples of every segment of the halves; the die zone at the
+    return's samples and its exit."""
+    law = get_law(s.params.motion_law)
+    fractions = ca.DM(np.linspace(0.0, 1.0, law.samples + 1)[:-1])
+    lim = case.limits
+    v_die = limits["die_speed"]
+    for _, states, segs in (s.feed, s.ret):
+        for seg, st in zip(segs, states, strict=True):
+            th, om, al, _ = advance_segment(seg, *st, fractions * seg.duration)
+            h, d1, d2, _ = s.setup.jets(th)
+            rows.add((d2 * om**2 + d1 * al) / limits["slider_accel"], -1.0, 1.0)
+            if lim.slider_speed_mm_s is not None:
+                rows.add(d1 * om / limits["slider_speed"], -1.0, 1.0)
+    if s.setup.die_exit is not None:
+        th_x, om_x = angle_at(s.v["die_exit_time"], *s.ret)
+        slope = abs(float(s.setup.jets(s.setup.die_exit)[1]))
+        rows.add(ca.vertcat(th_x - s.setup.die_exit), 0.0, 0.0)
+        rows.add(slope * om_x / v_die, -math.inf, 1.0)
+
+
+@dataclass
+class PendulumNLP:
+    """The compiled NLP of one case: the solver, the rows' bounds, the variables' names, scales and bounds."""
+
+    solver: NLPSolver
+    lbg: np.ndarray
+    ubg: np.ndarray
+    names: tuple[str, ...]
+    scales: np.ndarray
+    lbx: np.ndarray
+    ubx: np.ndarray
+    setups: tuple[SwingSetup, SwingSetup]
+
+
+def _variables(case: Case) -> tuple[tuple[str, ...], np.ndarray]:
+    """The variables' names and scales (the halves NLP's scales by kind; the swing's ends in radians)."""
+    halves_scale = variable_scales(case)
+    names, scales = [], []
+    for swing in SWINGS:
+        for name, kind in SWING_VARIABLES:
+            names.append(f"{swing}_{name}")
+            scales.append(halves_scale[VARIABLE_INDEX[kind]])
+    for name, kind in SHARED_VARIABLES:
+        names.append(name)
+        scales.append(1.0 if kind is None else halves_scale[VARIABLE_INDEX[kind]])
+    return tuple(names), np.array(scales)
+
+
+def build(case: Case, limits: dict[str, float]) -> PendulumNLP:
+    """The NLP of ``case`` with the sampled limits at ``limits`` (by id, inside units)."""
+    names, scales = _variables(case)
+    x = ca.SX.sym("x", len(names))
+    phys = {name: x[i] * scales[i] for i, name in enumerate(names)}
+    setups = swing_setups(case, limits)
+    theta_s, theta_e = phys["swing_start"], phys["swing_end"]
+    ends = {"forward": (theta_s, theta_e), "backward": (TWO_PI - theta_e, TWO_PI - theta_s)}
+    law = case.planner.motion_law
+    rows = _Rows()
+    units = {"speed": scales[0], "half": scales[3]}
+    swings = {}
+    for setup in setups:
+        v = {name: phys[f"{setup.name}_{name}"] for name, _ in SWING_VARIABLES}
+        swings[setup.name] = _swing(setup, v, ends[setup.name], law, phys["law_parameter"])
+        _swing_rows(rows, swings[setup.name], case, limits, units)
+    f, b = swings["forward"], swings["backward"]
+    transfer = case.process.transfer_time_s
+    window_e = f.params.return_time - f.v["opening_time"] + phys["turn_end_s"] + b.v["closing_time"]
+    window_s = b.params.return_time - b.v["opening_time"] + phys["turn_start_s"] + f.v["closing_time"]
+    rows.add(ca.vertcat(window_e, window_s) / transfer - 1.0, 0.0, math.inf)
+    period = PendulumParameters(f.params, b.params, phys["turn_end_s"], phys["turn_start_s"]).period
+    solver = NLPSolver("pendulum", {"x": x, "f": period / transfer, "g": ca.vertcat(*rows.g)}, OPTIONS, scales)
+    lbx, ubx = _bounds(case, names, setups)
+    return PendulumNLP(solver, np.array(rows.lb), np.array(rows.ub), names, scales, lbx, ubx, setups)
+
+
+def _bounds(case: Case, names: tuple[str, ...], setups: tuple[SwingSetup, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """Variable bounds: speeds from the least crank speed (the draw) or 0 up to the top crank speed, the draw
+    speed at most its swing's bound (the case's own when it gives one), durations above ``MIN_HALF_S``."""
+    lo, hi = np.zeros(len(names)), np.full(len(names), np.inf)
+    top = case.limits.crank_speed_rpm * RPM if case.limits.crank_speed_rpm else TOP_SPEED
+    given = case.process.draw_speed_rpm
+    (s_lo, s_hi), (e_lo, e_hi) = swing_bounds(case)
+    for i, name in enumerate(names):
+        if name.endswith("peak_speed"):
+            hi[i] = top
+        elif name.endswith("draw_speed"):
+            bound = next(s.draw_speed_bound for s in setups if name.startswith(s.name))
+            lo[i] = case.limits.min_crank_speed_rpm * RPM
+            hi[i] = min(bound, top)
+            if given is not None:
+                lo[i] = hi[i] = given * RPM
+        elif name.endswith("_duration"):
+            lo[i] = MIN_HALF_S
+        elif name == "swing_start":
+            lo[i], hi[i] = s_lo, s_hi
+        elif name == "swing_end":
+            lo[i], hi[i] = e_lo, e_hi
+        elif name == "law_parameter":
+            lo[i], hi[i] = _law_parameter_bounds(case)
+    return lo, hi
+
+
+def _law_parameter_bounds(case: Case) -> tuple[float, float]:
+    law = get_law(case.planner.motion_law)
+    fixed = case.planner.law_parameter
+    if law.parameter is None:
+        return 0.0, 0.0
+    if fixed is not None:
+        return fixed, fixed
+    return law.parameter.low, law.parameter.high
+
+
+def starts(case: Case, nlp: PendulumNLP) -> list[dict[str, float]]:
+    """Starting points that meet the swings' own rows: the draw at its bound and at half of it, the peaks 1.5 and
+    3 times the draw speed, each swing turning midway in its room; each S-curve with one jerk (Eq. 14) that sweeps
+    its angle, the key points' times where that motion passes them."""
+    (s_lo, s_hi), (e_lo, e_hi) = swing_bounds(case)
+    law = get_law(case.planner.motion_law)
+    shape = 0.0 if law.parameter is None else (case.planner.law_parameter or law.parameter.start)
+    out = []
+    for draw_share, peak in ((1.0, 1.5), (0.5, 3.0), (1.0, 3.0), (0.5, 1.5)):
+        values = {"swing_start": 0.5 * (s_lo + s_hi), "swing_end": 0.5 * (e_lo + e_hi), "law_parameter": shape}
+        values.update({"turn_end_s": 0.0, "turn_start_s": 0.0})
+        ends = {
+            "forward": (values["swing_start"], values["swing_end"]),
+            "backward": (TWO_PI - values["swing_end"], TWO_PI - values["swing_start"]),
+        }
+        for setup in nlp.setups:
+            i = nlp.names.index(f"{setup.name}_draw_speed")
+            w2 = max(nlp.lbx[i], min(nlp.ubx[i], draw_share * nlp.ubx[i]))
+            values.update(_swing_start(setup, ends[setup.name], w2, peak * w2, law.name, shape))
+        transfer = case.process.transfer_time_s
+        turns = (("turn_end_s", ("forward", "backward")), ("turn_start_s", ("backward", "forward")))
+        for turn, (first, second) in turns:
+            window = _tail(values, first) + values[f"{second}_closing_time"]
+            values[turn] = max(transfer - window, 0.0)
+        out.append(values)
+    return out
+
+
+def _tail(values: dict[str, float], swing: str) -> float:
+    """[s] from the swing's theta4 to its end."""
+    ret = values[f"{swing}_return_accel_duration"] + values[f"{swing}_return_decel_duration"]
+    return ret - values[f"{swing}_opening_time"]
+
+
+def _swing_start(setup: SwingSetup, ends: tuple[float, float], w2: float, wm: float, law: str, shape: float) -> dict:
+    """One swing's start values: S-curves of one jerk each (Eq. 14: ``dv = k J T^2`` per half of ``4 T``, the
+    half sweeping ``D (v0 + v1) / 2``) through the draw speed ``w2`` with peaks ``wm``."""
+    a, e = ends
+    feed, ret = setup.keys[1] - a, e - setup.keys[2]
+    # feed: 0 -> wm -> w2 sweeps 2 T_a wm + 2 T_d (wm + w2), T = sqrt(dv / (k J)): solve for sqrt(k J)
+    root = 2 * (wm**1.5 + math.sqrt(wm - w2) * (wm + w2)) / feed
+    fa, fd = 4 * math.sqrt(wm) / root, max(4 * math.sqrt(wm - w2) / root, MIN_HALF_S)
+    root = 2 * (math.sqrt(wm - w2) * (w2 + wm) + wm**1.5) / ret
+    ra, rd = max(4 * math.sqrt(wm - w2) / root, MIN_HALF_S), 4 * math.sqrt(wm) / root
+    p = SwingParameters(w2, wm, wm, fa, fd, ra, rd, a, setup.keys[1], setup.keys[2], e, law, shape)
+    feed_profile = Profile(tuple(p.feed_segments()), a, 0.0)
+    ret_profile = Profile(tuple(p.return_segments()), setup.keys[2], w2)
+    n = setup.name
+    exit_time = ret_profile.time_at_angle(setup.die_exit) if setup.die_exit is not None else 0.0
+    return {
+        f"{n}_draw_speed": w2,
+        f"{n}_feed_peak_speed": wm,
+        f"{n}_return_peak_speed": wm,
+        f"{n}_feed_accel_duration": fa,
+        f"{n}_feed_decel_duration": fd,
+        f"{n}_return_accel_duration": ra,
+        f"{n}_return_decel_duration": rd,
+        f"{n}_closing_time": feed_profile.time_at_angle(setup.keys[0]),
+        f"{n}_opening_time": ret_profile.time_at_angle(setup.keys[3]),
+        f"{n}_die_exit_time": exit_time,
+    }
+
+
+def plan_of_values(case: Case, values: dict[str, float], info: SolverInfo) -> PendulumPlan:
+    """The plan of the NLP's variable ``values``."""
+    law = case.planner.motion_law
+    setups = swing_setups(case, {})
+    theta_s, theta_e = values["swing_start"], values["swing_end"]
+    ends = {"forward": (theta_s, theta_e), "backward": (TWO_PI - theta_e, TWO_PI - theta_s)}
+    swings = {}
+    for setup in setups:
+        n = setup.name
+        a, e = ends[n]
+        swings[n] = SwingParameters(
+            *(float(values[f"{n}_{k}"]) for k, _ in SWING_VARIABLES[:7]),
+            a,
+            setup.keys[1],
+            setup.keys[2],
+            e,
+            law,
+            float(values["law_parameter"]),
+        )
+    params = PendulumParameters(swings["forward"], swings["backward"], values["turn_end_s"], values["turn_start_s"])
+    fwd = tuple(float(a) for a in case.key_angles)
+    return PendulumPlan(params, profile_of(params), fwd, backward_key_angles(case), info, dict(values))
+
+
+def solve_once(case: Case, nlp: PendulumNLP, start: dict[str, float]) -> tuple[dict[str, float] | None, Any]:
+    """One IPOPT solve from ``start``: the variable values when it converged (else None) and the result."""
+    x0 = np.array([start[name] for name in nlp.names])
+    res = nlp.solver.solve(x0, nlp.lbx, nlp.ubx, nlp.lbg, nlp.ubg)
+    values = {name: float(res.x[i]) for i, name in enumerate(nlp.names)} if res.success else None
+    return values, res
+
+
+def sampled_limit_values(case: Case) -> dict[str, float]:
+    """The sampled limits' values the first NLP holds (inside units; the acceleration ``ACCEL_BACKOFF`` inside)."""
+    lim = case.limits
+    out = {"slider_accel": lim.slider_accel_mm_s2 * (1 - ACCEL_BACKOFF), "die_speed": lim.die_speed_mm_s}
+    if lim.slider_speed_mm_s is not None:
+        out["slider_speed"] = lim.slider_speed_mm_s
+    return out
+
+
+def refined(limits: dict[str, float], failures: list) -> dict[str, float] | None:
+    """``limits`` with each sampled limit the dense check found exceeded lowered by its overshoot (None when a
+    failure is no sampled limit's: refining cannot help)."""
+    out = dict(limits)
+    for check in failures:
+        if check.id not in SAMPLED_LIMITS:
+            return None
+        out[check.id] = limits[check.id] * min(check.limit / check.value, 1 - ACCEL_BACKOFF)
+    return out
+
+
+def elapsed_info(t0: float, iterations: int, tried: int, status: str) -> SolverInfo:
+    """The solver's report of a pendulum solve."""
+    return SolverInfo(iterations, time.perf_counter() - t0, tried, status)

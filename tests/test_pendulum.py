@@ -1,0 +1,185 @@
+"""The pendulum stroke (issue 40): the crank swings through BDC and back, never past TDC; each swing a stroke.
+
+Checked from the written trajectory with the crank-slider's own closed form and finite differences (not the plan's
+derivatives), against the rotary stroke of the same case, against the certified bound (an inequality every plan
+must meet), on a link drive whose two swings differ, and with plans changed just past a limit."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from planning.cli import main
+from planning.model.case_file import read_case
+from planning.model.pendulum import profile_of
+from planning.solver.pendulum import solve_pendulum
+from planning.solver.pendulum_bound import pendulum_bound
+from planning.solver.pendulum_check import evaluate_pendulum
+
+from .conftest import ROOT
+
+SHALLOW = ROOT / "cases" / "pendulum" / "shallow-pendulum.yaml"
+LINK = ROOT / "tests" / "data" / "cases" / "link-pendulum.yaml"
+RPM = 2 * math.pi / 60
+
+
+@pytest.fixture(scope="module")
+def shallow():
+    case = read_case(SHALLOW)
+    return case, solve_pendulum(case)
+
+
+@pytest.fixture(scope="module")
+def link():
+    case = read_case(LINK)
+    return case, solve_pendulum(case, compare=False)
+
+
+def _columns(path) -> dict[str, np.ndarray]:  # noqa: ANN001
+    with open(path, encoding="utf-8") as fh:
+        rows = list(csv.DictReader(fh))
+    return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]}
+
+
+def test_shallow_part_more_strokes_than_rotary_and_below_the_bound(shallow):
+    case, solution = shallow
+    assert solution.evaluation.verification.passed
+    assert solution.rotary_spm is not None  # the rotary stroke of the same case, verified (solve raises otherwise)
+    assert solution.plan.spm > 1.2 * solution.rotary_spm  # the swing skips the trip through TDC
+    bound = pendulum_bound(case)
+    assert bound.spm >= solution.plan.spm
+    for k, swing in enumerate(("forward", "backward")):  # the bound's least arc time is below the plan's own
+        t = solution.plan.key_times(swing)
+        assert t[3] - t[0] >= bound.arc_times_s[k]
+
+
+def test_written_swing_through_the_closed_form(shallow, tmp_path):
+    """From trajectory.csv alone: the slide from the crank angle by the crank-slider's closed form, the crank never
+    past TDC, turning at rest twice a cycle, the limits by finite differences, the robot's windows."""
+    case, _ = shallow
+    assert main(["solve", str(SHALLOW), "--out", str(tmp_path), "--no-plots"]) == 0
+    c = _columns(tmp_path / "trajectory.csv")
+    t, theta = c["time_s"], np.radians(c["crank_angle_deg"])
+    r, rod = case.press.crank_radius_mm, case.press.rod_length_mm
+    h = r * (1 + np.cos(theta)) + rod - np.sqrt(rod**2 - (r * np.sin(theta)) ** 2)  # the slide below the crank
+    assert np.max(np.abs(h - c["slider_height_mm"])) < 1e-9
+    assert 0 < np.min(theta) and np.max(theta) < 2 * math.pi  # never through TDC
+    speed = np.gradient(theta, t)
+    assert np.max(np.abs(speed)) / RPM <= case.limits.crank_speed_rpm * (1 + 1e-3)
+    signs = np.sign(np.round(c["crank_speed_rpm"], 6))
+    assert np.count_nonzero(np.diff(signs[signs != 0]) != 0) == 1  # forward, then back: one reversal inside
+    accel = np.gradient(np.gradient(c["slider_height_mm"], t), t)
+    assert np.max(np.abs(accel[2:-2])) <= case.limits.slider_accel_mm_s2 * 1.01
+    above = c["slider_height_mm"] >= case.process.safety_height_mm
+    runs, start = [], None  # the windows: the slide above the safety height around each turn
+    for k, up in enumerate(np.append(above, False)):
+        if up and start is None:
+            start = k
+        if not up and start is not None:
+            runs.append(t[k - 1] - t[start])
+            start = None
+    middle = max(runs[1:-1])  # the turn at theta_e; the one at theta_s wraps over the cycle's ends
+    wrapped = runs[0] + runs[-1] + (t[1] - t[0])
+    step = t[1] - t[0]
+    assert min(middle, wrapped) >= case.process.transfer_time_s - 2 * step
+    result = json.loads((tmp_path / "result.json").read_text())
+    assert result["mode"] == "pendulum" and result["rotary"]["gain_percent"] > 20
+
+
+def test_crank_slider_swings_are_mirror_images(shallow):
+    case, solution = shallow
+    p, plan = solution.plan.parameters, solution.plan
+    for name in ("draw_speed", "feed_peak_speed", "return_peak_speed", "feed_accel_duration", "return_decel_duration"):
+        assert getattr(p.backward, name) == pytest.approx(getattr(p.forward, name), rel=1e-6)
+    (f0, f1), (b0, _) = plan.swing_spans().values()
+    tau = np.linspace(0.0, f1 - f0, 400)
+    forward = plan.profile.at_time(f0 + tau)[0]
+    backward = plan.profile.at_time(b0 + tau)[0]
+    assert np.max(np.abs(backward - (2 * math.pi - forward))) < 1e-6
+
+
+def test_link_drive_swings_differ_both_verified(link):
+    case, solution = link
+    assert solution.evaluation.verification.passed
+    f, b = solution.plan.parameters.forward, solution.plan.parameters.backward
+    assert abs(f.duration - b.duration) > 0.05 * f.duration  # the slide comes down on the fast side going back
+    keys = solution.plan.backward_keys
+    m = case.machine
+    assert np.allclose(m.height(np.array(keys)), m.height(case.key_angles), atol=1e-6)  # the same heights
+    assert keys[0] > m.bdc_angle > keys[3]  # on the other side of BDC, in the other order
+    assert pendulum_bound(case).spm >= solution.plan.spm
+
+
+def test_verification_fails_just_past_a_limit(shallow):
+    """The verified plan against cases changed just past what it does: each check fails."""
+    case, solution = shallow
+    plan = solution.plan
+    window = min(c.value for c in solution.evaluation.verification.checks if c.id == "transfer_time")
+    peak = next(c.value for c in solution.evaluation.verification.checks if c.id == "crank_speed")
+    longer = case.model_copy(update={"process": case.process.model_copy(update={"transfer_time_s": window + 0.01})})
+    slower = case.model_copy(update={"limits": case.limits.model_copy(update={"crank_speed_rpm": peak * 0.995})})
+    for changed, check_id in ((longer, "transfer_time"), (slower, "crank_speed")):
+        failed = {c.id for c in evaluate_pendulum(plan, changed).verification.failures()}
+        assert failed == {check_id}
+    back = plan.parameters.backward
+    longer_half = replace(back, return_decel_duration=back.return_decel_duration * 1.001)  # sweeps past theta_s
+    moved = replace(plan.parameters, backward=longer_half)
+    wrong = replace(plan, parameters=moved, profile=profile_of(moved))
+    assert "cycle_angle" in {c.id for c in evaluate_pendulum(wrong, case).verification.failures()}
+
+
+@pytest.mark.parametrize(
+    ("setting", "field"),
+    [
+        ("planner.motion_law=optimal", "planner.motion_law"),
+        ("process.hold_time_s=0.2", "process.hold_time_s"),
+        ("planner.objective=min-energy", "planner.objective"),
+    ],
+)
+def test_what_a_swing_does_not_plan_with_is_refused(setting, field, capsys):
+    assert main(["solve", str(SHALLOW), "--set", setting, "--no-plots", "--out", "/nonexistent/x"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and field in err[0] and "pendulum" in err[0]
+
+
+@pytest.mark.parametrize("command", [["compare"], ["cam"], ["tradeoff", "--spm", "30"]])
+def test_commands_without_swings_refuse_in_one_line(command, tmp_path, capsys):
+    args = [command[0], str(SHALLOW), *command[1:], "--out", str(tmp_path)]
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "planner.mode: pendulum" in err[0]
+
+
+def test_check_and_bound_take_a_swing(capsys):
+    assert main(["check", str(LINK)]) == 0
+    out = capsys.readouterr().out
+    assert "the backward swing's key angles" in out and "highest draw speed of each swing" in out
+    assert main(["bound", str(SHALLOW), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["mode"] == "pendulum" and data["upper_bound_spm"] > 0
+
+
+def test_sweep_and_laws_take_a_swing(tmp_path, capsys):
+    """A transfer-time sweep: every point verified, fewer strokes the longer the transfer; each law with halves
+    plans the swings, the optimal law says why not."""
+    out = tmp_path / "sweep"
+    assert main(["sweep", str(SHALLOW), "--vary", "process.transfer_time_s=0.3:0.5:3", "--out", str(out)]) == 0
+    rows = _columns_of(out / "sweep.csv")
+    assert [r["status"] for r in rows] == ["verified"] * 3
+    spm = [float(r["spm"]) for r in rows]
+    assert spm[0] > spm[1] > spm[2]
+    capsys.readouterr()
+    assert main(["laws", str(SHALLOW), "--out", str(tmp_path / "laws"), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    status = {r["law"]: r["status"] for r in data["laws"]}
+    assert status.pop("optimal") == "no plan" and set(status.values()) == {"verified"}
+
+
+def _columns_of(path) -> list[dict[str, str]]:  # noqa: ANN001
+    with open(path, encoding="utf-8") as fh:
+        return list(csv.DictReader(fh))
