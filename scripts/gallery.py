@@ -24,6 +24,7 @@ SWEEPS = {  # the published case's sweeps: one field, two fields (some points wi
 CAPTIONS = {
     "motion_vs_angle.png": "the motion against crank angle (`pressplan solve`)",
     "motion_vs_time.png": "the motion against time (`pressplan solve`)",
+    "swing.png": "the swings against time and against crank angle (`pressplan solve`, a pendulum stroke)",
     "drive.png": "the drive (`pressplan solve`, a case with a drive)",
     "interference.png": "the robots on their interference curves (`pressplan solve`, a case with robots)",
     "laws_overlay.png": "every motion law (`pressplan laws`)",
@@ -48,7 +49,8 @@ def case_figures(case: Path, scratch: Path) -> dict[str, Path]:
     _run(["solve", str(case), "--out", str(scratch / "solve")])
     found.update({p.name: p for p in (scratch / "solve").glob("*.png")})
     _run(["laws", str(case), "--out", str(scratch / "laws")])
-    found["laws_overlay.png"] = scratch / "laws" / "laws_overlay.png"
+    if (scratch / "laws" / "laws_overlay.png").exists():  # a pendulum case's laws are a table only
+        found["laws_overlay.png"] = scratch / "laws" / "laws_overlay.png"
     if "\ndrive:" in case.read_text(encoding="utf-8"):
         _run(["tradeoff", str(case), "--spm", "5:max:5", "--out", str(scratch / "tradeoff")])
         found["tradeoff.png"] = scratch / "tradeoff" / "tradeoff.png"
@@ -76,12 +78,13 @@ def main() -> int:
         "Every figure of every shipped case, written by `scripts/gallery.py` from a fresh run.",
         "",
     ]
-    for case in sorted((ROOT / "cases").glob("*.yaml")):
+    for case in sorted((ROOT / "cases").glob("*.yaml")) + sorted((ROOT / "cases" / "pendulum").glob("*.yaml")):
         with tempfile.TemporaryDirectory() as folder:
             figures = case_figures(case, Path(folder))
             target = GALLERY / case.stem
             target.mkdir(parents=True)
-            lines += [f"## {case.stem}", "", f"[`cases/{case.name}`](../cases/{case.name})", ""]
+            where = case.relative_to(ROOT).as_posix()
+            lines += [f"## {case.stem}", "", f"[`{where}`](../{where})", ""]
             for name in CAPTIONS:
                 if name in figures:
                     _compact(figures[name], target / name)

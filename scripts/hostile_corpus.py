@@ -191,6 +191,12 @@ CORPUS: dict[str, tuple[str, str | bytes]] = {
     # a draw at constant slide speed: the published case gives a constant draw speed too
     "slide_speed_with_draw_speed": ("process.draw_speed_rpm", add("process.draw_slide_speed_mm_s", "60")),
     "slide_speed_negative": ("process.draw_slide_speed_mm_s", add("process.draw_slide_speed_mm_s", "-60")),
+    # a pendulum stroke: a mode that is no mode; a swing under the optimal law (not yet)
+    "mode_word": ("planner.mode", add("planner.mode", "swing")),
+    "pendulum_optimal": (
+        "planner.motion_law",
+        BASE.replace("  motion_law: improved-s-curve", "  motion_law: optimal\n  mode: pendulum"),
+    ),
     "angle_inf": ("key_points.opening_deg", field("key_points.opening_deg", "-.inf")),
     # types an engineer might not mean
     "bool_number": ("press.crank_radius_mm", field("press.crank_radius_mm", "true")),

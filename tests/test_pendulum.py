@@ -183,3 +183,10 @@ def test_sweep_and_laws_take_a_swing(tmp_path, capsys):
 def _columns_of(path) -> list[dict[str, str]]:  # noqa: ANN001
     with open(path, encoding="utf-8") as fh:
         return list(csv.DictReader(fh))
+
+
+def test_plot_redraws_a_swing(tmp_path):
+    assert main(["solve", str(SHALLOW), "--out", str(tmp_path), "--no-plots"]) == 0
+    assert not list(tmp_path.glob("swing.*"))
+    assert main(["plot", str(tmp_path), "--format", "svg"]) == 0
+    assert (tmp_path / "swing.svg").read_text(encoding="utf-8").lstrip().startswith("<?xml")

@@ -115,6 +115,7 @@ _PLANNER = """\
 planner:
   motion_law: improved-s-curve       # or seven-segment, quintic, cycloidal, logistic, optimal (`pressplan laws`)
   placement: free                    # free: the motion may pass theta1/theta4 anywhere in its stages
+  # mode: pendulum                   # swing through BDC and back, each swing a stroke (docs/modes.md)
 """
 
 _FORCE = {

@@ -57,6 +57,8 @@ def pendulum_result(solution: PendulumSolution, case: Case) -> dict[str, Any]:
             "end_deg": math.degrees(float(p.swing_end)),
             "turn_end_s": float(p.turn_end_s),
             "turn_start_s": float(p.turn_start_s),
+            "safety_height_mm": case.process.safety_height_mm,
+            "die_height_mm": case.limits.die_height_mm,
         },
         "swings": swings,
         "rotary": rotary,
@@ -128,14 +130,14 @@ def pendulum_writers(solution: PendulumSolution, case: Case, figure_format: str 
         "trajectory.csv": lambda p: write_table(p, table, trajectory_columns(case)),
     }
     if figure_format is not None:
-        writers[f"swing.{figure_format}"] = lambda p: _save_swing(result, columns, case, p)
+        writers[f"swing.{figure_format}"] = lambda p: _save_swing(result, columns, p)
     return writers
 
 
-def _save_swing(result: dict[str, Any], columns: dict[str, np.ndarray], case: Case, path: Path) -> None:
+def _save_swing(result: dict[str, Any], columns: dict[str, np.ndarray], path: Path) -> None:
     from planning.reports.plots import save, swing_figure
 
-    save(swing_figure(result, columns, case.process.safety_height_mm, case.limits.die_height_mm), path)
+    save(swing_figure(result, columns), path)
 
 
 def pendulum_laws(case: Case) -> dict[str, Any]:

@@ -721,13 +721,14 @@ def line_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
     return fig
 
 
-def swing_figure(result: dict[str, Any], traj: dict[str, np.ndarray], safety_mm: float, die_mm: float) -> Figure:
+def swing_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
     """A pendulum plan (``planning.reports.pendulum``): the crank angle, its signed speed and the slide against
     time (the robot's windows through the turns shaded), and the slide against crank angle for each swing."""
     fig = Figure(figsize=(11, 7.5), layout="constrained")
     FigureCanvasAgg(fig)
     ax = fig.subplots(2, 2)
     t, theta, h = traj["time_s"], traj["crank_angle_deg"], traj["slider_height_mm"]
+    safety_mm, die_mm = result["swing"]["safety_height_mm"], result["swing"]["die_height_mm"]
     f, b = result["swings"]["forward"]["key_points"], result["swings"]["backward"]["key_points"]
     period = result["cycle_time_s"]
     windows = [(f[3]["time_s"], b[0]["time_s"]), (b[3]["time_s"], period), (0.0, f[0]["time_s"])]

@@ -39,7 +39,12 @@ def redraw(folder: Path, plot_format: str = "png") -> dict[str, Writer]:
         traj = read_table(folder / "trajectory.csv")
         pub_path = folder / "published_profile.csv"
         published = read_table(pub_path) if pub_path.exists() else None
-        figures = plot_files(result, traj, published, plot_format)
+        if result.get("mode") == "pendulum":  # a pendulum plan's own figure (``planning.reports.pendulum``)
+            from planning.reports.plots import swing_figure
+
+            figures = {f"swing.{plot_format}": swing_figure(result, traj)}
+        else:
+            figures = plot_files(result, traj, published, plot_format)
     except (OSError, ValueError, KeyError, IndexError, TypeError, AttributeError) as exc:
         reason = " ".join(str(exc).split())[:120] or type(exc).__name__
         raise OutputError(f"{folder}: not a finished pressplan output folder ({reason})") from None
