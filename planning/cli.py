@@ -334,7 +334,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if case.pendulum and args.command not in PENDULUM_COMMANDS:
             raise CommandError(
                 f"{args.case}: planner.mode: pendulum: pressplan {args.command} plans rotary strokes only (yet); "
-                f"{', '.join(sorted(PENDULUM_COMMANDS))} take a pendulum stroke"
+                f"{', '.join(sorted(PENDULUM_COMMANDS | {'cam', 'plot'}))} take a pendulum stroke"
             )
         return command(case, args)
     except Exception as exc:
@@ -416,28 +416,44 @@ def _solve(case, args) -> int:
 
 
 def _solve_pendulum(case, args) -> int:
-    """``pressplan solve`` of a pendulum stroke (``planning.reports.pendulum``): its own files, no cams yet."""
-    from planning.reports.outputs import options as outputs_taking
-    from planning.reports.pendulum import PENDULUM_FILES, pendulum_result, pendulum_summary, pendulum_writers
+    """``pressplan solve`` of a pendulum stroke (``planning.reports.pendulum``): its own files, the cam table and,
+    with ``--cam``, the proved cams (on a master turning once a cycle of two swings)."""
+    from planning.reports.cam_export import proof_lines
+    from planning.reports.outputs import Written
+    from planning.reports.pendulum import pendulum_result, pendulum_summary, pendulum_writers
     from planning.solver.pendulum import solve_pendulum
 
-    given = [
-        o.flag
-        for o in outputs_taking()
-        if o.kwargs["dest"] not in ("no_plots", "plot_format")  # the figures' own: the swing's figure takes them
-        and getattr(args, o.kwargs["dest"]) not in (None, False, o.kwargs.get("default"))
-    ]
-    if given or args.placement == "published":
-        flag = given[0] if given else "--placement published"
-        raise CommandError(f"{args.case}: {flag}: not with planner.mode: pendulum (a swing's files are its own)")
-    out = _output_folder(case, args, PENDULUM_FILES)
+    if args.placement == "published":
+        raise CommandError(f"{args.case}: --placement published: not with planner.mode: pendulum")
+    owned = _pendulum_files()
+    out = _output_folder(case, args, owned)
     solution = solve_pendulum(case)
     figures = not args.no_plots
     if figures:
         _load_plots()
     writers = pendulum_writers(solution, case, args.plot_format if figures else None)
+    written = Written(solution, case, {o.kwargs["dest"]: getattr(args, o.kwargs["dest"]) for o in output_options()})
+    writers.update(_pendulum_cam_writers(written, with_table=True))
     result = pendulum_result(solution, case)
-    return _write_and_report(out, writers, result, pendulum_summary(result), args, PENDULUM_FILES)
+    text = pendulum_summary(result)
+    if written.cam is not None:
+        text += "\n\n" + "\n".join(proof_lines(written.cam))
+    return _write_and_report(out, writers, result, text, args, owned)
+
+
+def _pendulum_files() -> tuple[str, ...]:
+    """What a pendulum solve owns in its folder: its own files, the cam table and the cams."""
+    from planning.reports.pendulum import PENDULUM_FILES
+
+    return PENDULUM_FILES + ("cam_table.csv",) + tuple(p for o in _cam_outputs() for p in o.files)
+
+
+def _pendulum_cam_writers(written, with_table: bool) -> dict:  # noqa: ANN001 - a Written
+    """The cam outputs' writers for a pendulum plan (the registry's cam outputs read its plan and case only)."""
+    from planning.reports.outputs import BY_NAME
+
+    chosen = _cam_outputs() + ((BY_NAME["cam_table.csv"],) if with_table else ())
+    return {name: w for output in chosen for name, w in output.writers(written).items()}
 
 
 def _cam(args) -> int:
@@ -459,14 +475,20 @@ def _cam(args) -> int:
 
         args.case = args.source
         case = _read(args)
-        if case.pendulum:  # a swing's cam is not monotonic in the crank angle: on a time master, not yet
-            raise CommandError(f"{args.case}: planner.mode: pendulum: pressplan cam exports rotary strokes only (yet)")
         out = _output_folder(case, args, ())
-        solution = solve(case)
+        if case.pendulum:  # the swings' cams: the crank goes forward and back on a master turning once a cycle
+            from planning.solver.pendulum import solve_pendulum
+
+            solution = solve_pendulum(case, compare=False)
+        else:
+            solution = solve(case)
     options = {o.kwargs["dest"]: getattr(args, o.kwargs["dest"]) for o in OPTIONS}
     written = Written(solution, case, options)
     owned = tuple(pattern for output in _cam_outputs() for pattern in output.files)
-    writers = {name: w for name, w in writers_of(written, figures=False).items() if name in owned}
+    if case.pendulum:
+        writers = _pendulum_cam_writers(written, with_table=False)
+    else:
+        writers = {name: w for name, w in writers_of(written, figures=False).items() if name in owned}
     args.case = None if source.is_dir() else args.source
     data, text = proof_dict(written.cam), "\n".join(proof_lines(written.cam))
     return _write_and_report(out, writers, data, text, args, owned)

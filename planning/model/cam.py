@@ -94,13 +94,16 @@ FIFTH_POWER = FifthPower()
 class Cam:
     """A cam as a controller holds it: ``master_deg`` (X, increasing from 0 to 360, both ends), ``slave_deg``
     (Y, the crank's angle: 0 at TDC, 360 a stroke on) and, for ``poly5``, ``slope`` (V) and ``curvature``
-    (A) at the same points; ``interpolation`` between them (module docstring)."""
+    (A) at the same points; ``interpolation`` between them (module docstring). ``slave_turn_deg``: how far the
+    slave is on after one master turn (360: a rotary stroke; 0: a pendulum cycle, the crank back where it
+    started)."""
 
     interpolation: Interpolation
     master_deg: np.ndarray
     slave_deg: np.ndarray
     slope: np.ndarray | None = None
     curvature: np.ndarray | None = None
+    slave_turn_deg: float = TURN_DEG
 
     def __post_init__(self) -> None:
         x = self.master_deg
@@ -133,7 +136,7 @@ class Cam:
 
     def at(self, master_deg: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``(Y [deg], dY/dX, d2Y/dX2, d3Y/dX3)`` at master angles (any real: a turn on adds 360 deg to
-        ``Y``); at a point the interval that starts there."""
+        ``Y`` the slave's turn, :attr:`slave_turn_deg`); at a point the interval that starts there."""
         m = np.asarray(master_deg, dtype=float)
         turns = np.floor(m / TURN_DEG)
         local = m - turns * TURN_DEG
@@ -144,7 +147,7 @@ class Cam:
         v = b[:, 1] + x * (2 * b[:, 2] + x * (3 * b[:, 3] + x * (4 * b[:, 4] + x * 5 * b[:, 5])))
         a = 2 * b[:, 2] + x * (6 * b[:, 3] + x * (12 * b[:, 4] + x * 20 * b[:, 5]))
         j = 6 * b[:, 3] + x * (24 * b[:, 4] + x * 60 * b[:, 5])
-        return y + turns * TURN_DEG, v, a, j
+        return y + turns * self.slave_turn_deg, v, a, j
 
     def at_end(self) -> tuple[float, float, float, float]:
         """``(Y, dY/dX, d2Y/dX2, d3Y/dX3)`` at 360 deg from the last interval's polynomial (its left end)."""
@@ -156,12 +159,12 @@ class Cam:
         return float(y), float(v), float(a), float(j)
 
     def end_steps(self) -> tuple[float, float, float]:
-        """The steps across the cam's end (360 deg back to 0, a turn on): in ``Y`` [deg], ``dY/dX`` and
+        """The steps across the cam's end (360 deg back to 0, the slave's turn on): in ``Y`` [deg], ``dY/dX`` and
         ``d2Y/dX2`` (zero for a cam that repeats smoothly; a linear table's slope steps there as at every
         point)."""
         y_end, v_end, a_end, _ = self.at_end()
         first = self.coefficients[0]
-        return float(first[0] + TURN_DEG - y_end), float(first[1] - v_end), float(2 * first[2] - a_end)
+        return float(first[0] + self.slave_turn_deg - y_end), float(first[1] - v_end), float(2 * first[2] - a_end)
 
 
 def quintic_coefficients(w: np.ndarray, y: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:

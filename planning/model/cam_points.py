@@ -1,9 +1,9 @@
 """A plan's cams (``planning.model.cam``): where the points go and what they hold.
 
-The master runs ``m = 360 t / P`` [deg] (``t`` [s] from TDC, ``P`` the plan's period), the slave is the crank
-angle in degrees; at a point the plan gives ``Y = theta``, ``V = dY/dX = omega / w_m`` and
-``A = d2Y/dX2 = alpha / w_m^2 * pi / 180`` with the master's speed ``w_m = 2 pi / P`` [rad/s] (the form of
-``cam_table.csv``). Three placements:
+The master runs ``m = 360 t / P`` [deg] (``t`` [s] from TDC, ``P`` the plan's period; a pendulum plan's ``t``
+from its forward swing's start, one master turn its two swings), the slave is the crank angle in degrees; at a
+point the plan gives ``Y = theta``, ``V = dY/dX = omega / w_m`` and ``A = d2Y/dX2 = alpha / w_m^2 * pi / 180``
+with the master's speed ``w_m = 2 pi / P`` [rad/s] (the form of ``cam_table.csv``). Three placements:
 
 - :func:`law_cam`: XYVA points where the law's segments end. Between two of them a law whose crank angle is
   a polynomial of degree five or less in time (the improved S-curve, the seven-segment law, the optimal
@@ -12,7 +12,7 @@ angle in degrees; at a point the plan gives ``Y = theta``, ``V = dY/dX = omega /
 - :func:`fewest_xyva`: the fewest XYVA points whose quintics keep the slide within a tolerance of the plan
   (the quintic law's speed is of degree five, its angle six; the logistic and cycloidal laws are no
   polynomials): from each point the farthest next one that holds, over the plan's dense samples; a hold's
-  standstill starts and ends at a point.
+  standstill and a swing's turn start and end at a point.
 - :func:`table_cam`: ``n`` points equidistant in the master (a table for a controller that interpolates
   linearly or by a spline).
 """
@@ -26,14 +26,17 @@ import numpy as np
 
 from planning.model.cam import DEG, TURN_DEG, Cam, Interpolation, quintic_coefficients
 from planning.model.cycle import HOLD_SEGMENT
+from planning.model.pendulum import TURN_SEGMENT, PendulumPlan
 from planning.model.plan import Plan
 from planning.model.profile import sample_times
 from planning.tolerances import CAM_POINT_GAP_DEG
 
+CamPlan = Plan | PendulumPlan  # a rotary plan, or a pendulum plan (its slave back where it started after a cycle)
+
 Height = Callable[[np.ndarray], np.ndarray]  # crank angle [rad] -> the slide's height [mm]
 
 
-def xyva(plan: Plan, master_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def xyva(plan: CamPlan, master_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(Y [deg], V [deg/deg], A [deg/deg^2])`` of the plan at master angles in ``[0, 360]``; at 360 deg the
     state at 0 a turn on (the plan closes within the verification's tolerances; a cam repeats exactly)."""
     period = plan.period
@@ -41,16 +44,16 @@ def xyva(plan: Plan, master_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray, np
     end = master >= TURN_DEG
     th, om, al, _ = plan.profile.at_time(np.where(end, 0.0, master) / TURN_DEG * period)
     w_m = 2 * math.pi / period
-    return np.degrees(th) + np.where(end, TURN_DEG, 0.0), om / w_m, al / w_m**2 * DEG
+    return np.degrees(th) + np.where(end, plan.slave_turn_deg, 0.0), om / w_m, al / w_m**2 * DEG
 
 
-def poly5_cam(plan: Plan, master_deg: np.ndarray) -> Cam:
+def poly5_cam(plan: CamPlan, master_deg: np.ndarray) -> Cam:
     """The XYVA cam of the plan at the master angles (0 and 360 among them)."""
     y, v, a = xyva(plan, master_deg)
-    return Cam(Interpolation.POLY5, np.asarray(master_deg, dtype=float), y, v, a)
+    return Cam(Interpolation.POLY5, np.asarray(master_deg, dtype=float), y, v, a, plan.slave_turn_deg)
 
 
-def segment_ends(plan: Plan) -> np.ndarray:
+def segment_ends(plan: CamPlan) -> np.ndarray:
     """The master angles [deg] where the law's segments end, 0 and 360 included; an end closer than
     :data:`~planning.tolerances.CAM_POINT_GAP_DEG` to the point before it (or to 360) is left out."""
     master = np.unique(np.clip(plan.profile.knot_times / plan.period * TURN_DEG, 0.0, TURN_DEG))
@@ -61,34 +64,34 @@ def segment_ends(plan: Plan) -> np.ndarray:
     return np.array([*kept, TURN_DEG])
 
 
-def exact_in_poly5(plan: Plan) -> bool:
+def exact_in_poly5(plan: CamPlan) -> bool:
     """Whether each of the plan's segments is a polynomial of degree five or less in time (linear jerk and
     no shape): then :func:`law_cam` is the plan to round-off (two segment ends closer than
     :data:`~planning.tolerances.CAM_POINT_GAP_DEG` apart are one point: a short piece's error instead)."""
     return all(seg.shape is None for seg in plan.profile.segments)
 
 
-def law_cam(plan: Plan) -> Cam:
+def law_cam(plan: CamPlan) -> Cam:
     """XYVA points where the law's segments end."""
     return poly5_cam(plan, segment_ends(plan))
 
 
-def table_cam(plan: Plan, points: int, interpolation: Interpolation) -> Cam:
+def table_cam(plan: CamPlan, points: int, interpolation: Interpolation) -> Cam:
     """``points`` points equidistant in the master (a table; the end, 360 deg, is the start a turn on)."""
     if interpolation is Interpolation.POLY5:
         return poly5_cam(plan, np.linspace(0.0, TURN_DEG, points + 1))
     master = np.linspace(0.0, TURN_DEG, points + 1)
-    return Cam(interpolation, master, xyva(plan, master)[0])
+    return Cam(interpolation, master, xyva(plan, master)[0], slave_turn_deg=plan.slave_turn_deg)
 
 
-def slide_deviation_mm(cam: Cam, plan: Plan, height: Height, master_deg: np.ndarray) -> float:
+def slide_deviation_mm(cam: Cam, plan: CamPlan, height: Height, master_deg: np.ndarray) -> float:
     """The largest ``|h(cam) - h(plan)|`` [mm] at the master angles."""
     y_cam = cam.at(master_deg)[0]
     y_plan = xyva(plan, master_deg)[0]
     return float(np.max(np.abs(height(y_cam * DEG) - height(y_plan * DEG))))
 
 
-def fewest_xyva(plan: Plan, height: Height, tolerance_mm: float) -> Cam:
+def fewest_xyva(plan: CamPlan, height: Height, tolerance_mm: float) -> Cam:
     """The fewest XYVA points (from the plan's dense samples: every millisecond and every knot) whose
     quintics keep the slide within ``tolerance_mm`` of the plan at every sample: from each point, the
     farthest sample whose quintic back to it holds (found by doubling the reach, then halving it)."""
@@ -114,10 +117,10 @@ def fewest_xyva(plan: Plan, height: Height, tolerance_mm: float) -> Cam:
     picked = np.array(chosen)
     x = master[picked]
     x[0], x[-1] = 0.0, TURN_DEG
-    return Cam(Interpolation.POLY5, x, y[picked], v[picked], a[picked])
+    return Cam(Interpolation.POLY5, x, y[picked], v[picked], a[picked], plan.slave_turn_deg)
 
 
-def standstill_samples(plan: Plan, times: np.ndarray) -> list[int]:
+def standstill_samples(plan: CamPlan, times: np.ndarray) -> list[int]:
     """The indices in ``times`` (the plan's samples, its knots among them) of where a hold's standstill starts
     and ends: points of every cam, so that the crank stands still between them (a quintic from a point
     before the standstill to one after it would move)."""
@@ -125,7 +128,7 @@ def standstill_samples(plan: Plan, times: np.ndarray) -> list[int]:
     ends = [
         t
         for k, seg in enumerate(plan.profile.segments)
-        if seg.name == HOLD_SEGMENT
+        if seg.name in (HOLD_SEGMENT, TURN_SEGMENT)
         for t in (knots[k], knots[k + 1])
     ]
     return sorted(int(np.argmin(np.abs(times - t))) for t in ends)

@@ -36,6 +36,8 @@ def first_layout(free_draw: bool) -> Layout:
 def draws_freely(layout: Layout) -> bool:
     """Whether ``layout`` plans the draw as a phase of its own (a draw at constant slide speed)."""
     return any(phase == DRAW_PHASE[0] for phase, _ in layout)
+
+
 FINE_FACTOR = 2.5  # the finer layout: this many times the segments of each phase (finer)
 
 

@@ -231,7 +231,9 @@ def profile_of(params: PendulumParameters) -> Profile:
 class PendulumPlan:
     """A solved pendulum cycle: its ``parameters``, the ``profile`` (time 0 at the forward swing's start), the
     key angles of each swing [rad, the crank's own] (``forward_keys``, ``backward_keys``), the ``solver``'s
-    report (``planning.model.plan.SolverInfo``) and the NLP's variable values."""
+    report (``planning.model.plan.SolverInfo``) and the NLP's variable values; ``time_scale``: the profile runs
+    this many times as fast as the parameters say (a cam run at another master speed: its swings' times
+    divided by it)."""
 
     parameters: PendulumParameters
     profile: Profile
@@ -239,6 +241,12 @@ class PendulumPlan:
     backward_keys: tuple[float, float, float, float]
     solver: Any
     nlp_values: dict[str, float]
+    time_scale: float = 1.0
+
+    @property
+    def slave_turn_deg(self) -> float:
+        """[deg] the crank's turn over one cycle: none, the swings bring it back (a cam's slave returns)."""
+        return 0.0
 
     @property
     def period(self) -> float:
@@ -256,9 +264,10 @@ class PendulumPlan:
     def swing_spans(self) -> dict[str, tuple[float, float]]:
         """``name -> (start, end)`` [s] of each swing's motion (the standstills between)."""
         f, b = self.parameters.forward, self.parameters.backward
+        k = self.time_scale
         tf = float(f.duration)
         tb0 = tf + float(self.parameters.turn_end_s)
-        return {"forward": (0.0, tf), "backward": (tb0, tb0 + float(b.duration))}
+        return {"forward": (0.0, tf / k), "backward": (tb0 / k, (tb0 + float(b.duration)) / k)}
 
     def key_times(self, swing: str) -> np.ndarray:
         """Times [s from the forward swing's start] at which ``swing`` passes its four key angles."""

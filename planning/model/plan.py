@@ -61,6 +61,11 @@ class Plan:
         """Strokes per minute."""
         return 60.0 / self.period
 
+    @property
+    def slave_turn_deg(self) -> float:
+        """[deg] the crank's turn over one cycle (a cam's slave after one master turn): a rotary stroke's 360."""
+        return 360.0
+
     def key_times(self) -> np.ndarray:
         """Times [s] from TDC at which the crank reaches theta1..theta4."""
         return np.array([self.profile.time_at_angle(a) for a in self.key_angles])

@@ -28,6 +28,7 @@ def rounded_down(value: float, decimals: int = HIGHEST_DECIMALS) -> str:
     nudged = value * scale * (1 + SAME_RELATIVE)  # a value on a printed digit up to round-off is that digit
     return f"{math.floor(nudged) / scale:.{decimals}f}"
 
+
 Length = Annotated[float, Field(ge=0.1, le=20_000)]  # [mm] press dimensions
 Offset = Annotated[float, Field(ge=-20_000, le=20_000)]  # [mm] a sideways offset, either side
 Height = Annotated[float, Field(ge=0, le=40_000)]  # [mm above BDC]

@@ -72,12 +72,19 @@ class CamExport:
             Interpolation.LINEAR: "points, straight lines between them",
         }[cam.interpolation]
         slave = "crank angle" if self.slave == CRANK else f"motor angle (crank angle x gear ratio {self.ratio:g})"
+        swing = cam.slave_turn_deg == 0.0  # a pendulum cycle: the slave back where it started
+        master = (
+            "master: 0 .. 360 deg per cycle of two swings, two strokes (0 = the forward swing's start, at rest)"
+            if swing
+            else "master: 0 .. 360 deg per stroke (0 = TDC)"
+        )
+        turn = "back where it started" if swing else "360 deg (x ratio) on"
         lines = [
             f"pressplan cam for {self.case.name}: {cam.points} {kind}",
-            f"master: 0 .. 360 deg per stroke (0 = TDC); slave: {slave} [deg], 0 at TDC",
+            f"{master}; slave: {slave} [deg], 0 at TDC",
             f"master speed {self.master_speed_deg_s:.6f} deg/s = {self.spm:.6f} strokes/min "
             f"({100 * p.speed:.2f} % of the plan's {p.plan.spm:.6f})",
-            "ends: both given; at 360 deg the slave is 360 deg (x ratio) on, the same slope and curvature "
+            f"ends: both given; at 360 deg the slave is {turn}, the same slope and curvature "
             + ("(continuous across the end)" if p.ends_join else "(the slope steps there as at every point)"),
             f"proof: run as the controller interpolates it, every limit of the case "
             f"{'holds' if p.passed else 'does NOT hold'}; slide within {_mm(p.deviation_mm)} of the plan "

@@ -258,7 +258,6 @@ def _robot_text(**values: float) -> str:
     return "".join(line.rstrip() + "\n" for line in lines)
 
 
-
 def drive_template(mechanism: str) -> dict:
     """The drive section :func:`new_case_text` writes for ``mechanism``, with its forming force (the page's
     "add a drive": a press of that size, to be replaced by the user's own figures)."""

@@ -495,8 +495,7 @@ def _objective_lines(r: dict[str, Any]) -> list[str]:
         f"saving {saving['rms_torque']:.1f} % "
         f"RMS torque, {saving['energy']:.1f} % energy"
         + (
-            f", {saving['grid_peak']:.1f} % grid peak "
-            f"({b['grid_peak_kW']:.0f} -> {r['power']['grid_peak_kW']:.0f} kW)"
+            f", {saving['grid_peak']:.1f} % grid peak ({b['grid_peak_kW']:.0f} -> {r['power']['grid_peak_kW']:.0f} kW)"
             if "grid_peak" in saving
             else ""
         )

@@ -3,9 +3,10 @@
 A cam (``planning.model.cam``) is run as its controller interpolates it, the master turning at a share
 ``speed`` of the plan's master speed (1: the plan's, ``360 / P`` deg/s; an operator's override turns it up
 or down), and passed through the dense verification the plan passed (``planning.solver.verify.evaluate``
-with ``cam``): the cycle closes and every limit of the press and the process holds. At a master speed
-``s`` times the plan's, the crank's speed scales with ``s``, its acceleration with ``s^2``, its jerk with
-``s^3`` and the robot's window with ``1 / s``; the proof does not scale figures, it runs the cam at that
+with ``cam``; a pendulum plan's, ``planning.solver.pendulum_check.evaluate_pendulum``): the cycle closes
+and every limit of the press and the process holds. At a master speed ``s`` times the plan's, the crank's
+speed scales with ``s``, its acceleration with ``s^2``, its jerk with ``s^3`` and the robot's window with
+``1 / s``; the proof does not scale figures, it runs the cam at that
 speed. What a proof states (:class:`CamProof`): whether every limit holds, each limit's margin, the
 largest slide deviation from the plan [mm] at the same master angle, the steps across the cam's end, and
 the highest master speed at which every limit still holds (to :data:`SPEED_RESOLUTION`), with the first
@@ -23,10 +24,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from planning.model.cam import DEG, Cam, Interpolation, realised_profile
-from planning.model.cam_points import exact_in_poly5, fewest_xyva, law_cam, table_cam
+from planning.model.cam_points import CamPlan, exact_in_poly5, fewest_xyva, law_cam, table_cam
 from planning.model.case import Case
 from planning.model.limits.base import Check
-from planning.model.plan import Plan
+from planning.model.pendulum import PendulumPlan
+from planning.solver.pendulum_check import evaluate_pendulum
 from planning.solver.verify import Evaluation, Verification, evaluate
 from planning.tolerances import CAM_END_TOL, CAM_TIGHTEST_MM, SPEED_RESOLUTION
 
@@ -64,7 +66,7 @@ class CamProof:
     the search's ceiling holds)."""
 
     cam: Cam
-    plan: Plan
+    plan: CamPlan
     speed: float
     evaluation: Evaluation
     deviation_mm: float
@@ -89,14 +91,16 @@ class CamProof:
         return failures[0] if failures else None
 
 
-def run(cam: Cam, plan: Plan, case: Case, speed: float = 1.0, cycle_s: float = CONTROLLER_CYCLE_S) -> Evaluation:
+def run(cam: Cam, plan: CamPlan, case: Case, speed: float = 1.0, cycle_s: float = CONTROLLER_CYCLE_S) -> Evaluation:
     """The dense verification of ``cam`` run at ``speed`` times the plan's master speed."""
     profile = realised_profile(cam, plan.period / speed, cycle_s)
+    if isinstance(plan, PendulumPlan):  # the swings' own verification, their times divided by the speed
+        return evaluate_pendulum(replace(plan, profile=profile, time_scale=speed), case, cam=True)
     # the robots follow their cams on the same master: at ``speed`` they run that many times as fast
     return evaluate(replace(plan, profile=profile, robot_time_scale=speed), case, cam=True)
 
 
-def prove(cam: Cam, plan: Plan, case: Case, speed: float = 1.0, cycle_s: float = CONTROLLER_CYCLE_S) -> CamProof:
+def prove(cam: Cam, plan: CamPlan, case: Case, speed: float = 1.0, cycle_s: float = CONTROLLER_CYCLE_S) -> CamProof:
     """The :class:`CamProof` of ``cam`` at ``speed``."""
     evaluation = run(cam, plan, case, speed, cycle_s)
     deviation_mm, deviation_deg = _deviation(evaluation, plan, case, speed)
@@ -104,7 +108,7 @@ def prove(cam: Cam, plan: Plan, case: Case, speed: float = 1.0, cycle_s: float =
     return CamProof(cam, plan, speed, evaluation, deviation_mm, deviation_deg, cam.end_steps(), highest, above)
 
 
-def _deviation(evaluation: Evaluation, plan: Plan, case: Case, speed: float) -> tuple[float, float]:
+def _deviation(evaluation: Evaluation, plan: CamPlan, case: Case, speed: float) -> tuple[float, float]:
     """The largest slide [mm] and crank [deg] deviation of the run cam from the plan at the same master
     angle, over the run's dense samples."""
     samples = evaluation.samples
@@ -115,7 +119,7 @@ def _deviation(evaluation: Evaluation, plan: Plan, case: Case, speed: float) -> 
 
 
 def _highest_speed(
-    cam: Cam, plan: Plan, case: Case, speed: float, holds: bool, cycle_s: float
+    cam: Cam, plan: CamPlan, case: Case, speed: float, holds: bool, cycle_s: float
 ) -> tuple[float, Verification | None]:
     """The highest master speed share at which every limit holds, to :data:`SPEED_RESOLUTION`, and the
     verification :data:`OVERRIDE_STEP` above it: up from ``speed`` where the cam holds there, down from it
@@ -151,7 +155,7 @@ def _highest_speed(
     return lo, above
 
 
-def cam_for(plan: Plan, case: Case, spec: CamSpec) -> CamProof:
+def cam_for(plan: CamPlan, case: Case, spec: CamSpec) -> CamProof:
     """The cam ``spec`` asks of ``plan``, proved (module docstring)."""
     poly5 = spec.interpolation is Interpolation.POLY5
     if spec.points is not None:
@@ -165,7 +169,7 @@ def cam_for(plan: Plan, case: Case, spec: CamSpec) -> CamProof:
     return prove(cam, plan, case, spec.speed, spec.cycle_s)
 
 
-def _within_points(plan: Plan, case: Case, most: int) -> Cam:
+def _within_points(plan: CamPlan, case: Case, most: int) -> Cam:
     """The XYVA cam of at most ``most`` points that keeps the slide closest to the plan: the law's segment
     ends where they are exact and few enough; else the fewest points within a tolerance, the tolerance
     halved while they stay at most ``most`` (from the stroke down; equidistant points where even that needs
@@ -185,7 +189,7 @@ def _within_points(plan: Plan, case: Case, most: int) -> Cam:
     return best
 
 
-def _fewest_that_hold(plan: Plan, case: Case, spec: CamSpec) -> Cam:
+def _fewest_that_hold(plan: CamPlan, case: Case, spec: CamSpec) -> Cam:
     """The fewest points for which every limit holds at ``spec.speed``: an XYVA cam's tolerance tightened by
     :data:`TOLERANCE_SHRINK` from a hundredth of the stroke; a table's count by doubling, then halving
     the step. The last cam tried when none holds (its proof then says what it breaks)."""

@@ -140,9 +140,7 @@ def variable_bounds(
     return lo, hi
 
 
-def make_plan(
-    case: Case, values: dict[str, float], placement: str, info: SolverInfo, phases: Layout = PHASES
-) -> Plan:
+def make_plan(case: Case, values: dict[str, float], placement: str, info: SolverInfo, phases: Layout = PHASES) -> Plan:
     """The plan of the NLP's values (``planning.model.plan.plan_of``): the profile propagated from theta3
     through the segments' closed forms (the NLP's knot states agree with it to its tolerance), then the draw;
     the optimal law's placement is free."""

@@ -25,9 +25,7 @@ from planning.solver.verify import evaluate
 MOTOR_LIMITS = frozenset(limit.id for limit in BY_ID.values() if limit.motor)  # the motor's limits
 
 
-def solve_max_spm(
-    case: Case, placement: Placement | None = None, neighbour: Plan | Solution | None = None
-) -> Solution:
+def solve_max_spm(case: Case, placement: Placement | None = None, neighbour: Plan | Solution | None = None) -> Solution:
     """The fastest verified cycle of ``case`` under its law with halves; ``neighbour``: a plan whose values
     start the multi-start (and which answers when it verifies here and beats the starts). Without a
     neighbour: the cold solve (``planning.solver.optimize.solve`` compares the two)."""

@@ -27,7 +27,6 @@ from planning.tolerances import BETTER_SHARE
 __all__ = ["Solution", "solve", "solve_from"]
 
 
-
 def solve(
     case: Case, placement: Placement | None = None, neighbour: Plan | Solution | None = None, follow: bool = False
 ) -> Solution:

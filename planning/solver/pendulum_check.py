@@ -37,8 +37,11 @@ from press.mechanism import slider_motion
 OWN_CHECKS = ("transfer_time", "safety_height", "min_crank_speed", "die_speed", "draw_start_speed")  # here
 
 
-def evaluate_pendulum(plan: PendulumPlan, case: Case) -> Evaluation:
-    """The dense re-simulation of ``plan`` against ``case`` and every check (module docstring)."""
+def evaluate_pendulum(plan: PendulumPlan, case: Case, cam: bool = False) -> Evaluation:
+    """The dense re-simulation of ``plan`` against ``case`` and every check (module docstring). ``cam``: the
+    profile is a cam as its controller runs it (``planning.solver.cam_proof``): the law's own checks (continuous
+    at its knots, one way per swing to the last 1e-9 rpm, at rest at the turns, each draw at one speed) are not
+    the cam's; the cycle closes, never passes TDC, and every limit of the press and the process holds."""
     prof = plan.profile
     t, uniform = sample_times(plan.period, prof.knot_times)
     th, om, al, je = prof.at_time(t)
@@ -46,7 +49,7 @@ def evaluate_pendulum(plan: PendulumPlan, case: Case) -> Evaluation:
     _, v, a, slide_jerk = slider_motion(h, d1, d2, d3, om, al, je)
     keys = plan.key_times("forward")
     dense = Dense(case, plan, t, th, om, al, je, h, v, a, keys, slide_jerk=slide_jerk, slope=d1, curvature=d2)
-    checks = _cycle_checks(dense) + _swing_checks(dense)
+    checks = _cycle_checks(dense, cam) + _swing_checks(dense, cam)
     magnitude = replace(dense, omega=np.abs(om))  # the limits of the crank's speed read its magnitude
     for limit in limits_of(case):
         if limit.id not in OWN_CHECKS:
@@ -55,7 +58,7 @@ def evaluate_pendulum(plan: PendulumPlan, case: Case) -> Evaluation:
     return Evaluation(dense, uniform, verification)
 
 
-def _cycle_checks(d: Dense) -> list[Check]:
+def _cycle_checks(d: Dense, cam: bool) -> list[Check]:
     """Finite, closed (at theta_s at rest again), continuous at every knot, never past TDC."""
     plan = d.plan
     finite = bool(np.all(np.isfinite(np.concatenate([d.theta, d.omega, d.alpha, d.h, d.v, d.a]))))
@@ -67,17 +70,16 @@ def _cycle_checks(d: Dense) -> list[Check]:
             CheckId.CYCLE_ANGLE, "back at the swing's start", gap, 0.0, "deg", "equal", math.degrees(ANGLE_TOL_RAD)
         )
     )
-    speeds = float(np.max(np.abs(end[1]))) / RPM
-    out.append(
-        Check.of(
-            CheckId.SPEED_CLOSES, "at rest at the swing's start", speeds, 0.0, "rpm", "equal", SPEED_TOL_RAD_S / RPM
-        )
-    )
+    if cam:  # a cam repeats: its speed closes (a table's ramps need not stand still at a point)
+        speeds, name = float(end[1][1] - end[1][0]) / RPM, "speed closes"
+    else:
+        speeds, name = float(np.max(np.abs(end[1]))) / RPM, "at rest at the swing's start"
+    out.append(Check.of(CheckId.SPEED_CLOSES, name, speeds, 0.0, "rpm", "equal", SPEED_TOL_RAD_S / RPM))
     accel = float(end[2][1] - end[2][0])
     out.append(
         Check.of(CheckId.ACCEL_CLOSES, "acceleration closes", accel, 0.0, "rad/s^2", "equal", ACCEL_CLOSE_TOL_RAD_S2)
     )
-    out += continuity_checks(plan.profile)
+    out += [] if cam else continuity_checks(plan.profile)
     tol = math.degrees(ANGLE_TOL_RAD)
     low, high = math.degrees(float(np.min(d.theta))), math.degrees(float(np.max(d.theta)))
     out.append(Check.of("swing_after_tdc", "lowest crank angle (never back past TDC)", low, 0.0, "deg", "min", tol))
@@ -85,55 +87,45 @@ def _cycle_checks(d: Dense) -> list[Check]:
     return out
 
 
-def _swing_checks(d: Dense) -> list[Check]:
-    """Each swing one way, the draws, the windows, the least crank speed, the die and draw-start speeds."""
+def _swing_checks(d: Dense, cam: bool) -> list[Check]:
+    """Each swing one way, the draws, the windows, the least crank speed, the die and draw-start speeds (a
+    cam: the law's own, one way, at rest at the turns and the draws at one speed, left out)."""
     plan, case = d.plan, d.case
     spans = plan.swing_spans()
-    out = []
-    draw_speeds, times = [], {}
-    for swing, sign in zip(SWINGS, (1.0, -1.0), strict=True):
-        lo, hi = spans[swing]
-        inside = (d.t >= lo) & (d.t <= hi)
-        wrong_way = float(np.max(-sign * d.omega[inside], initial=0.0)) / RPM
-        out.append(
-            Check.of(
-                "swing_direction",
-                f"{swing} swing turning {'back' if sign < 0 else 'forward'} only",
-                wrong_way,
-                0.0,
-                "rpm",
-                "equal",
-                SPEED_TOL_RAD_S / RPM,
-            )
-        )
-        times[swing] = plan.key_times(swing)
-        out.append(_draw_check(d, swing, times[swing], draw_speeds))
-    standing = np.array([swing_of(s.name) == "turn" for s in plan.profile.segments])
-    out.append(_standstill_check(d, standing))
+    times = {swing: plan.key_times(swing) for swing in SWINGS}
+    out = [] if cam else _law_checks(d, spans, times)
     out += _window_checks(d, times)
     least = case.limits.min_crank_speed_rpm
-    out.append(
-        Check.of(
-            "min_crank_speed",
-            "crank speed in the draws (the swings turn at rest)",
-            min(draw_speeds) / RPM,
-            least,
-            "rpm",
-            "min",
-            LIMIT_REL_TOL * least,
-        )
-    )
+    draws = [np.abs(d.omega[(d.t >= t[1]) & (d.t <= t[2])]) for t in times.values()]
+    slowest = min(float(np.min(w, initial=np.inf)) for w in draws)
+    name = "crank speed in the draws (the swings turn at rest)"
+    out.append(Check.of("min_crank_speed", name, slowest / RPM, least, "rpm", "min", LIMIT_REL_TOL * least))
     out.append(_draw_start_check(d, times))
     out.append(_die_check(d, spans))
     return out
 
 
-def _draw_check(d: Dense, swing: str, keys: np.ndarray, speeds: list[float]) -> Check:
-    """The swing's draw, theta2 to theta3, at one crank speed (its |speed| collected in ``speeds``)."""
+def _law_checks(d: Dense, spans: dict[str, tuple[float, float]], times: dict[str, np.ndarray]) -> list[Check]:
+    """The plan's own: each swing turning one way only, its draw at one crank speed, the crank at rest where
+    the plan turns."""
+    out = []
+    for swing, sign in zip(SWINGS, (1.0, -1.0), strict=True):
+        lo, hi = spans[swing]
+        inside = (d.t >= lo) & (d.t <= hi)
+        wrong_way = float(np.max(-sign * d.omega[inside], initial=0.0)) / RPM
+        name = f"{swing} swing turning {'back' if sign < 0 else 'forward'} only"
+        out.append(Check.of("swing_direction", name, wrong_way, 0.0, "rpm", "equal", SPEED_TOL_RAD_S / RPM))
+        out.append(_draw_check(d, swing, times[swing]))
+    standing = np.array([swing_of(s.name) == "turn" for s in d.plan.profile.segments])
+    out.append(_standstill_check(d, standing))
+    return out
+
+
+def _draw_check(d: Dense, swing: str, keys: np.ndarray) -> Check:
+    """The swing's draw, theta2 to theta3, at one crank speed."""
     _, t2, t3, _ = keys
     draw = (d.t >= t2) & (d.t <= t3)
     w = np.abs(d.omega[draw])
-    speeds.append(float(np.min(w)))
     off = float(np.max(w) - np.min(w)) / RPM
     return Check.of(
         CheckId.DRAW_CONSTANT, f"{swing} draw at constant crank speed", off, 0.0, "rpm", "equal", SPEED_TOL_RAD_S / RPM

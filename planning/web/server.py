@@ -63,7 +63,8 @@ from planning.web.cams import (
 
 STATIC = Path(__file__).resolve().parent / "static"
 PENDULUM_ON_THE_PAGE = (
-    "planner.mode: pendulum: the page plans rotary strokes only (yet); pressplan solve, check and bound plan the swings"
+    "planner.mode: pendulum: the page plans rotary strokes only (yet); pressplan solve, check, bound and cam "
+    "plan the swings"
 )
 MAX_REQUEST_BYTES = 2 * MAX_BYTES  # a case as JSON, with the page's own fields
 MAX_SESSIONS = 64
