@@ -29,8 +29,9 @@ Model (derived from the power balance; see the README):
   (for a crank-slider, whose rod is split, the link terms are zero).
 
 - Motor (all motors together), gear ratio i, efficiency eta, motor-side inertia J_m:
-  ``omega_m = i omega``; ``T_m = T_c / (i eta) + J_m i alpha`` when ``T_c >= 0`` (power flows to the
-  crank), ``T_m = T_c eta / i + J_m i alpha`` when ``T_c < 0`` (the crank drives the motor back).
+  ``omega_m = i omega``; ``T_m = T_c / (i eta) + J_m i alpha`` when power flows to the crank (``T_c`` and
+  ``omega`` of one sign: ``T_c >= 0`` turning forward or standing, ``T_c < 0`` turning backward, as on a
+  pendulum stroke's backward swing), ``T_m = T_c eta / i + J_m i alpha`` when the crank drives the motor back.
   Shaft power ``P = T_m omega_m``.
 
 Every function works on numpy arrays and on CasADi symbols (``press.backend``).
@@ -43,7 +44,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from planning.tolerances import TINY
+from planning.tolerances import HOLD_STILL_RAD_S, TINY
 from press.backend import math_module
 from press.jets import Jet
 
@@ -186,14 +187,20 @@ def crank_torque(
     return torque
 
 
-def motor_torque(crank_torque_Nm: Any, alpha: Any, drive: DriveModel) -> Any:
+def motor_torque(crank_torque_Nm: Any, alpha: Any, drive: DriveModel, omega: Any = None) -> Any:
     """Motor torque [N m] (all motors): the crank torque through the gear (losses against the power
-    flow) plus the motor-side inertia: ``T_c/(i eta)`` when ``T_c >= 0``, ``T_c eta/i`` when ``T_c < 0``,
-    plus ``J_m i alpha``."""
+    flow) plus the motor-side inertia: ``T_c/(i eta)`` where power flows to the crank, ``T_c eta/i`` where
+    the crank drives the motor back, plus ``J_m i alpha``. The power flows to the crank where ``T_c >= 0``
+    and the crank turns forward or stands (``omega`` None: it does), or ``T_c < 0`` and it turns backward."""
     m = math_module(crank_torque_Nm, alpha)
     t = crank_torque_Nm
     driving, braking = t / (drive.i * drive.eta), t * drive.eta / drive.i
-    through = np.where(t >= 0, driving, braking) if m is np else m.if_else(t >= 0, driving, braking)
+    if m is np:
+        forward = True if omega is None else np.asarray(omega) >= -HOLD_STILL_RAD_S  # standing: as forward
+        to_crank = (t >= 0) == forward
+        through = np.where(to_crank, driving, braking)
+    else:
+        through = m.if_else(t >= 0, driving, braking)  # the NLPs turn forward
     return through + drive.J_m * drive.i * alpha
 
 
@@ -228,15 +235,18 @@ def forming_work(h_start_mm: float, h_end_mm: float, drive: DriveModel) -> float
     return float(np.sum(np.diff(nodes) * (values[1:] + values[:-1]) / 2)) * 1e-3  # N * mm -> J
 
 
-def drive_state(theta: Any, omega: Any, alpha: Any, mechanism: Mechanism, drive: DriveModel) -> dict[str, Any]:
+def drive_state(
+    theta: Any, omega: Any, alpha: Any, mechanism: Mechanism, drive: DriveModel, forming_N: Any = None
+) -> dict[str, Any]:
     """Everything the drive does at crank states (numpy arrays): ``forming_N``, ``crank_torque_Nm``,
-    ``motor_speed_rad_s``, ``motor_torque_Nm``, ``motor_power_W``; ``theta`` [rad], ``omega`` [rad/s],
-    ``alpha`` [rad/s^2]."""
+    ``motor_speed_rad_s``, ``motor_torque_Nm``, ``motor_power_W``; ``theta`` [rad], ``omega`` [rad/s, either
+    sign], ``alpha`` [rad/s^2]; ``forming_N``: the forming force [N] there when the caller knows it (a pendulum
+    stroke's, acting on either swing), else :func:`forming_force`'s."""
     h, d1, d2, _ = mechanism.jets(theta)
-    f = forming_force(theta, h, drive)
+    f = forming_force(theta, h, drive) if forming_N is None else forming_N
     links = link_terms(mechanism.frames(theta), drive.links) if drive.links else None
     tc = crank_torque(omega, alpha, d1, d2, f, drive, links)
-    tm = motor_torque(tc, alpha, drive)
+    tm = motor_torque(tc, alpha, drive, omega)
     wm = motor_speed(omega, drive)
     return {
         "forming_N": f,

@@ -223,3 +223,45 @@ def test_a_swing_cam_read_back_by_independent_clients(tmp_path, shallow, capsys)
     proof = json.loads((out / "cam_proof.json").read_text())
     assert proof["passed"] and proof["ends_join"]
     assert proof["above"]["passed"] is False  # 1 % above the plan's master speed a limit breaks: the proof can fail
+
+
+DRIVE = ROOT / "cases" / "wang2023-side-panel-drive.yaml"
+
+
+def test_a_swing_with_its_drive_mirrors_and_balances(tmp_path):
+    """The side panel's drive case in pendulum strokes: verified (the motor's RMS binds); from trajectory.csv
+    alone the crank's work over the cycle is twice the forming work of the table (two strokes: energy is
+    conserved, gravity and the counterbalance doing none), and on this in-line crank-slider the motor's torque on
+    the backward swing is the forward swing's with its sign flipped (gear losses against the power flow on
+    either swing)."""
+    assert main(["solve", str(DRIVE), "--set", "planner.mode=pendulum", "--out", str(tmp_path), "--no-plots"]) == 0
+    result = json.loads((tmp_path / "result.json").read_text())
+    assert result["status"] == "verified" and "motor RMS torque" in result["verification"]["binding"]
+    c = _columns(tmp_path / "trajectory.csv")
+    t, omega = c["time_s"], c["crank_speed_rpm"] * RPM
+    power = c["crank_torque_Nm"] * omega
+    work = float(np.sum(np.diff(t) * (power[1:] + power[:-1]) / 2))
+    table = np.array(read_case(DRIVE).process.forming_force_kN)  # the whole table lies below theta2's height
+    forming = abs(float(np.trapezoid(table[:, 1], table[:, 0])))  # [kN mm = J] the work of one stroke's draw
+    assert work == pytest.approx(2 * forming, rel=5e-3)
+    forward = result["swings"]["forward"]["time_s"]
+    tau = np.linspace(0.05, forward - 0.05, 200)
+    back0 = forward + result["swing"]["turn_end_s"]
+    forward_tm = np.interp(tau, t, c["motor_torque_Nm"])
+    backward_tm = np.interp(back0 + tau, t, c["motor_torque_Nm"])
+    assert np.max(np.abs(backward_tm + forward_tm)) < 1e-3 * np.max(np.abs(forward_tm))
+
+
+def test_what_a_swing_cannot_draw_is_refused_before_solving(capsys):
+    """On the link drive the backward swing draws on the fast side of BDC: the forming force's lever is longer
+    there, beyond the motors' peak torque at any speed; on the offset crank the case's draw speed is above what
+    the backward draw's start allows. Each refused in one line, exit 3, naming the field."""
+    link = ROOT / "cases" / "link-drive-side-panel.yaml"
+    assert main(["solve", str(link), "--set", "planner.mode=pendulum", "--no-plots", "--out", "/nonexistent/x"]) == 3
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "drive.motor.peak_torque_Nm" in err[0] and "backward swing's draw" in err[0]
+    offset = ["--set", "planner.mode=pendulum", "--set", "planner.placement=free"]
+    path = ROOT / "cases" / "offset-crank-side-panel.yaml"
+    assert main(["solve", str(path), *offset, "--no-plots", "--out", "/nonexistent/x"]) == 3
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "process.draw_speed_rpm" in err[0] and "backward" in err[0]

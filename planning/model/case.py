@@ -960,7 +960,7 @@ PENDULUM_NOT_WITH = (  # what a pendulum stroke does not plan with yet: (field, 
     ("planner.target_spm", lambda c: c.planner.target_spm, "a swing plans the most strokes"),
     ("process.hold_time_s", lambda c: c.process.hold_time_s, "no hold in a swing yet"),
     ("process.draw_slide_speed_mm_s", lambda c: c.process.draw_slide_speed_mm_s, "a swing draws at a crank speed"),
-    ("drive", lambda c: "a drive" if c.drive is not None else None, "no drive model for the swings yet"),
+    ("drive", lambda c: "a drive" if c.electrical else None, "its electrical side (losses, storage, grid) not yet"),
     (
         "robots",
         lambda c: "robots" if c.robots is not None else None,

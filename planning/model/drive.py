@@ -122,10 +122,13 @@ def _breakpoints(profile: Profile, case: Case) -> np.ndarray:
     return np.unique(np.clip(np.asarray(times, dtype=float), profile.t0, profile.t0 + profile.duration))
 
 
-def quadrature(profile: Profile, case: Case, extra_edges: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+def quadrature(
+    profile: Profile, case: Case, extra_edges: np.ndarray | None = None, edges: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Nodes [s] and weights [s] of the cycle's quadrature (see the module docstring); ``extra_edges`` [s]:
-    more breakpoints (the storage schedule's, where its power jumps)."""
-    edges = _breakpoints(profile, case)
+    more breakpoints (the storage schedule's, where its power jumps); ``edges`` [s]: the breakpoints themselves
+    (a pendulum stroke's, whose crank turns back: ``planning.solver.pendulum_check``), else a rotary cycle's."""
+    edges = _breakpoints(profile, case) if edges is None else np.unique(np.asarray(edges, dtype=float))
     if extra_edges is not None:
         edges = np.unique(np.concatenate([edges, np.clip(extra_edges, profile.t0, profile.t0 + profile.duration)]))
         edges = edges[np.concatenate([[True], np.diff(edges) > SAME_TIME_S])]
@@ -142,13 +145,16 @@ def quadrature(profile: Profile, case: Case, extra_edges: np.ndarray | None = No
     return nodes, weights
 
 
-def cycle_integrals(profile: Profile, case: Case) -> dict[str, float]:
+def cycle_integrals(profile: Profile, case: Case, swings: Any = None) -> dict[str, float]:
     """The quadrature's integrals over the cycle: ``rms_motor_torque_Nm``, ``energy_drawn_kJ``,
     ``energy_returned_kJ``, ``crank_work_kJ``, ``crank_work_abs_kJ``, ``forming_work_kJ``, and the
-    quadrature's drive state (``state``, ``omega``) for the peaks."""
-    t, w = quadrature(profile, case)
+    quadrature's drive state (``state``, ``omega``) for the peaks. ``swings``: a pendulum stroke's
+    ``(breakpoints [s], forming(theta, omega) [N])``: its quadrature's edges and the forming force on either swing,
+    two strokes a cycle (the forming work twice)."""
+    edges, forming = (None, None) if swings is None else swings
+    t, w = quadrature(profile, case, edges=edges)
     th, om, al, _ = profile.at_time(t)
-    s = drive_state(th, om, al, case.machine, case.drive_model)
+    s = drive_state(th, om, al, case.machine, case.drive_model, None if forming is None else forming(th, om))
     tm, p = s["motor_torque_Nm"], s["motor_power_W"]
     h2 = float(case.machine.height(case.key_angles[1]))
     work = s["crank_torque_Nm"] * om
@@ -161,12 +167,12 @@ def cycle_integrals(profile: Profile, case: Case) -> dict[str, float]:
         "supply_energy_kJ": drawn + case.drive.regen_efficiency * returned,
         "crank_work_kJ": float(np.sum(w * work)) / 1e3,
         "crank_work_abs_kJ": float(np.sum(w * np.abs(work))) / 1e3,
-        "forming_work_kJ": forming_work(h2, 0.0, case.drive_model) / 1e3,
+        "forming_work_kJ": (1 if swings is None else 2) * forming_work(h2, 0.0, case.drive_model) / 1e3,
         "state": s,
     }
 
 
-def dense_drive_state(profile: Profile, case: Case) -> tuple[np.ndarray, dict]:
+def dense_drive_state(profile: Profile, case: Case) -> tuple[np.ndarray, dict]:  # a rotary plan's
     """The crank angle [rad] and the drive's state (``press.dynamics.drive_state``) on the verification's
     dense grid (uniform, knots included)."""
     t = dense_times(profile.duration, profile.knot_times - profile.t0)

@@ -37,13 +37,14 @@ from planning.model.limits.base import DRAW_GRID, Draw
 from planning.model.profile import Profile, Segment
 from planning.model.units import RPM
 from planning.tolerances import ANGLE_ROUND_OFF_RAD, SAME_TIME_S, TINY
+from press.backend import math_module
 
 TWO_PI = 2 * math.pi
 SWINGS = ("forward", "backward")
 STROKES_PER_CYCLE = 2  # a pendulum cycle is two swings, each a stroke
 TURN_SEGMENT = "turn:standstill"  # the crank standing at a swing's end
 SWING_HALVES = ("feed_accel", "feed_decel", "return_accel", "return_decel")
-DRAW_BOUND_LIMITS = ("crank_speed", "slider_accel", "slider_speed", "draw_start_speed")  # their own draw bounds
+DRAW_BOUND_LIMITS = ("crank_speed", "motor_speed", "slider_accel", "slider_speed", "draw_start_speed")  # their own
 BISECTIONS = 60  # halvings of a bracket to find where the draw crosses the die height
 
 
@@ -365,3 +366,44 @@ def draw_speed_bound(case: Any, keys: tuple[float, ...], jets: Any, limits: dict
     if accel is not None:  # the refined acceleration limit in the draw too
         bounds.append(math.sqrt(accel / max(float(np.max(np.abs(d2))), TINY)))
     return min(bounds)
+
+
+def swing_forming_N(case: Any, theta: np.ndarray, omega: np.ndarray, h: np.ndarray) -> np.ndarray:
+    """The forming force [N, upward on the slide] on a pendulum stroke at crank angles ``theta`` [rad], speeds
+    ``omega`` [rad/s] and slide heights ``h`` [mm]: the case's table (height above BDC -> force, linear between
+    rows, zero outside) from theta2 to BDC turning forward, and on the backward swing over the same arc of the
+    slide's way down, from its theta2 back to BDC; zero elsewhere (``press.dynamics``: a rotary stroke's window,
+    on either swing)."""
+    table = sorted(case.process.forming_force_kN or [])
+    theta, omega, h = (np.asarray(x, dtype=float) for x in (theta, omega, h))
+    if not table:
+        return np.zeros(np.shape(theta))
+    hs = np.array([row[0] for row in table])
+    fs = np.array([row[1] for row in table]) * 1e3
+    bdc = float(case.machine.bdc_angle)
+    th2, back2 = float(case.key_angles[1]), backward_key_angles(case)[1]
+    forward = (omega > 0) & (theta >= th2) & (theta <= bdc)
+    backward = (omega < 0) & (theta >= bdc) & (theta <= back2)
+    inside = (h >= hs[0]) & (h <= hs[-1]) & (forward | backward)
+    return np.where(inside, np.interp(h, hs, fs, left=0.0, right=0.0), 0.0)
+
+
+def forming_on_path(case: Any, swing: str, u: Any, h: Any) -> Any:
+    """The forming force [N] at path angles ``u`` [rad] of ``swing`` (numbers or symbols; the swing turning its
+    way): the table's where u lies between theta2 and BDC on that swing's path (:func:`swing_forming_N`)."""
+    table = sorted(case.process.forming_force_kN or [])
+    if not table:
+        return 0 * u
+    m = math_module(u, h)
+    bdc = float(case.machine.bdc_angle)
+    u2 = float(case.key_angles[1]) if swing == "forward" else TWO_PI - backward_key_angles(case)[1]
+    u_bdc = bdc if swing == "forward" else TWO_PI - bdc
+    hs = [row[0] for row in table]
+    fs = [row[1] * 1e3 for row in table]
+    if m is np:
+        value = np.interp(h, hs, fs, left=0.0, right=0.0)
+        return np.where((u >= u2) & (u <= u_bdc) & (h >= hs[0]) & (h <= hs[-1]), value, 0.0)
+    active = (u >= u2) * (u <= u_bdc) * (h >= hs[0]) * (h <= hs[-1])
+    table_h, table_f = m.DM(hs), m.DM(fs)
+    value = m.vertcat(*[m.pw_lin(h[k], table_h, table_f) for k in range(h.shape[0])])  # pw_lin takes a scalar
+    return m.if_else(active, value, 0)

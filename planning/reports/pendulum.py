@@ -41,6 +41,7 @@ def pendulum_result(solution: PendulumSolution, case: Case) -> dict[str, Any]:
             ],
         }
     rotary = {"spm": solution.rotary_spm, "gain_percent": None if solution.gain is None else 100 * solution.gain}
+    drive = solution.evaluation.drive
     if solution.rotary_spm is None:
         rotary["reason"] = solution.rotary_reason
     return {
@@ -62,6 +63,7 @@ def pendulum_result(solution: PendulumSolution, case: Case) -> dict[str, Any]:
         },
         "swings": swings,
         "rotary": rotary,
+        **({"drive": drive.as_dict()} if drive is not None else {}),
         "verification": {
             "passed": verification.passed,
             "samples": verification.samples,
@@ -101,6 +103,14 @@ def pendulum_summary(r: dict[str, Any]) -> str:
         )
     else:
         lines.append(f"  the rotary stroke under the same limits: no plan ({rot['reason']})")
+    d = r.get("drive")
+    if d:
+        lines.append(
+            f"  motor: peak torque {d['peak_motor_torque_Nm']:.0f} N m ({d['peak_torque_use_pct']:.1f} % of its "
+            f"envelope), RMS {d['rms_motor_torque_Nm']:.0f} N m ({d['rms_torque_use_pct']:.1f} % of rated), peak power "
+            f"{d['peak_motor_power_kW']:.1f} kW; per stroke {d['energy_drawn_kJ'] / 2:.2f} kJ drawn, "
+            f"{-d['energy_returned_kJ'] / 2:.2f} kJ returned (both swings regenerate)"
+        )
     v = r["verification"]
     lines.append(f"  binding: {', '.join(v['binding']) or 'none'}")
     failed = [c for c in v["checks"] if not c["passed"]]

@@ -10,13 +10,18 @@ same case is solved as a rotary stroke (``rotary``): the gain of the swing is st
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 
+import numpy as np
+
 from planning.model.case import Case
-from planning.model.pendulum import PendulumPlan
-from planning.solver.outcomes import NoPlanFound, PlanningError, Unverified
+from planning.model.pendulum import TWO_PI, PendulumPlan, swing_setups
+from planning.model.units import RPM, rounded_down
+from planning.solver.outcomes import Infeasible, NoPlanFound, PlanningError, Unverified
 from planning.solver.pendulum_check import evaluate_pendulum
+from planning.solver.pendulum_drive import draw_torque
 from planning.solver.pendulum_nlp import (
     build,
     elapsed_info,
@@ -27,6 +32,8 @@ from planning.solver.pendulum_nlp import (
     starts,
 )
 from planning.solver.verify import Evaluation
+from planning.tolerances import SAME_RELATIVE
+from press.dynamics import envelope_torque
 
 REFINE_ROUNDS = 4  # the NLP built again with the sampled limits lowered, at most this often
 
@@ -52,6 +59,9 @@ def solve_pendulum(case: Case, compare: bool = True) -> PendulumSolution:
     rotary stroke too. Raises :class:`~planning.solver.outcomes.PlanningError` without one."""
     t0 = time.perf_counter()
     limits = sampled_limit_values(case)
+    _precheck_draw_speed(case)
+    if case.drive is not None:
+        _precheck_draw_torque(case)
     tried, iterations, previous = 0, 0, None
     failure = None
     for _ in range(REFINE_ROUNDS + 1):
@@ -79,7 +89,47 @@ def solve_pendulum(case: Case, compare: bool = True) -> PendulumSolution:
         if limits is None:
             break
     check = failure[0]
-    raise Unverified(f"unverified: {check.name} = {check.value:.6g} {check.unit} (limit {check.limit:.6g})", check)
+    raise Unverified(f"{check.name} = {check.value:.6g} {check.unit} (limit {check.limit:.6g})", check)
+
+
+def _precheck_draw_speed(case: Case) -> None:
+    """A draw speed the case gives that one swing's draw cannot take (on an asymmetric press the backward
+    swing's draw meets its heights on the other side of BDC): refused before solving."""
+    given = case.process.draw_speed_rpm
+    if given is None:
+        return
+    for setup in swing_setups(case, {}):
+        if given * RPM > setup.draw_speed_bound * (1 + SAME_RELATIVE):
+            raise Infeasible(
+                f"process.draw_speed_rpm = {given:g} is above the {rounded_down(setup.draw_speed_bound / RPM)} rpm "
+                f"the limits allow in the {setup.name} swing's draw (pressplan check prints each swing's)",
+                "process.draw_speed_rpm",
+                given,
+                setup.draw_speed_bound / RPM,
+            )
+
+
+def _precheck_draw_torque(case: Case) -> None:
+    """A draw the motors cannot make on one swing even at the least draw speed (the forming force's torque on
+    the crank does not fall with the speed; on a link drive the backward swing draws where the slide moves
+    fast for the crank, its lever longer): refused before solving."""
+    motor = case.drive.motor
+    lowest = max(case.limits.min_crank_speed_rpm, case.process.draw_speed_rpm or 0.0) * RPM
+    for setup in swing_setups(case, {}):
+        u, torque, speed = draw_torque(case, setup, lowest)
+        envelope = envelope_torque(speed, motor.peak_torque_Nm, motor.base_speed_rpm * RPM)
+        use = np.abs(torque) / envelope
+        k = int(np.argmax(use))
+        if use[k] > 1.0:
+            angle = math.degrees(u[k] if setup.name == "forward" else TWO_PI - u[k])
+            raise Infeasible(
+                f"drive.motor.peak_torque_Nm = {motor.peak_torque_Nm:g} cannot make the {setup.name} swing's draw: "
+                f"at {angle:.1f} deg and {lowest / RPM:.3g} rpm the motors must give {abs(torque[k]):.0f} N m",
+                "drive.motor.peak_torque_Nm",
+                motor.peak_torque_Nm,
+                float(abs(torque[k])),
+                angle,
+            )
 
 
 def _with_rotary(case: Case, best: tuple, t0: float, iterations: int, tried: int, compare: bool) -> PendulumSolution:

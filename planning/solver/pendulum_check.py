@@ -15,15 +15,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 
 from planning.model.case import RPM, Case
+from planning.model.drive import cycle_integrals, drive_figures
 from planning.model.limits import limits_of
 from planning.model.limits.base import Check, Dense
-from planning.model.pendulum import SWINGS, PendulumPlan, swing_of, time_at
+from planning.model.pendulum import SWINGS, PendulumPlan, swing_forming_N, swing_of, time_at
 from planning.model.profile import sample_times
-from planning.solver.verify import CheckId, Evaluation, Verification, continuity_checks
+from planning.solver.verify import CheckId, Evaluation, Verification, continuity_checks, energy_balance
 from planning.tolerances import (
     ACCEL_CLOSE_TOL_RAD_S2,
     ANGLE_TOL_RAD,
@@ -32,6 +34,7 @@ from planning.tolerances import (
     SPEED_TOL_RAD_S,
     TIME_TOL_S,
 )
+from press.dynamics import drive_state
 from press.mechanism import slider_motion
 
 OWN_CHECKS = ("transfer_time", "safety_height", "min_crank_speed", "die_speed", "draw_start_speed")  # here
@@ -50,12 +53,47 @@ def evaluate_pendulum(plan: PendulumPlan, case: Case, cam: bool = False) -> Eval
     keys = plan.key_times("forward")
     dense = Dense(case, plan, t, th, om, al, je, h, v, a, keys, slide_jerk=slide_jerk, slope=d1, curvature=d2)
     checks = _cycle_checks(dense, cam) + _swing_checks(dense, cam)
+    figures = None
+    if case.drive is not None:  # the drive on either swing (``press.dynamics``: signed speeds)
+        dense.drive_state = drive_state(th, om, al, case.machine, case.drive_model, swing_forming_N(case, th, om, h))
+        dense.integrals = cycle_integrals(prof, case, (_breakpoints(plan, case), _forming(case)))
+        checks.append(energy_balance(dense.integrals))
+        figures = drive_figures(prof, case, dense.integrals, (th, dense.drive_state))
     magnitude = replace(dense, omega=np.abs(om))  # the limits of the crank's speed read its magnitude
     for limit in limits_of(case):
         if limit.id not in OWN_CHECKS:
             checks += limit.check(magnitude)
     verification = Verification(tuple(checks), float(np.max(np.diff(t))), int(t.size))
-    return Evaluation(dense, uniform, verification)
+    return Evaluation(dense, uniform, verification, figures)
+
+
+def _forming(case: Case) -> Any:
+    """The forming force [N] at crank states ``(theta, omega)`` on either swing."""
+
+    def forming(theta: np.ndarray, omega: np.ndarray) -> np.ndarray:
+        return swing_forming_N(case, theta, omega, case.machine.height(theta))
+
+    return forming
+
+
+def _breakpoints(plan: PendulumPlan, case: Case) -> np.ndarray:
+    """Where the drive's integrands may kink [s]: every knot, and on each swing where it passes theta2, BDC and
+    the forming table's heights (the forming force starts, ends and kinks there)."""
+    m, spans = case.machine, plan.swing_spans()
+    times = list(plan.profile.knot_times)
+    heights = [h for h, _ in (case.process.forming_force_kN or []) if 0 < h < m.stroke]
+    for swing, (lo, hi) in spans.items():
+        keys = plan.forward_keys if swing == "forward" else plan.backward_keys
+        angles = [keys[1], float(m.bdc_angle)]
+        for hh in heights:  # where each swing comes down through the height
+            side = m.angles_at_height(hh)
+            angles.append(float(side[0] if swing == "forward" else side[1]))
+        for angle in angles:
+            try:
+                times.append(time_at(plan.profile, angle, lo, hi))
+            except ValueError:  # the swing does not reach it
+                continue
+    return np.unique(np.asarray(times, dtype=float))
 
 
 def _cycle_checks(d: Dense, cam: bool) -> list[Check]:

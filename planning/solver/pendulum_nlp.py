@@ -32,6 +32,8 @@ import numpy as np
 
 from planning.model.case import RPM, Case
 from planning.model.laws import get_law
+from planning.model.limits import limits_of
+from planning.model.limits.capacity import torque_capacity_kNm
 from planning.model.pendulum import (
     SWINGS,
     TWO_PI,
@@ -48,7 +50,8 @@ from planning.model.plan import SolverInfo
 from planning.model.profile import Profile, advance_segment, knot_states
 from planning.solver.halves_nlp import MIN_HALF_S, TOP_SPEED, VARIABLE_INDEX, angle_at, variable_scales
 from planning.solver.ipopt import NLPSolver
-from planning.tolerances import ACCEL_BACKOFF, IPOPT_CONSTR_VIOL_TOL
+from planning.solver.pendulum_drive import drive_rows, swing_drive
+from planning.tolerances import ACCEL_BACKOFF, DRIVE_BACKOFF, IPOPT_CONSTR_VIOL_TOL
 
 SWING_VARIABLES = (  # per swing, prefixed ``forward_`` / ``backward_``: (name, scale kind of the halves NLP)
     ("draw_speed", "draw_speed"),
@@ -69,7 +72,8 @@ SHARED_VARIABLES = (
     ("turn_start_s", "closing_time"),
     ("law_parameter", "law_parameter"),
 )
-SAMPLED_LIMITS = ("slider_accel", "slider_speed", "die_speed")  # held at samples: refined on a dense failure
+# held at samples (or, the RMS, by the trapezoidal rule): refined on a dense failure
+SAMPLED_LIMITS = ("slider_accel", "slider_speed", "die_speed", "motor_peak_torque", "motor_rms_torque", "crank_torque")
 OPTIONS = {"ipopt.constr_viol_tol": IPOPT_CONSTR_VIOL_TOL, "ipopt.max_iter": 600}
 
 
@@ -226,6 +230,9 @@ def build(case: Case, limits: dict[str, float]) -> PendulumNLP:
     window_s = b.params.return_time - b.v["opening_time"] + phys["turn_start_s"] + f.v["closing_time"]
     rows.add(ca.vertcat(window_e, window_s) / transfer - 1.0, 0.0, math.inf)
     period = PendulumParameters(f.params, b.params, phys["turn_end_s"], phys["turn_start_s"]).period
+    if case.drive is not None:  # the motor's torques at the swings' samples (``planning.solver.pendulum_drive``)
+        drives = {name: swing_drive(case, swing) for name, swing in swings.items()}
+        drive_rows(case, rows.add, drives, (phys["turn_end_s"], phys["turn_start_s"]), period, limits)
     solver = NLPSolver("pendulum", {"x": x, "f": period / transfer, "g": ca.vertcat(*rows.g)}, OPTIONS, scales)
     lbx, ubx = _bounds(case, names, setups)
     return PendulumNLP(solver, np.array(rows.lb), np.array(rows.ub), names, scales, lbx, ubx, setups)
@@ -235,7 +242,8 @@ def _bounds(case: Case, names: tuple[str, ...], setups: tuple[SwingSetup, ...]) 
     """Variable bounds: speeds from the least crank speed (the draw) or 0 up to the top crank speed, the draw
     speed at most its swing's bound (the case's own when it gives one), durations above ``MIN_HALF_S``."""
     lo, hi = np.zeros(len(names)), np.full(len(names), np.inf)
-    top = case.limits.crank_speed_rpm * RPM if case.limits.crank_speed_rpm else TOP_SPEED
+    tops = [t for limit in limits_of(case) if (t := limit.top_crank_speed(case)) is not None]
+    top = min(tops, default=TOP_SPEED)  # the crank's and the motor's top speed
     given = case.process.draw_speed_rpm
     (s_lo, s_hi), (e_lo, e_hi) = swing_bounds(case)
     for i, name in enumerate(names):
@@ -364,11 +372,19 @@ def solve_once(case: Case, nlp: PendulumNLP, start: dict[str, float]) -> tuple[d
 
 
 def sampled_limit_values(case: Case) -> dict[str, float]:
-    """The sampled limits' values the first NLP holds (inside units; the acceleration ``ACCEL_BACKOFF`` inside)."""
+    """The sampled limits' values the first NLP holds (inside units; the acceleration ``ACCEL_BACKOFF`` and the
+    motor's torques ``DRIVE_BACKOFF`` inside)."""
     lim = case.limits
     out = {"slider_accel": lim.slider_accel_mm_s2 * (1 - ACCEL_BACKOFF), "die_speed": lim.die_speed_mm_s}
     if lim.slider_speed_mm_s is not None:
         out["slider_speed"] = lim.slider_speed_mm_s
+    if case.drive is not None:
+        motor = case.drive.motor
+        out["motor_peak_torque"] = motor.peak_torque_Nm * (1 - DRIVE_BACKOFF)
+        out["motor_rms_torque"] = motor.rated_torque_Nm * (1 - DRIVE_BACKOFF)
+        cap = torque_capacity_kNm(case)
+        if cap is not None:
+            out["crank_torque"] = cap * (1 - DRIVE_BACKOFF)
     return out
 
 

@@ -176,7 +176,7 @@ def _judged(dense: Dense, uniform: np.ndarray, cam: bool = False) -> Evaluation:
         if not (cam and limit.goal):
             checks += limit.check(dense)
     if case.drive is not None:
-        checks.append(_energy_balance(dense.integrals))
+        checks.append(energy_balance(dense.integrals))
     columns = None
     if dense.power is not None:
         checks += _power_checks(dense.power, dense.integrals, case.drive.storage is not None)
@@ -303,7 +303,7 @@ def continuity_checks(prof) -> list[Check]:  # noqa: ANN001 - a Profile
     ]
 
 
-def _energy_balance(integrals: dict) -> Check:
+def energy_balance(integrals: dict) -> Check:
     """Over a cycle the kinetic energy returns to its start and gravity and the counterbalance are
     conservative: the crank's work equals the forming work (``planning.model.drive``)."""
     scale = max(abs(integrals["forming_work_kJ"]), integrals["crank_work_abs_kJ"])

@@ -1,0 +1,135 @@
+"""The drive's rows of a pendulum NLP (``planning.solver.pendulum_nlp``): the motor's peak and RMS torque and the
+crank's torque capacity at the swings' samples.
+
+Each swing runs on its path coordinate u with speeds >= 0 (``planning.model.pendulum``); on the backward swing
+``theta = 2 pi - u``, so ``theta' = -u'``, ``theta'' = -u''``, ``h' = -h_b'`` and a linkage's ``J_links' `` and
+weight term change sign. Lagrange's equation (``press.dynamics``) then gives the crank torque on u as ``-T_c``:
+``T_u = J0 u'' + M h_b' (h_b' u'' + h'' u'^2) - F_env h_b' + J_links u'' + 1/2 J_links,u u'^2 + G_u`` with
+``J_links,u = -J_links'`` and ``G_u = -sum m g y_G'`` there. Power flows to the crank where ``T_c`` and the crank
+speed have one sign, that is where ``T_u >= 0``: the motor torque on u is ``press.dynamics.motor_torque`` of
+``T_u`` (its magnitude the motor's, its sign flipped), the motor's speed ``i u'``, its power ``T_m omega_m``
+the same on either coordinate. The forming force acts where the slide descends at or below the draw start's
+height: on each swing's path from theta2 to BDC (``planning.model.pendulum.forming_on_path``).
+
+Samples: every segment of the halves at ``law.samples`` points and the swing's end (at rest), the draw at
+:data:`~planning.solver.parameters.DRAW_SAMPLES_DRIVE` + 1 fixed angles at the draw speed. The RMS integrates
+``T_m^2`` by the trapezoidal rule over each swing's samples in time and adds each standstill's holding torque
+squared times its time.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from planning.model.case import RPM, Case
+from planning.model.laws import get_law
+from planning.model.limits.capacity import torque_capacity_kNm
+from planning.model.pendulum import TWO_PI, forming_on_path
+from planning.model.profile import advance_segment
+from planning.solver.parameters import DRAW_SAMPLES_DRIVE
+from press.dynamics import crank_torque, link_terms, motor_torque
+
+
+@dataclass
+class DriveSamples:
+    """One swing's samples in time order: crank torque ``tc`` and motor torque ``tm`` on u [N m], motor speed
+    [rad/s], their ``times`` from the swing's start [s]; ``holding``: the motor torque at rest at its end."""
+
+    tc: Any
+    tm: Any
+    speed: Any
+    times: Any
+    holding: Any
+
+
+def _links(case: Case, swing: str, u: Any) -> tuple[Any, Any, Any] | None:
+    """A linkage's link terms on u: ``(J, dJ/du, G_u)`` (signs flipped on the backward swing)."""
+    model = case.drive_model
+    if not model.links:
+        return None
+    theta = u if swing == "forward" else TWO_PI - u
+    J, dJ, G = link_terms(case.machine.frames(theta), model.links)
+    return (J, dJ, G) if swing == "forward" else (J, -dJ, -G)
+
+
+def swing_drive(case: Case, swing: Any) -> DriveSamples:
+    """The drive at the samples of one swing (``swing``: the NLP's ``_Swing``)."""
+    model = case.drive_model
+    p = swing.params
+    fractions = ca.DM(np.linspace(0.0, 1.0, get_law(p.motion_law).samples + 1)[:-1])
+    parts = []  # (u, omega, alpha, times from the swing's start, forming force) of each segment, in time order
+    parts += _half_samples(*swing.feed, fractions, 0.0)
+    parts.append(_draw_samples(swing))
+    parts += _half_samples(*swing.ret, fractions, p.feed_time + p.draw_time)
+    end = swing.return_end  # at rest at the swing's end
+    parts.append((end[0], end[1], end[2], p.duration))
+    u, om, al, times = (ca.vertcat(*column) for column in zip(*parts, strict=True))
+    h, d1, d2, _ = swing.setup.jets(u)
+    forming = forming_on_path(case, swing.setup.name, u, h)  # the draw's and, past theta3 before BDC, the return's
+    tc = crank_torque(om, al, d1, d2, forming, model, _links(case, swing.setup.name, u))
+    tm = motor_torque(tc, al, model)
+    return DriveSamples(tc, tm, model.i * om, times, tm[tm.shape[0] - 1])
+
+
+def _half_samples(starts: list, states: list, segs: list, fractions: ca.DM, offset: Any) -> list[tuple]:
+    """The samples of a half's segments: ``(u, omega, alpha, times)``."""
+    out = []
+    for seg, st, t0 in zip(segs, states, starts, strict=True):
+        th, om, al, _ = advance_segment(seg, *st, fractions * seg.duration)
+        out.append((th, om, al, offset + t0 + fractions * seg.duration))
+    return out
+
+
+def _draw_samples(swing: Any) -> tuple:
+    """The draw's samples: fixed angles theta2 .. theta3 on u at the draw speed."""
+    u2, u3 = swing.setup.keys[1], swing.setup.keys[2]
+    u = np.linspace(u2, u3, DRAW_SAMPLES_DRIVE + 1)
+    w2 = swing.params.draw_speed
+    times = swing.params.feed_time + ca.DM(u - u2) / w2
+    return ca.DM(u), w2 * ca.DM.ones(u.size), ca.DM.zeros(u.size), times
+
+
+def trapezoid_heat(samples: DriveSamples) -> Any:
+    """``integral T_m^2 dt`` over a swing by the trapezoidal rule on its samples [N^2 m^2 s]."""
+    t, sq = samples.times, samples.tm**2
+    n = t.shape[0]
+    return ca.sum1((t[1:n] - t[0 : n - 1]) * (sq[1:n] + sq[0 : n - 1]) / 2)
+
+
+def drive_rows(
+    case: Case, add: Any, drives: dict[str, DriveSamples], turns: tuple[Any, Any], period: Any, limits: dict[str, float]
+) -> None:
+    """The drive's rows (``add(expr, lo, hi)``): the motor's peak torque within its envelope at every sample,
+    its RMS over the cycle (``turns``: the standstills at theta_e and theta_s, after the forward and the backward
+    swing), the crank's torque capacity."""
+    motor = case.drive.motor
+    base = motor.base_speed_rpm * RPM
+    for samples in drives.values():
+        above_base = ca.fmax(1.0, samples.speed / base)
+        add(samples.tm * above_base / limits["motor_peak_torque"], -1.0, 1.0)
+        cap = torque_capacity_kNm(case)
+        if cap is not None:
+            add(samples.tc / (1e3 * limits.get("crank_torque", cap)), -1.0, 1.0)
+    f, b = drives["forward"], drives["backward"]
+    heat = trapezoid_heat(f) + trapezoid_heat(b) + f.holding**2 * turns[0] + b.holding**2 * turns[1]
+    add(heat / period / limits["motor_rms_torque"] ** 2, -math.inf, 1.0)
+
+
+DRAW_TORQUE_POINTS = 2001  # angles of a swing's draw on which the precheck takes the motor's torque
+
+
+def draw_torque(case: Case, setup: Any, speed: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The motor's torque through a swing's draw at the constant crank ``speed`` [rad/s] (numbers): ``(u [rad],
+    motor torque on u [N m], motor speed [rad/s])`` (``setup``: the swing's ``SwingSetup``)."""
+    model = case.drive_model
+    u = np.linspace(setup.keys[1], setup.keys[2], DRAW_TORQUE_POINTS)
+    h, d1, d2, _ = (np.asarray(x) for x in setup.jets(u))
+    forming = forming_on_path(case, setup.name, u, h)
+    omega = np.full(u.size, speed)
+    tc = crank_torque(omega, 0.0 * u, d1, d2, forming, model, _links(case, setup.name, u))
+    return u, motor_torque(tc, 0.0 * u, model), model.i * omega
