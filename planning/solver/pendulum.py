@@ -64,8 +64,9 @@ def solve_pendulum(case: Case, compare: bool = True) -> PendulumSolution:
         _precheck_draw_torque(case)
     tried, iterations, previous = 0, 0, None
     failure = None
+    compiled = build(case)  # once: the sampled limits are its parameters
     for _ in range(REFINE_ROUNDS + 1):
-        nlp = build(case, limits)
+        nlp = compiled.at(limits)
         best, best_failed = None, None
         for start in starts(case, nlp) + ([previous] if previous else []):
             values, res = solve_once(case, nlp, start)

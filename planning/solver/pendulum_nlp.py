@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import casadi as ca
@@ -182,16 +182,27 @@ def _sampled_rows(rows: _Rows, s: _Swing, case: Case, limits: dict[str, float]) 
 
 @dataclass
 class PendulumNLP:
-    """The compiled NLP of one case: the solver, the rows' bounds, the variables' names, scales and bounds."""
+    """The compiled NLP of one case: the solver, the rows' bounds, the variables' names and scales; the sampled
+    limits it takes as parameters (``limit_names``, in that order) and, for the values it is solved at
+    (:meth:`at`), the variables' bounds and the swings' setups (each draw speed's bound follows them)."""
 
+    case: Case
     solver: NLPSolver
     lbg: np.ndarray
     ubg: np.ndarray
     names: tuple[str, ...]
     scales: np.ndarray
-    lbx: np.ndarray
-    ubx: np.ndarray
-    setups: tuple[SwingSetup, SwingSetup]
+    limit_names: tuple[str, ...]
+    lbx: np.ndarray | None = None
+    ubx: np.ndarray | None = None
+    setups: tuple[SwingSetup, SwingSetup] | None = None
+    limits: dict[str, float] | None = None
+
+    def at(self, limits: dict[str, float]) -> PendulumNLP:
+        """The NLP held at the sampled limits' values ``limits`` (by id, inside units)."""
+        setups = swing_setups(self.case, limits)
+        lbx, ubx = _bounds(self.case, self.names, setups)
+        return replace(self, lbx=lbx, ubx=ubx, setups=setups, limits=dict(limits))
 
 
 def _variables(case: Case) -> tuple[tuple[str, ...], np.ndarray]:
@@ -208,12 +219,16 @@ def _variables(case: Case) -> tuple[tuple[str, ...], np.ndarray]:
     return tuple(names), np.array(scales)
 
 
-def build(case: Case, limits: dict[str, float]) -> PendulumNLP:
-    """The NLP of ``case`` with the sampled limits at ``limits`` (by id, inside units)."""
+def build(case: Case) -> PendulumNLP:
+    """The NLP of ``case``, its sampled limits (``sampled_limit_values``' keys) parameters: built once a case and
+    solved at each refinement's values (:meth:`PendulumNLP.at`)."""
     names, scales = _variables(case)
     x = ca.SX.sym("x", len(names))
     phys = {name: x[i] * scales[i] for i, name in enumerate(names)}
-    setups = swing_setups(case, limits)
+    limit_names = tuple(sampled_limit_values(case))
+    p = ca.SX.sym("limits", len(limit_names))
+    limits = {name: p[k] for k, name in enumerate(limit_names)}
+    setups = swing_setups(case, {})  # their key angles, mechanism and die exit (the bounds follow in ``at``)
     theta_s, theta_e = phys["swing_start"], phys["swing_end"]
     ends = {"forward": (theta_s, theta_e), "backward": (TWO_PI - theta_e, TWO_PI - theta_s)}
     law = case.planner.motion_law
@@ -233,9 +248,9 @@ def build(case: Case, limits: dict[str, float]) -> PendulumNLP:
     if case.drive is not None:  # the motor's torques at the swings' samples (``planning.solver.pendulum_drive``)
         drives = {name: swing_drive(case, swing) for name, swing in swings.items()}
         drive_rows(case, rows.add, drives, (phys["turn_end_s"], phys["turn_start_s"]), period, limits)
-    solver = NLPSolver("pendulum", {"x": x, "f": period / transfer, "g": ca.vertcat(*rows.g)}, OPTIONS, scales)
-    lbx, ubx = _bounds(case, names, setups)
-    return PendulumNLP(solver, np.array(rows.lb), np.array(rows.ub), names, scales, lbx, ubx, setups)
+    problem = {"x": x, "p": p, "f": period / transfer, "g": ca.vertcat(*rows.g)}
+    solver = NLPSolver("pendulum", problem, OPTIONS, scales)
+    return PendulumNLP(case, solver, np.array(rows.lb), np.array(rows.ub), names, scales, limit_names)
 
 
 def _bounds(case: Case, names: tuple[str, ...], setups: tuple[SwingSetup, ...]) -> tuple[np.ndarray, np.ndarray]:
@@ -366,7 +381,8 @@ def plan_of_values(case: Case, values: dict[str, float], info: SolverInfo) -> Pe
 def solve_once(case: Case, nlp: PendulumNLP, start: dict[str, float]) -> tuple[dict[str, float] | None, Any]:
     """One IPOPT solve from ``start``: the variable values when it converged (else None) and the result."""
     x0 = np.array([start[name] for name in nlp.names])
-    res = nlp.solver.solve(x0, nlp.lbx, nlp.ubx, nlp.lbg, nlp.ubg)
+    p = np.array([nlp.limits[name] for name in nlp.limit_names])
+    res = nlp.solver.solve(x0, nlp.lbx, nlp.ubx, nlp.lbg, nlp.ubg, p=p)
     values = {name: float(res.x[i]) for i, name in enumerate(nlp.names)} if res.success else None
     return values, res
 
