@@ -174,6 +174,7 @@ CASADI_MODULES = {  # the wrapper and the modules that build expressions for it
     "planning.solver.halves_nlp",
     "planning.solver.free_nlp",
     "planning.solver.pendulum_nlp",
+    "planning.solver.pendulum_drive",
     "planning.solver.bound",
     "planning.solver.upper_bound",
     "planning.solver.peak_shaving",  # the peak-shaving linear programme (HiGHS through casadi.conic)
