@@ -452,7 +452,6 @@ def test_a_download_is_the_confirmed_plan_on_screen_without_a_solve(monkeypatch)
     assert client.post("/api/download/trajectory.csv", json=other).status_code == 409
 
 
-
 @browser
 def test_the_charts_draw_every_limit_of_the_case_and_the_robot_window(page) -> None:
     """On the servo-limited case (crank speed, acceleration and jerk bind) every limit of the case is a
@@ -836,3 +835,41 @@ def test_a_draw_at_slide_speed_is_planned_and_its_speed_edited_with_the_mouse_an
     assert page.locator("#spm").inner_text() == f"{solve(case_from_data(data, label)).plan.spm:.3f}"
     assert "draw at 45 mm/s slide speed" in page.locator("#summary").inner_text()
     screenshot(page, "web-slide-draw")
+
+
+@browser
+def test_a_pendulum_stroke_on_the_page(page) -> None:
+    """The shallow cup's press set to pendulum strokes with the mouse: the page's strokes are the CLI's pendulum
+    plan's, the summary says the swing's gain over the rotary stroke, both robot's windows and both draws are
+    shaded on the chart against time, and the bracket's bound is the pendulum's certified bound."""
+    from planning.solver.pendulum import solve_pendulum
+    from planning.solver.pendulum_bound import pendulum_bound
+
+    pick_case(page, "small-fast-cup.yaml")
+    data = load_yaml((CASES / "small-fast-cup.yaml").read_text(encoding="utf-8"))
+    before = int(page.evaluate("document.body.dataset.rendered"))
+    select = page.locator('[data-field="planner.mode"]')
+    select.click()  # the mouse opens it
+    select.select_option("pendulum")
+    wait_rendered(page, before)
+    data["planner"]["mode"] = "pendulum"
+    case = case_from_data(data, "cases/small-fast-cup.yaml")
+    solution = solve_pendulum(case)
+    assert page.locator("#spm").inner_text() == f"{solution.plan.spm:.3f}"
+    page.locator("#summary").locator("xpath=..").locator("summary").click()  # the summary unfolded
+    summary = page.locator("#summary").inner_text()
+    assert (
+        "in pendulum strokes" in summary
+        and f"the rotary stroke under the same limits: {solution.rotary_spm:.3f}" in summary
+    )
+    page.locator("#x-axis").select_option("time")
+    rects = "document.getElementById('motion-chart').layout.shapes.filter((s) => s.type === 'rect')"
+    shapes = page.evaluate(rects + ".map((s) => [s.x0, s.x1])")
+    f, b = solution.plan.key_times("forward"), solution.plan.key_times("backward")
+    for lo, hi in ((f[3], b[0]), (f[1], f[2]), (b[1], b[2])):  # the window through theta_e, both draws
+        assert any(abs(x0 - lo) < 1e-9 and abs(x1 - hi) < 1e-9 for x0, x1 in shapes), (lo, hi, shapes)
+    page.wait_for_function("document.getElementById('bound-share').textContent.endsWith('%')")
+    share = float(page.locator("#bound-share").inner_text().rstrip(" %"))
+    assert share == pytest.approx(round(100 * solution.plan.spm / pendulum_bound(case).spm, 1))
+    assert page.locator("#downloads button").first.is_disabled()  # its files: the CLI's (not the page's yet)
+    screenshot(page, "web-pendulum")

@@ -54,6 +54,8 @@ class LimitLine:
 def robot_windows(result: dict[str, Any], axis: str, x: np.ndarray) -> list[tuple[float, float]]:
     """The robot's window theta4 -> TDC -> theta1 as spans of ``x`` (time [s] or crank angle [deg]): from
     theta4 to the cycle's end and from its start to theta1."""
+    if result.get("windows"):  # a pendulum stroke's: through each turn (``planning.reports.pendulum``)
+        return [tuple(span) for span in result["windows"][axis]]
     keys = {k["name"]: k for k in result["key_points"]}
     at = "time_s" if axis == "time" else "angle_deg"
     return [(keys["opening"][at], float(x[-1])), (float(x[0]), keys["closing"][at])]

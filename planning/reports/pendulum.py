@@ -197,3 +197,80 @@ def pendulum_laws_text(data: dict[str, Any]) -> str:
             continue
         lines.append(f"  {r['law']:<18} {r['spm']:11.3f}  {', '.join(r['binding']) or '-'}")
     return "\n".join(lines)
+
+
+def pendulum_page_result(solution: PendulumSolution, case: Case) -> dict[str, Any]:
+    """What the web page reads of a pendulum plan: ``result.json``'s data and the page's own fields (its key
+    points with the slide's and the crank's speed, both swings' as ``name`` and ``name_back``; the swings and the
+    standstills as the stage table's rows; the robot's windows and the draws as spans against time and crank
+    angle; ``placement`` in words; the case's process and limits for the charts' limit lines)."""
+    r = pendulum_result(solution, case)
+    plan, d = solution.plan, solution.evaluation.samples
+    points = []
+    for swing, suffix in (("forward", ""), ("backward", "_back")):
+        keys = plan.forward_keys if swing == "forward" else plan.backward_keys
+        times = plan.key_times(swing)
+        th, om, al, je = plan.profile.at_time(times)
+        h, v, _, _ = case.machine.slider(th, om, al, je)
+        for name, angle, t, hh, vv, w in zip(KEY_NAMES, keys, times, h, v, om, strict=True):
+            points.append(
+                {
+                    "name": name + suffix,
+                    "angle_deg": math.degrees(angle),
+                    "time_s": float(t),
+                    "height_mm": float(hh),
+                    "slider_speed_mm_s": float(abs(vv)),
+                    "direction": "down" if vv < 0 else "up",
+                    "crank_speed_rpm": float(w) / RPM,
+                }
+            )
+    f, b = (plan.key_times(s) for s in ("forward", "backward"))
+    s = r["swing"]
+    windows_time = [[float(f[3]), float(b[0])], [float(b[3]), plan.period], [0.0, float(f[0])]]
+    low = min(math.degrees(plan.forward_keys[3]), math.degrees(plan.backward_keys[0]))
+    high = max(math.degrees(plan.forward_keys[0]), math.degrees(plan.backward_keys[3]))
+    return {
+        **r,
+        "placement": "pendulum",
+        "binding_constraints": r["verification"]["binding"],
+        "binding_over_cycle": [],
+        "key_points": points,
+        "stages": _swing_stages(solution, d),
+        "transfer_window_s": min(b[0] - f[3], f[0] + plan.period - b[3]),
+        "windows": {"time": windows_time, "angle": [[low, s["end_deg"]], [s["start_deg"], high]]},
+        "draws": {
+            "time": [[float(f[1]), float(f[2])], [float(b[1]), float(b[2])]],
+            "angle": [sorted(math.degrees(k[i]) for i in (1, 2)) for k in (plan.forward_keys, plan.backward_keys)],
+        },
+        "process": {"safety_height_mm": case.process.safety_height_mm, "transfer_time_s": case.process.transfer_time_s},
+        "limits": case.limits.model_dump(),
+    }
+
+
+def _swing_stages(solution: PendulumSolution, d: Any) -> list[dict[str, Any]]:
+    """The stage table's rows of a pendulum plan: each swing and each standstill, with its peak crank speed."""
+    plan = solution.plan
+    spans = plan.swing_spans()
+    rows = []
+    edges = [
+        ("forward swing", spans["forward"]),
+        ("turn at theta_e", (spans["forward"][1], spans["backward"][0])),
+        ("backward swing", spans["backward"]),
+        ("turn at theta_s", (spans["backward"][1], plan.period)),
+    ]
+    for name, (t0, t1) in edges:
+        inside = (d.t >= t0) & (d.t <= t1)
+        th = plan.profile.at_time(np.array([t0, t1]))[0]
+        peak = float(np.max(np.abs(d.omega[inside]), initial=0.0)) / RPM
+        rows.append(
+            {
+                "name": name,
+                "start_angle_deg": math.degrees(th[0]),
+                "end_angle_deg": math.degrees(th[1]),
+                "start_time_s": t0,
+                "duration_s": t1 - t0,
+                "peak_crank_speed_rpm": peak,
+                "binding": [],
+            }
+        )
+    return rows

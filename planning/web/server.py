@@ -40,7 +40,7 @@ import yaml
 from flask import Flask, Response, jsonify, request, send_file
 from werkzeug.exceptions import HTTPException, RequestEntityTooLarge
 
-from planning.model.case import OBJECTIVES, ROBOT_NAMES, Case, RobotOrder
+from planning.model.case import OBJECTIVES, ROBOT_NAMES, Case, Mode, RobotOrder
 from planning.model.case_file import MAX_BYTES, CaseFileError, case_from_data, load_yaml, read_case, too_large_words
 from planning.model.laws import LAWS
 from planning.model.outcome import Outcome
@@ -62,10 +62,7 @@ from planning.web.cams import (
 )
 
 STATIC = Path(__file__).resolve().parent / "static"
-PENDULUM_ON_THE_PAGE = (
-    "planner.mode: pendulum: the page plans rotary strokes only (yet); pressplan solve, check, bound and cam "
-    "plan the swings"
-)
+PENDULUM_BOUND_LEAVES_OUT = ("limits.crank_jerk_rad_s3", "the turns")  # what the pendulum's bound leaves out
 MAX_REQUEST_BYTES = 2 * MAX_BYTES  # a case as JSON, with the page's own fields
 MAX_SESSIONS = 64
 CHART_POINTS = 600  # samples of a plan's curves sent to the page (the files keep the full 1 ms step)
@@ -445,8 +442,8 @@ def _answer(shared: _Shared, session: Session, body: dict[str, Any], seq: int) -
                 session.shown = (case_key(data), case, solution)
             return dict(answer)
         answer = solve_case(data, label, session, body.get("confirm") is True)
-        if answer.get("confirmed") and answer["status"] is Outcome.VERIFIED:
-            with shared.answers_lock:
+        if answer.get("confirmed") and answer["status"] is Outcome.VERIFIED and session.shown is not None:
+            with shared.answers_lock:  # (a pendulum's answer is not kept: no plan of it is shown for downloads)
                 shared.answers[known] = (answer, *session.shown[1:])
                 while len(shared.answers) > ANSWER_CACHE:
                     shared.answers.popitem(last=False)
@@ -563,6 +560,7 @@ def field_specs() -> list[dict[str, Any]]:
         {"name": "planner.motion_law", "kind": "choice", "choices": list(LAWS)},
         {"name": "planner.placement", "kind": "choice", "choices": ["free", "published"]},
         {"name": "planner.objective", "kind": "choice", "choices": list(OBJECTIVES)},
+        {"name": "planner.mode", "kind": "choice", "choices": list(Mode.__args__)},
         {"name": "process.forming_force_kN", "kind": "table", "optional": True, "columns": ["height mm", "force kN"]},
         {"name": "robots.order", "kind": "choice", "choices": list(RobotOrder.__args__)},
     ]
@@ -598,7 +596,7 @@ def solve_case(data: Any, label: str, session: Session, confirm: bool = True) ->
     except CaseFileError as exc:
         return {"status": Outcome.BAD_INPUT, "message": str(exc), "field": exc.field}
     if case.pendulum:
-        return {"status": Outcome.BAD_INPUT, "message": f"{label}: {PENDULUM_ON_THE_PAGE}", "field": "planner.mode"}
+        return _pendulum_answer(case, label, session)
     try:
         solution = None
         if not confirm and session.plan is not None:
@@ -625,6 +623,37 @@ def solve_case(data: Any, label: str, session: Session, confirm: bool = True) ->
         "summary": summary_text(result),
         "mechanism": mechanism_drawing(case),
         "utilisation": utilisation(solution.verification, case),
+        **_warned(case),
+    }
+
+
+def _pendulum_answer(case: Case, label: str, session: Session) -> dict[str, Any]:
+    """The page's answer for a pendulum case (``planning.solver.pendulum``): a cold solve each time (no fast
+    answer from the last plan yet), the rotary stroke's rate beside it in the summary; no downloads yet."""
+    from planning.reports.pendulum import pendulum_page_result, pendulum_summary
+    from planning.reports.report import columns_at
+    from planning.solver.outcomes import Infeasible, PlanningError
+    from planning.solver.pendulum import solve_pendulum
+
+    try:
+        solution = solve_pendulum(case)
+    except PlanningError as exc:
+        limit = exc.limit if isinstance(exc, Infeasible) else None
+        return {"status": exc.outcome, "message": f"{label}: {exc}", "field": limit, "confirmed": True, **_warned(case)}
+    session.plan = None  # a rotary solve's warm start cannot start from a swing
+    with session.guard:
+        session.shown = None
+    result = pendulum_page_result(solution, case)
+    columns = columns_at(solution.evaluation, case, solution.evaluation.rows(CHART_POINTS))
+    return {
+        "status": Outcome.VERIFIED,
+        "confirmed": True,
+        "result": _finite(result),
+        "curves": {name: _rounded(col) for name, col in columns.items()},
+        "limit_lines": chart_limits(result, columns),
+        "summary": pendulum_summary(result),
+        "mechanism": mechanism_drawing(case),
+        "utilisation": utilisation(solution.evaluation.verification, case),
         **_warned(case),
     }
 
@@ -737,8 +766,10 @@ def bound_of(data: Any, label: str) -> dict[str, Any]:
 
     try:
         case = case_from_data(data, label)
-        if case.pendulum:
-            return {"message": f"{label}: {PENDULUM_ON_THE_PAGE}"}
+        if case.pendulum:  # its certified bound (``planning.solver.pendulum_bound``); no grid bound
+            from planning.solver.pendulum_bound import pendulum_bound
+
+            return {"spm": None, "upper_spm": pendulum_bound(case).spm, "left_out": list(PENDULUM_BOUND_LEAVES_OUT)}
         upper = upper_bound(case, LAWS_UPPER_POINTS, LAWS_UPPER_PIECES)
         grid = time_optimal_bound(case)
     except (CaseFileError, PlanningError) as exc:

@@ -9,7 +9,7 @@ const ONE_HEIGHT_KEYS = ["process.safety_height_mm", "process.transfer_time_s"];
 const CRANK_SLIDER_KEYS = ["press.crank_radius_mm", "press.rod_length_mm", "press.offset_mm", "drive.rod_mass_kg", "drive.rod_cg_from_crank_pin_mm"];
 const SECTION_TITLES = { robots: "robots", "robots.unloader": "unloader (takes the part out)", "robots.loader": "loader (brings the blank in)", press: "press", "press.link_drive": "link drive", "press.knuckle_joint": "knuckle joint", key_points: "key angles", process: "process", limits: "limits", drive: "drive", "drive.motor": "motor (all motors together)", planner: "planner" };
 const WINDOW_COLOUR = "#d9ecff", DRAW_COLOUR = "#e2f0d9", HOLD_COLOUR = "#c8b99a"; // the robot's window, the draw, a hold
-const KEY_LABELS = { closing: "θ1", draw_start: "θ2", draw_end: "θ3", opening: "θ4" };
+const KEY_LABELS = { closing: "θ1", draw_start: "θ2", draw_end: "θ3", opening: "θ4", closing_back: "θ1′", draw_start_back: "θ2′", draw_end_back: "θ3′", opening_back: "θ4′" };
 const TYPING_REST_MS = 120; // a pause this long in typing solves (a fast typist's keys come closer)
 const BOUND_REST_MS = 800;
 
@@ -396,7 +396,8 @@ async function requestBound(data, seq) {
   $("#bound-share").textContent = bounded ? (100 * spm / answer.upper_spm).toFixed(1) + " %" : "no bound";
   $("#bound-share").title = bounded
     ? `bracket: ${spm.toFixed(3)} strokes/min verified … ${answer.upper_spm.toFixed(3)} certified upper bound (no motion within the limits makes more` +
-      (answer.left_out.length ? `; left out: ${answer.left_out.join(", ")}` : "") + `); the grid bound ${answer.spm.toFixed(3)}`
+      (answer.left_out.length ? `; left out: ${answer.left_out.join(", ")}` : "") + ")" +
+      (answer.spm != null ? `; the grid bound ${answer.spm.toFixed(3)}` : "")
     : answer.message;
 }
 
@@ -416,12 +417,14 @@ function showBadge(refused) {
   const stale = Boolean(refused);
   document.body.dataset.stale = stale && r ? "1" : "";
   if (stale && state.camFile) camReset(); // a proved cam belongs to the plan, not to the form's refused case
+  const swing = Boolean(r && r.mode === "pendulum"); // a pendulum's files: pressplan solve and cam write them
   for (const b of document.querySelectorAll("#downloads button, #cam-prove")) {
-    b.disabled = stale;
-    b.title = stale ? "the case on the form has no plan: fix the value marked, then download" : "";
+    b.disabled = stale || swing;
+    b.title = stale ? "the case on the form has no plan: fix the value marked, then download"
+      : swing ? "a pendulum stroke's files and cams: pressplan solve and pressplan cam write them (not the page yet)" : "";
   }
   if (!r) { badge.textContent = refused ? "no plan" : ""; badge.className = "badge none"; return; }
-  const what = `${r.motion_law}, ${r.placement} placement, ${r.spm.toFixed(3)} strokes/min`;
+  const what = `${r.motion_law}, ${planWords(r)}, ${r.spm.toFixed(3)} strokes/min`;
   if (stale) {
     badge.textContent = `showing the last good plan (${what}): the case on the form has none`;
     badge.className = "badge stale";
@@ -476,7 +479,7 @@ function render(answer, seq, confirmed) {
   $("#spm").textContent = r.spm.toFixed(3);
   $("#cycle").textContent = r.cycle_time_s.toFixed(4);
   $("#binding").textContent = r.binding_constraints.join(", ") || "none";
-  setStatus(`${r.motion_law}, ${r.placement} placement, ${r.status}: every limit holds on the dense ${(r.verification.step_s * 1e3).toFixed(3)} ms grid` +
+  setStatus(`${r.motion_law}, ${planWords(r)}, ${r.status}: every limit holds on the dense ${(r.verification.step_s * 1e3).toFixed(3)} ms grid` +
     (confirmed ? "" : "; confirming against the cold solve…"), confirmed ? "" : "busy");
   $("#objective-line").textContent = r.baseline
     ? `${r.objective} at ${r.target_spm} SPM: RMS ${(r.drive.rms_motor_torque_Nm / 1e3).toFixed(2)} kN m, energy ${r.energy_kJ.toFixed(1)} kJ/stroke (${r.energy_at === "bus" ? "at the bus" : "at the shaft"}); ` +
@@ -521,6 +524,11 @@ function render(answer, seq, confirmed) {
   if (!confirmed || window.firstRenderedSeq !== seq) { window.firstRenderedAt = performance.now(); window.firstRenderedSeq = seq; }
   window.renderedAt = performance.now();
   document.body.dataset.rendered = String(seq);
+}
+
+// how the plan runs, in words: its placement, or a pendulum stroke's swings
+function planWords(r) {
+  return r.mode === "pendulum" ? "pendulum strokes" : `${r.placement} placement`;
 }
 
 // the pinned plan's SPM beside the one on screen (a pin changes nothing else: the badge and status stay)
@@ -647,6 +655,7 @@ function pickedPanels() {
 }
 
 function cycleShapes(r, x, axis, width) {
+  if (r.windows) return swingShapes(r, axis);
   const at = (name) => { const k = r.key_points.find((p) => p.name === name); return axis === "time" ? k.time_s : k.angle_deg; };
   const rect = (x0, x1, fillcolor) => ({ type: "rect", xref: "x", yref: "paper", x0, x1, y0: 0, y1: 1, fillcolor, opacity: 0.6, line: { width: 0 }, layer: "below" });
   const robots = r.robots != null; // the robots' interference curves replace the one robot's window
@@ -669,6 +678,19 @@ function cycleShapes(r, x, axis, width) {
     annotations.push({ xref: "x", yref: "paper", x: (at("draw_start") + at("draw_end")) / 2, y: 1.0, xanchor: "center", yanchor: "bottom", text: draw, showarrow: false, font: { size: 11, color: "#3b6e22" } });
   }
   if (r.hold) holdShape(r.hold, at("draw_end"), axis, shapes, annotations);
+  return { shapes, annotations };
+}
+
+// a pendulum stroke: the robot's windows through both turns and both swings' draws shaded, every key point a line
+function swingShapes(r, axis) {
+  const rect = ([x0, x1], fillcolor) => ({ type: "rect", xref: "x", yref: "paper", x0, x1, y0: 0, y1: 1, fillcolor, opacity: 0.6, line: { width: 0 }, layer: "below" });
+  const shapes = [...r.windows[axis].map((span) => rect(span, WINDOW_COLOUR)), ...r.draws[axis].map((span) => rect(span, DRAW_COLOUR))];
+  for (const k of r.key_points) {
+    const kx = axis === "time" ? k.time_s : k.angle_deg;
+    shapes.push({ type: "line", xref: "x", yref: "paper", x0: kx, x1: kx, y0: 0, y1: 1, line: { dash: "dot", width: 1, color: "#555" } });
+  }
+  const text = `robot windows through the turns: ${r.transfer_window_s.toFixed(3)} s (≥ ${r.process.transfer_time_s} s)`;
+  const annotations = [{ xref: "paper", yref: "paper", x: 0, y: 1.0, xanchor: "left", yanchor: "bottom", text, showarrow: false, font: { size: 11, color: "#1f4e79" } }];
   return { shapes, annotations };
 }
 
@@ -763,7 +785,7 @@ function drawCharts() {
     margin: { l: 48, r: 14, t: 20, b: 40 },
     hovermode: "x unified",
     showlegend: false,
-    xaxis: { title: { text: axis === "time" ? "time from TDC [s]" : "crank angle from TDC [deg]" }, anchor: `y${picked.length > 1 ? picked.length : ""}` },
+    xaxis: { title: { text: axis === "time" ? (r.windows ? "time from the forward swing's start [s]" : "time from TDC [s]") : "crank angle from TDC [deg]" }, anchor: `y${picked.length > 1 ? picked.length : ""}` },
   };
   const axes = {}, traces = [], gap = 0.04, n = Math.max(picked.length, 1), height = (1 - gap * (n - 1)) / n;
   const notes = [];
