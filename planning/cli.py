@@ -393,14 +393,14 @@ def _output_folder(case, args, owned: tuple[str, ...]) -> Path:
 
 
 def _solve(case, args) -> int:
-    from planning.reports.outputs import Written, owned_files, writers_of
+    from planning.reports.outputs import Written, writers_of
     from planning.reports.report import summary_text
     from planning.solver.optimize import solve
 
     case = _with_objective(_with_law(case, args), args)
     if case.pendulum:
         return _solve_pendulum(case, args)
-    out = _output_folder(case, args, owned_files())
+    out = _output_folder(case, args, _solve_files())
     solution = solve(case, args.placement)
     figures = not args.no_plots
     if figures:
@@ -412,7 +412,7 @@ def _solve(case, args) -> int:
         from planning.reports.cam_export import proof_lines
 
         text += "\n\n" + "\n".join(proof_lines(written.cam))
-    return _write_and_report(out, writers, written.result, text, args, owned_files())
+    return _write_and_report(out, writers, written.result, text, args, _solve_files())
 
 
 def _solve_pendulum(case, args) -> int:
@@ -425,7 +425,7 @@ def _solve_pendulum(case, args) -> int:
 
     if args.placement == "published":
         raise CommandError(f"{args.case}: --placement published: not with planner.mode: pendulum")
-    owned = _pendulum_files()
+    owned = _solve_files()
     out = _output_folder(case, args, owned)
     solution = solve_pendulum(case)
     figures = not args.no_plots
@@ -441,11 +441,13 @@ def _solve_pendulum(case, args) -> int:
     return _write_and_report(out, writers, result, text, args, owned)
 
 
-def _pendulum_files() -> tuple[str, ...]:
-    """What a pendulum solve owns in its folder: its own files, the cam table and the cams."""
+def _solve_files() -> tuple[str, ...]:
+    """What ``pressplan solve`` owns in its folder, either stroke's: a rotary solve's files (the registry's) and a
+    pendulum solve's, so that a solve of the other stroke into the same folder leaves none of them behind."""
+    from planning.reports.outputs import owned_files
     from planning.reports.pendulum import PENDULUM_FILES
 
-    return PENDULUM_FILES + ("cam_table.csv",) + tuple(p for o in _cam_outputs() for p in o.files)
+    return tuple(dict.fromkeys(owned_files() + PENDULUM_FILES))
 
 
 def _pendulum_cam_writers(written, with_table: bool) -> dict:  # noqa: ANN001 - a Written

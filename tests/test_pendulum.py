@@ -244,6 +244,7 @@ def test_a_swing_with_its_drive_mirrors_and_balances(tmp_path):
     table = np.array(read_case(DRIVE).process.forming_force_kN)  # the whole table lies below theta2's height
     forming = abs(float(np.trapezoid(table[:, 1], table[:, 0])))  # [kN mm = J] the work of one stroke's draw
     assert work == pytest.approx(2 * forming, rel=5e-3)
+    assert pendulum_bound(read_case(DRIVE, {"planner.mode": "pendulum"})).spm >= result["spm"]  # the motor's cap too
     forward = result["swings"]["forward"]["time_s"]
     tau = np.linspace(0.05, forward - 0.05, 200)
     back0 = forward + result["swing"]["turn_end_s"]
@@ -265,3 +266,46 @@ def test_what_a_swing_cannot_draw_is_refused_before_solving(capsys):
     assert main(["solve", str(path), *offset, "--no-plots", "--out", "/nonexistent/x"]) == 3
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "process.draw_speed_rpm" in err[0] and "backward" in err[0]
+
+
+@pytest.mark.parametrize("name", ["pendulum-die-zone-after-draw.yaml", "pendulum-key-angle-at-the-turn.yaml"])
+def test_outside_trials_cases_verify(name, tmp_path):
+    """From an outside trial: a draw that ends above the die height before BDC (the return comes down into the die
+    zone: its speed held there, not only where the slide leaves it), and a swing whose end falls on a key angle
+    (there to the key angles' tolerance): each verified, where they ended unverified or in a traceback."""
+    path = ROOT / "tests" / "data" / "cases" / name
+    assert main(["solve", str(path), "--out", str(tmp_path), "--no-plots"]) == 0
+    assert json.loads((tmp_path / "result.json").read_text())["status"] == "verified"
+
+
+def test_one_folder_for_either_stroke(tmp_path, capsys):
+    """A pendulum solve into a rotary solve's folder leaves none of the rotary's files (and back), and ``pressplan
+    cam`` on a pendulum's folder asks for the case file in one line."""
+    cup = ROOT / "cases" / "small-fast-cup.yaml"
+    assert main(["solve", str(cup), "--out", str(tmp_path), "--no-plots"]) == 0
+    assert (tmp_path / "plan.json").exists()
+    assert main(["solve", str(cup), "--set", "planner.mode=pendulum", "--out", str(tmp_path)]) == 0
+    assert not (tmp_path / "plan.json").exists() and (tmp_path / "swing.png").exists()
+    capsys.readouterr()
+    assert main(["cam", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "give its case file" in err[0]
+    assert main(["solve", str(cup), "--out", str(tmp_path), "--no-plots"]) == 0
+    assert (tmp_path / "plan.json").exists() and not (tmp_path / "swing.png").exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "field"),
+    [
+        (["--objective", "min-rms-torque", "--spm", "20"], "--objective"),
+        (["--set", "process.transfer_time_s=20000"], "process.transfer_time_s"),
+    ],
+)
+def test_a_swing_refuses_in_one_line(args, field, capsys):
+    drive = ROOT / "cases" / "cup-2000kN-drive.yaml"
+    assert (
+        main(["solve", str(drive), "--set", "planner.mode=pendulum", *args, "--no-plots", "--out", "/nonexistent/x"])
+        == 2
+    )
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and field in err[0] and "pendulum" in err[0]

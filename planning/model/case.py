@@ -692,6 +692,7 @@ class Case(_Model):
         planner = PlannerModel.model_validate({**self.planner.model_dump(), **update})
         case = self.model_copy(update={"planner": planner})
         _objective_checks(case)
+        _pendulum_checks(case)
         return case
 
     def with_law(self, law: str) -> Case:
@@ -959,6 +960,11 @@ PENDULUM_NOT_WITH = (  # what a pendulum stroke does not plan with yet: (field, 
     ),
     ("planner.target_spm", lambda c: c.planner.target_spm, "a swing plans the most strokes"),
     ("process.hold_time_s", lambda c: c.process.hold_time_s, "no hold in a swing yet"),
+    (
+        "process.transfer_time_s",
+        lambda c: t if (t := c.process.transfer_time_s) is not None and t > MAX_HOLD_S else None,
+        f"at most {MAX_HOLD_S:g} s: the swings stand at the turns, a cycle's times within the plan's precision",
+    ),
     ("process.draw_slide_speed_mm_s", lambda c: c.process.draw_slide_speed_mm_s, "a swing draws at a crank speed"),
     ("drive", lambda c: "a drive" if c.electrical else None, "its electrical side (losses, storage, grid) not yet"),
     (

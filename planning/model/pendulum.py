@@ -36,7 +36,7 @@ from planning.model.limits import limits_of
 from planning.model.limits.base import DRAW_GRID, Draw
 from planning.model.profile import Profile, Segment
 from planning.model.units import RPM
-from planning.tolerances import ANGLE_ROUND_OFF_RAD, SAME_TIME_S, TINY
+from planning.tolerances import ANGLE_ROUND_OFF_RAD, ANGLE_TOL_RAD, SAME_TIME_S, TINY
 from press.backend import math_module
 
 TWO_PI = 2 * math.pi
@@ -46,6 +46,7 @@ TURN_SEGMENT = "turn:standstill"  # the crank standing at a swing's end
 SWING_HALVES = ("feed_accel", "feed_decel", "return_accel", "return_decel")
 DRAW_BOUND_LIMITS = ("crank_speed", "motor_speed", "slider_accel", "slider_speed", "draw_start_speed")  # their own
 BISECTIONS = 60  # halvings of a bracket to find where the draw crosses the die height
+DIE_ZONE_POINTS = 5  # angles of a swing's return in the die zone at which the NLP holds the die speed
 
 
 @dataclass(frozen=True)
@@ -278,12 +279,17 @@ class PendulumPlan:
 
 
 def time_at(profile: Profile, theta: float, lo: float, hi: float) -> float:
-    """The time [s] in ``lo .. hi`` (one swing: the angle monotone there) at which the crank is at ``theta``."""
+    """The time [s] in ``lo .. hi`` (one swing: the angle monotone there) at which the crank is at ``theta``; an
+    angle beyond the swing's ends by at most ``ANGLE_TOL_RAD`` (the key angles' tolerance) is at the nearer end.
+    ``ValueError`` for one farther off."""
     th_lo = float(profile.at_time(np.array([lo]))[0][0])
     th_hi = float(profile.at_time(np.array([hi]))[0][0])
     rising = th_hi >= th_lo
-    if not min(th_lo, th_hi) - ANGLE_ROUND_OFF_RAD <= theta <= max(th_lo, th_hi) + ANGLE_ROUND_OFF_RAD:
+    low, high = min(th_lo, th_hi), max(th_lo, th_hi)
+    if not low - ANGLE_TOL_RAD <= theta <= high + ANGLE_TOL_RAD:
         raise ValueError("angle outside the swing")
+    if not low < theta < high:  # at an end, to the key angles' tolerance
+        return lo if abs(theta - th_lo) <= abs(theta - th_hi) else hi
     a, b = lo, hi
     for _ in range(200):
         mid = 0.5 * (a + b)
@@ -300,14 +306,14 @@ def time_at(profile: Profile, theta: float, lo: float, hi: float) -> float:
 @dataclass(frozen=True)
 class SwingSetup:
     """What one swing's NLP needs before solving: its ``name``; its key angles ``keys`` on u [rad]; ``jets(u)``
-    (the mechanism on u: h, h', h'', h'''); ``die_exit``: u [rad] where the slide leaves the die zone after
-    theta3 (None when the draw ends above the die height); ``draw_speed_bound`` [rad/s]: the highest constant
-    draw speed the limits allow in its draw."""
+    (the mechanism on u: h and its first three derivatives); ``die_zone``: angles u [rad] of the return in the
+    die zone (:func:`die_zone`, empty when the return stays above the die height); ``draw_speed_bound``
+    [rad/s]: the highest constant draw speed the limits allow in its draw."""
 
     name: str
     keys: tuple[float, float, float, float]
     jets: Any
-    die_exit: float | None
+    die_zone: tuple[float, ...]
     draw_speed_bound: float
 
 
@@ -319,21 +325,23 @@ def swing_setups(case: Any, limits: dict[str, float]) -> tuple[SwingSetup, Swing
     out = []
     for name, keys in zip(SWINGS, (fwd, back), strict=True):
         jets = m.jets if name == "forward" else (lambda u: mirrored_jets(m, u))  # noqa: E731 - one line each
-        out.append(
-            SwingSetup(name, keys, jets, _die_exit(case, name, keys), draw_speed_bound(case, keys, jets, limits))
-        )
+        out.append(SwingSetup(name, keys, jets, die_zone(case, name, keys), draw_speed_bound(case, keys, jets, limits)))
     return out[0], out[1]
 
 
-def _die_exit(case: Any, swing: str, keys: tuple[float, ...]) -> float | None:
-    """u [rad] where the slide rises through the die height after theta3 (None: the draw ends above it)."""
+def die_zone(case: Any, swing: str, keys: tuple[float, ...]) -> tuple[float, ...]:
+    """:data:`DIE_ZONE_POINTS` angles u [rad] of the swing's return at or below the die height: evenly from where
+    the slide comes down through it after theta3 (or, where the draw ends in the zone, one step past theta3) to
+    where it rises out of it; empty when the return is above the die height all along."""
     m, die = case.machine, case.limits.die_height_mm
-    u3 = keys[2]
-    theta3 = u3 if swing == "forward" else TWO_PI - u3
-    if float(m.height(theta3)) > die:
-        return None
     down, up = (float(a) for a in m.angles_at_height(min(die, m.stroke)))
-    return up if swing == "forward" else TWO_PI - down
+    entry, leave = (down, up) if swing == "forward" else (TWO_PI - up, TWO_PI - down)
+    u3 = keys[2]
+    if u3 >= leave:
+        return ()
+    if u3 < entry:
+        return tuple(float(a) for a in np.linspace(entry, leave, DIE_ZONE_POINTS))
+    return tuple(float(a) for a in np.linspace(u3, leave, DIE_ZONE_POINTS + 1)[1:])
 
 
 def draw_speed_bound(case: Any, keys: tuple[float, ...], jets: Any, limits: dict[str, float]) -> float:

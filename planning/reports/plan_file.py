@@ -21,10 +21,20 @@ class PlanFileError(ValueError):
     """A ``plan.json`` that cannot be read (one line naming the file and what is wrong: exit 2)."""
 
 
+def _pendulum_folder(folder: Path) -> bool:
+    """Whether ``folder`` holds a pendulum solve's outputs (its ``result.json`` says so)."""
+    try:
+        return json.loads((folder / "result.json").read_text(encoding="utf-8")).get("mode") == "pendulum"
+    except (OSError, ValueError, AttributeError):
+        return False
+
+
 def read_plan(folder: str | Path) -> tuple[Case, Solution]:
     """The case and the verified plan written to ``folder/plan.json`` by ``pressplan solve``."""
     path = Path(folder) / FILE
     if not path.is_file():
+        if _pendulum_folder(Path(folder)):
+            raise PlanFileError(f"{folder}: a pendulum stroke's folder (no {FILE}): give its case file instead")
         raise PlanFileError(f"{folder}: no {FILE} here (solve the case with this version of pressplan first)")
     try:
         data = json.loads(path.read_text(encoding="utf-8"))

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from planning.model.case import RPM, Case
+from planning.model.case import Case
 from planning.model.limits import limits_of
 from planning.model.limits.canonical import SpeedCap
 from planning.model.pendulum import STROKES_PER_CYCLE, SwingSetup, swing_setups
@@ -72,15 +72,19 @@ def _nodes(case: Case, setup: SwingSetup) -> np.ndarray:
 
 
 def _caps(case: Case, setup: SwingSetup, u: np.ndarray, h: np.ndarray, d1: np.ndarray) -> np.ndarray:
-    """The largest crank speed squared each speed cap allows at the nodes [rad^2/s^2]."""
-    top = case.limits.crank_speed_rpm * RPM if case.limits.crank_speed_rpm else math.inf
-    caps = np.full(u.size, top**2)
+    """The largest crank speed squared each speed cap allows at the nodes [rad^2/s^2]: a cap on the crank's own
+    speed (the crank's top speed, the motor's through the gear: ``k`` a constant) everywhere, a cap on the
+    slide's speed (``k = h'``) where it applies."""
+    caps = np.full(u.size, math.inf)
     for limit in limits_of(case):
-        if isinstance(limit, SpeedCap) and not limit.lower and limit.id != "crank_speed":
-            inside = limit.where(case, h, bound=True)
-            inside = np.ones(u.size, dtype=bool) if inside is None else inside
-            moving = inside & (np.abs(d1) > 0)
-            caps[moving] = np.minimum(caps[moving], (limit.top(case) / d1[moving]) ** 2)
+        if not isinstance(limit, SpeedCap) or limit.lower:
+            continue
+        factor = limit.crank_factor(case)
+        inside = limit.where(case, h, bound=True)
+        inside = np.ones(u.size, dtype=bool) if inside is None else inside
+        k = np.full(u.size, float(factor)) if factor is not None else np.abs(d1)
+        moving = inside & (k > 0)
+        caps[moving] = np.minimum(caps[moving], (limit.top(case) / k[moving]) ** 2)
     u2, u3 = setup.keys[1], setup.keys[2]
     draw = (u >= u2 - SAME_NODE_RAD) & (u <= u3 + SAME_NODE_RAD)
     caps[draw] = min(float(np.min(caps[draw])), setup.draw_speed_bound**2)

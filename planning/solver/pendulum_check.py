@@ -130,7 +130,11 @@ def _swing_checks(d: Dense, cam: bool) -> list[Check]:
     cam: the law's own, one way, at rest at the turns and the draws at one speed, left out)."""
     plan, case = d.plan, d.case
     spans = plan.swing_spans()
-    times = {swing: plan.key_times(swing) for swing in SWINGS}
+    try:
+        times = {swing: plan.key_times(swing) for swing in SWINGS}
+    except ValueError:  # a swing that turns before one of its key angles: nothing more to check of it
+        tol = math.degrees(ANGLE_TOL_RAD)
+        return [Check.of(CheckId.KEY_ANGLES, "each swing passes its key angles", math.nan, 0.0, "deg", "equal", tol)]
     out = [] if cam else _law_checks(d, spans, times)
     out += _window_checks(d, times)
     least = case.limits.min_crank_speed_rpm

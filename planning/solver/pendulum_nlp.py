@@ -35,6 +35,7 @@ from planning.model.laws import get_law
 from planning.model.limits import limits_of
 from planning.model.limits.capacity import torque_capacity_kNm
 from planning.model.pendulum import (
+    DIE_ZONE_POINTS,
     SWINGS,
     TWO_PI,
     PendulumParameters,
@@ -63,7 +64,7 @@ SWING_VARIABLES = (  # per swing, prefixed ``forward_`` / ``backward_``: (name, 
     ("return_decel_duration", "feed_accel_duration"),
     ("closing_time", "closing_time"),
     ("opening_time", "closing_time"),
-    ("die_exit_time", "closing_time"),
+    *((f"die_time_{k}", "closing_time") for k in range(DIE_ZONE_POINTS)),  # from theta3 to the die zone's angles
 )
 SHARED_VARIABLES = (
     ("swing_start", None),  # theta_s [rad]
@@ -173,10 +174,10 @@ def _sampled_rows(rows: _Rows, s: _Swing, case: Case, limits: dict[str, float]) 
             rows.add((d2 * om**2 + d1 * al) / limits["slider_accel"], -1.0, 1.0)
             if lim.slider_speed_mm_s is not None:
                 rows.add(d1 * om / limits["slider_speed"], -1.0, 1.0)
-    if s.setup.die_exit is not None:
-        th_x, om_x = angle_at(s.v["die_exit_time"], *s.ret)
-        slope = abs(float(s.setup.jets(s.setup.die_exit)[1]))
-        rows.add(ca.vertcat(th_x - s.setup.die_exit), 0.0, 0.0)
+    for k, u in enumerate(s.setup.die_zone):  # the return in the die zone: at its fixed angles
+        th_x, om_x = angle_at(s.v[f"die_time_{k}"], *s.ret)
+        slope = abs(float(s.setup.jets(u)[1]))
+        rows.add(ca.vertcat(th_x - u), 0.0, 0.0)
         rows.add(slope * om_x / v_die, -math.inf, 1.0)
 
 
@@ -339,7 +340,7 @@ def _swing_start(setup: SwingSetup, ends: tuple[float, float], w2: float, wm: fl
     feed_profile = Profile(tuple(p.feed_segments()), a, 0.0)
     ret_profile = Profile(tuple(p.return_segments()), setup.keys[2], w2)
     n = setup.name
-    exit_time = ret_profile.time_at_angle(setup.die_exit) if setup.die_exit is not None else 0.0
+    zone = {f"{setup.name}_die_time_{k}": ret_profile.time_at_angle(u) for k, u in enumerate(setup.die_zone)}
     return {
         f"{n}_draw_speed": w2,
         f"{n}_feed_peak_speed": wm,
@@ -350,7 +351,8 @@ def _swing_start(setup: SwingSetup, ends: tuple[float, float], w2: float, wm: fl
         f"{n}_return_decel_duration": rd,
         f"{n}_closing_time": feed_profile.time_at_angle(setup.keys[0]),
         f"{n}_opening_time": ret_profile.time_at_angle(setup.keys[3]),
-        f"{n}_die_exit_time": exit_time,
+        **{f"{n}_die_time_{k}": 0.0 for k in range(DIE_ZONE_POINTS)},
+        **zone,
     }
 
 
