@@ -759,7 +759,8 @@ def _pendulum_bound(case, args) -> int:
         f"{case.name}: certified upper bound {bound.spm:.3f} strokes/min in pendulum strokes, two swings at least "
         f"{bound.cycle_time_s:.4f} s: no swing within the limits makes more (two robot's windows of "
         f"{case.process.transfer_time_s:g} s and theta1 .. theta4 at least {bound.arc_times_s[0]:.4f} s forward, "
-        f"{bound.arc_times_s[1]:.4f} s backward; the jerk limit and the turns left out)"
+        f"{bound.arc_times_s[1]:.4f} s backward; the jerk limit, the least crank speed, the torques and the turns left "
+        "out)"
     ]
     if args.bracket or args.tolerance is not None:
         from planning.solver.pendulum import solve_pendulum

@@ -146,20 +146,19 @@ def solve_block(
             case = case_from_data(point_data(base, fields, values), f"{label}[{index}]")
             if case.pendulum:  # a swing's cold multi-start (no neighbour's start yet: nothing to repair from)
                 row.update(_pendulum_row(case), case=case)
-                continue
-            sol = solve(case, placement, neighbour=previous)
-            previous = sol.plan
-            row.update(_solved_row(sol, case), plan=sol.plan, case=case)
+            else:
+                sol = solve(case, placement, neighbour=previous)
+                previous = sol.plan
+                row.update(_solved_row(sol, case), plan=sol.plan, case=case)
         except CaseFileError as exc:
             row.update(status=Outcome.BAD_INPUT, message=str(exc))
         except PlanningError as exc:
             row.update(status=exc.outcome, message=exc.reason)
         except Exception as exc:  # noqa: BLE001 - one failing point never stops the sweep
             row.update(status=Outcome.ERROR, message=f"{type(exc).__name__}: {exc}")
-        finally:
-            row["solve_time_s"] = time.perf_counter() - t
-            stamp(row, started)
-            rows.append(row)
+        row["solve_time_s"] = time.perf_counter() - t
+        stamp(row, started)
+        rows.append(row)
     return rows
 
 

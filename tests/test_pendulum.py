@@ -245,6 +245,8 @@ def test_a_swing_with_its_drive_mirrors_and_balances(tmp_path):
     forming = abs(float(np.trapezoid(table[:, 1], table[:, 0])))  # [kN mm = J] the work of one stroke's draw
     assert work == pytest.approx(2 * forming, rel=5e-3)
     assert pendulum_bound(read_case(DRIVE, {"planner.mode": "pendulum"})).spm >= result["spm"]  # the motor's cap too
+    peak = float(np.max(np.abs(c["motor_speed_rpm"])))  # either way: the backward swing's counts
+    assert result["drive"]["peak_motor_speed_rpm"] == pytest.approx(peak, rel=1e-3)
     forward = result["swings"]["forward"]["time_s"]
     tau = np.linspace(0.05, forward - 0.05, 200)
     back0 = forward + result["swing"]["turn_end_s"]
@@ -295,17 +297,30 @@ def test_one_folder_for_either_stroke(tmp_path, capsys):
 
 
 @pytest.mark.parametrize(
-    ("args", "field"),
+    ("path", "args", "field", "code"),
     [
-        (["--objective", "min-rms-torque", "--spm", "20"], "--objective"),
-        (["--set", "process.transfer_time_s=20000"], "process.transfer_time_s"),
+        ("cup-2000kN-drive", ["--objective", "min-rms-torque", "--spm", "20"], "--objective", 2),
+        ("cup-2000kN-drive", ["--set", "process.transfer_time_s=20000"], "process.transfer_time_s", 2),
+        ("wang2023-side-panel-drive", ["--set", "press.capacity.crank_torque_kNm=500"], "crank_torque_kNm", 3),
+        ("../tests/data/cases/link-pendulum", ["--set", "limits.min_crank_speed_rpm=10"], "backward swing's draw", 3),
     ],
 )
-def test_a_swing_refuses_in_one_line(args, field, capsys):
-    drive = ROOT / "cases" / "cup-2000kN-drive.yaml"
-    assert (
-        main(["solve", str(drive), "--set", "planner.mode=pendulum", *args, "--no-plots", "--out", "/nonexistent/x"])
-        == 2
-    )
+def test_a_swing_refuses_in_one_line(path, args, field, code, capsys):
+    """What a swing does not plan with (exit 2), and what no swing can do, found before solving (exit 3: the
+    crank's torque capacity below the draw's need; the least crank speed above what the backward swing's draw
+    allows on a link drive, though the forward's allows it), each in one line naming the field."""
+    case = ROOT / "cases" / f"{path}.yaml"
+    out = ["--no-plots", "--out", "/nonexistent/x"]
+    assert main(["solve", str(case), "--set", "planner.mode=pendulum", *args, *out]) == code
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and field in err[0] and "pendulum" in err[0]
+    assert len(err) == 1 and field in err[0] and ("pendulum" in err[0] or code == 3)
+
+
+def test_a_cam_that_misses_a_key_angle_is_refused_not_a_traceback(tmp_path, capsys):
+    """The swing turns on its opening angle; a linear cam of 40 points cuts the corner there and never reaches it:
+    the proof says which check breaks (exit 3), where the verification raised before."""
+    path = ROOT / "tests" / "data" / "cases" / "pendulum-turn-at-opening.yaml"
+    args = ["cam", str(path), "--cam-interpolation", "linear", "--cam-count", "40", "--out", str(tmp_path)]
+    assert main(args) == 3
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "each swing passes its key angles" in err[0]

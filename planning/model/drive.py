@@ -201,7 +201,7 @@ def drive_figures(
         rms_motor_torque_Nm=rms,
         peak_crank_torque_Nm=float(max(np.max(np.abs(s["crank_torque_Nm"])), np.max(np.abs(d["crank_torque_Nm"])))),
         peak_motor_power_kW=float(max(np.max(np.abs(p)), np.max(np.abs(d["motor_power_W"])))) / 1e3,
-        peak_motor_speed_rpm=float(np.max(s["motor_speed_rad_s"])) / RPM,
+        peak_motor_speed_rpm=float(np.max(np.abs(s["motor_speed_rad_s"]))) / RPM,  # either way (a pendulum's)
         energy_drawn_kJ=c["energy_drawn_kJ"],
         energy_returned_kJ=c["energy_returned_kJ"],
         energy_net_kJ=c["energy_drawn_kJ"] + c["energy_returned_kJ"],

@@ -35,7 +35,6 @@ from planning.model.laws import get_law
 from planning.model.limits import limits_of
 from planning.model.limits.base import DRAW_GRID, Draw
 from planning.model.profile import Profile, Segment
-from planning.model.units import RPM
 from planning.tolerances import ANGLE_ROUND_OFF_RAD, ANGLE_TOL_RAD, SAME_TIME_S, TINY
 from press.backend import math_module
 
@@ -47,6 +46,7 @@ SWING_HALVES = ("feed_accel", "feed_decel", "return_accel", "return_decel")
 DRAW_BOUND_LIMITS = ("crank_speed", "motor_speed", "slider_accel", "slider_speed", "draw_start_speed")  # their own
 BISECTIONS = 60  # halvings of a bracket to find where the draw crosses the die height
 DIE_ZONE_POINTS = 5  # angles of a swing's return in the die zone at which the NLP holds the die speed
+TIME_BISECTIONS = 200  # halvings of a swing's time to find when it passes an angle (stopped at SAME_TIME_S)
 
 
 @dataclass(frozen=True)
@@ -291,7 +291,7 @@ def time_at(profile: Profile, theta: float, lo: float, hi: float) -> float:
     if not low < theta < high:  # at an end, to the key angles' tolerance
         return lo if abs(theta - th_lo) <= abs(theta - th_hi) else hi
     a, b = lo, hi
-    for _ in range(200):
+    for _ in range(TIME_BISECTIONS):
         mid = 0.5 * (a + b)
         th = float(profile.at_time(np.array([mid]))[0][0])
         if (th < theta) == rising:
@@ -351,7 +351,7 @@ def draw_speed_bound(case: Any, keys: tuple[float, ...], jets: Any, limits: dict
     theta = np.linspace(keys[1], keys[2], DRAW_GRID)
     h, d1, d2, _ = jets(theta)
     draw = Draw(case, theta, np.asarray(h), np.asarray(d1), np.asarray(d2))
-    bounds = [case.limits.crank_speed_rpm * RPM if case.limits.crank_speed_rpm else math.inf]
+    bounds = [math.inf]
     for limit in limits_of(case):
         if limit.id in DRAW_BOUND_LIMITS:
             b = limit.draw_speed_bound(draw)

@@ -63,7 +63,7 @@ def pendulum_result(solution: PendulumSolution, case: Case) -> dict[str, Any]:
         },
         "swings": swings,
         "rotary": rotary,
-        **({"drive": drive.as_dict()} if drive is not None else {}),
+        **({"drive": {**drive.as_dict(), "per": "cycle of two strokes"}} if drive is not None else {}),
         "verification": {
             "passed": verification.passed,
             "samples": verification.samples,
@@ -109,7 +109,7 @@ def pendulum_summary(r: dict[str, Any]) -> str:
             f"  motor: peak torque {d['peak_motor_torque_Nm']:.0f} N m ({d['peak_torque_use_pct']:.1f} % of its "
             f"envelope), RMS {d['rms_motor_torque_Nm']:.0f} N m ({d['rms_torque_use_pct']:.1f} % of rated), peak power "
             f"{d['peak_motor_power_kW']:.1f} kW; per stroke {d['energy_drawn_kJ'] / 2:.2f} kJ drawn, "
-            f"{-d['energy_returned_kJ'] / 2:.2f} kJ returned (both swings regenerate)"
+            f"{-d['energy_returned_kJ'] / 2:.2f} kJ returned"
         )
     v = r["verification"]
     lines.append(f"  binding: {', '.join(v['binding']) or 'none'}")

@@ -1,22 +1,26 @@
 """Solve a pendulum stroke: the NLP from several starts, the dense verification, the sampled limits refined.
 
-Each start of :func:`~planning.solver.pendulum_nlp.starts` is solved; every converged plan is verified
-densely (``planning.solver.pendulum_check``); the answer is the verified plan with the most strokes. When none
-verifies and the failures are of limits the NLP holds at samples only (the slide's acceleration and speed, the
-die zone), those limits are lowered by their overshoot and the NLP built again, at most
-:data:`REFINE_ROUNDS` times, each round also starting from the last round's best plan. For comparison the
-same case is solved as a rotary stroke (``rotary``): the gain of the swing is stated beside its plan.
+Before solving, a given draw speed above a swing's draw-speed bound, and a draw the motors cannot make on a
+swing at the least draw speed, are refused (``Infeasible``). Each start of
+:func:`~planning.solver.pendulum_nlp.starts` is solved; every converged plan is verified densely
+(``planning.solver.pendulum_check``); the answer is the verified plan with the most strokes. When none verifies
+and the failures are of limits the NLP holds at samples only (the slide's acceleration and speed, the die
+zone, the motor's torques), those limits are lowered by their overshoot and the NLP (built once, the limits
+its parameters) solved again, at most :data:`REFINE_ROUNDS` times, each round also starting from the last
+round's best plan. For comparison the same case is solved as a rotary stroke: the gain of the swing is stated
+beside its plan.
 """
 
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from planning.model.case import Case
+from planning.model.limits.capacity import torque_capacity_kNm
 from planning.model.pendulum import TWO_PI, PendulumPlan, swing_setups
 from planning.model.units import RPM, rounded_down
 from planning.solver.outcomes import Infeasible, NoPlanFound, PlanningError, Unverified
@@ -35,7 +39,7 @@ from planning.solver.verify import Evaluation
 from planning.tolerances import SAME_RELATIVE
 from press.dynamics import envelope_torque
 
-REFINE_ROUNDS = 4  # the NLP built again with the sampled limits lowered, at most this often
+REFINE_ROUNDS = 4  # the NLP solved again with the sampled limits lowered, at most this often
 
 
 @dataclass(frozen=True)
@@ -83,6 +87,8 @@ def solve_pendulum(case: Case, compare: bool = True) -> PendulumSolution:
         if best is not None:
             return _with_rotary(case, best, t0, iterations, tried, compare)
         if best_failed is None:
+            if failure:  # an earlier round's plan failed its check; this round's found none
+                break
             raise NoPlanFound(f"no start of the pendulum NLP converged ({tried} tried)")
         failure = best_failed[1].verification.failures()
         limits = refined(limits, failure)
@@ -94,50 +100,52 @@ def solve_pendulum(case: Case, compare: bool = True) -> PendulumSolution:
 
 
 def _precheck_draw_speed(case: Case) -> None:
-    """A draw speed the case gives that one swing's draw cannot take (on an asymmetric press the backward
-    swing's draw meets its heights on the other side of BDC): refused before solving."""
+    """A draw speed the case gives that one swing's draw cannot take, or a swing whose draw allows less than the
+    least crank speed (on an asymmetric press the backward swing's draw meets its heights on the other side of
+    BDC): refused before solving."""
     given = case.process.draw_speed_rpm
-    if given is None:
-        return
+    least = case.limits.min_crank_speed_rpm
     for setup in swing_setups(case, {}):
-        if given * RPM > setup.draw_speed_bound * (1 + SAME_RELATIVE):
-            raise Infeasible(
-                f"process.draw_speed_rpm = {given:g} is above the {rounded_down(setup.draw_speed_bound / RPM)} rpm "
-                f"the limits allow in the {setup.name} swing's draw (pressplan check prints each swing's)",
-                "process.draw_speed_rpm",
-                given,
-                setup.draw_speed_bound / RPM,
-            )
+        bound = setup.draw_speed_bound / RPM
+        allows = f"the {rounded_down(bound)} rpm the limits allow in the {setup.name} swing's draw"
+        if given is not None and given > bound * (1 + SAME_RELATIVE):
+            reason = f"process.draw_speed_rpm = {given:g} is above {allows} (pressplan check prints each swing's)"
+            raise Infeasible(reason, "process.draw_speed_rpm", given, bound)
+        if least > bound * (1 + SAME_RELATIVE):
+            reason = f"limits.min_crank_speed_rpm = {least:g} is above {allows}"
+            raise Infeasible(reason, "limits.min_crank_speed_rpm", least, bound)
 
 
 def _precheck_draw_torque(case: Case) -> None:
-    """A draw the motors cannot make on one swing even at the least draw speed (the forming force's torque on
-    the crank does not fall with the speed; on a link drive the backward swing draws where the slide moves
-    fast for the crank, its lever longer): refused before solving."""
+    """A draw the motors, or the crank, cannot make on one swing even at the least draw speed (the forming
+    force's torque on the crank does not fall with the speed; on a link drive the backward swing draws where the
+    slide moves fast for the crank, its lever longer): refused before solving."""
     motor = case.drive.motor
     lowest = max(case.limits.min_crank_speed_rpm, case.process.draw_speed_rpm or 0.0) * RPM
+    capacity = torque_capacity_kNm(case)
     for setup in swing_setups(case, {}):
-        u, torque, speed = draw_torque(case, setup, lowest)
+        u, torque, speed, crank = draw_torque(case, setup, lowest)
         envelope = envelope_torque(speed, motor.peak_torque_Nm, motor.base_speed_rpm * RPM)
-        use = np.abs(torque) / envelope
-        k = int(np.argmax(use))
-        if use[k] > 1.0:
-            angle = math.degrees(u[k] if setup.name == "forward" else TWO_PI - u[k])
-            raise Infeasible(
-                f"drive.motor.peak_torque_Nm = {motor.peak_torque_Nm:g} cannot make the {setup.name} swing's draw: "
-                f"at {angle:.1f} deg and {lowest / RPM:.3g} rpm the motors must give {abs(torque[k]):.0f} N m",
-                "drive.motor.peak_torque_Nm",
-                motor.peak_torque_Nm,
-                float(abs(torque[k])),
-                angle,
+        uses = [("drive.motor.peak_torque_Nm", np.abs(torque) / envelope, torque, motor.peak_torque_Nm, "N m")]
+        if capacity is not None:
+            uses.append(
+                ("press.capacity.crank_torque_kNm", np.abs(crank) / (1e3 * capacity), crank / 1e3, capacity, "kN m")
             )
+        for field, use, needed, value, unit in uses:
+            k = int(np.argmax(use))
+            if use[k] > 1.0:
+                angle = math.degrees(u[k] if setup.name == "forward" else TWO_PI - u[k])
+                reason = (
+                    f"{field} = {value:g} cannot make the {setup.name} swing's draw: at {angle:.1f} deg and "
+                    f"{lowest / RPM:.3g} rpm it must give {abs(needed[k]):.0f} {unit}"
+                )
+                raise Infeasible(reason, field, value, float(abs(needed[k])), angle)
 
 
 def _with_rotary(case: Case, best: tuple, t0: float, iterations: int, tried: int, compare: bool) -> PendulumSolution:
     plan, evaluation = best
-    info = elapsed_info(t0, iterations, tried, plan.solver.status)
-    plan = PendulumPlan(plan.parameters, plan.profile, plan.forward_keys, plan.backward_keys, info, plan.nlp_values)
-    evaluation = evaluate_pendulum(plan, case)
+    plan = replace(plan, solver=elapsed_info(t0, iterations, tried, plan.solver.status))  # the whole solve's
+    evaluation = replace(evaluation, samples=replace(evaluation.samples, plan=plan))
     if not compare:
         return PendulumSolution(plan, evaluation)
     from planning.solver.optimize import solve

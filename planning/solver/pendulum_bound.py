@@ -71,16 +71,22 @@ def _nodes(case: Case, setup: SwingSetup) -> np.ndarray:
     return np.concatenate([*parts, [u4]])
 
 
-def _caps(case: Case, setup: SwingSetup, u: np.ndarray, h: np.ndarray, d1: np.ndarray) -> np.ndarray:
+def _caps(
+    case: Case, setup: SwingSetup, u: np.ndarray, h: np.ndarray, d1: np.ndarray, everywhere: bool = False
+) -> np.ndarray:
     """The largest crank speed squared each speed cap allows at the nodes [rad^2/s^2]: a cap on the crank's own
     speed (the crank's top speed, the motor's through the gear: ``k`` a constant) everywhere, a cap on the
-    slide's speed (``k = h'``) where it applies."""
+    slide's speed (``k = h'``) where it applies (``everywhere``: only the caps that apply at every angle, and the
+    draw's, for an interval that leaves a cap's domain: a node on the die height's crossing bounds no interval
+    above it)."""
     caps = np.full(u.size, math.inf)
     for limit in limits_of(case):
         if not isinstance(limit, SpeedCap) or limit.lower:
             continue
         factor = limit.crank_factor(case)
         inside = limit.where(case, h, bound=True)
+        if inside is not None and everywhere:
+            continue
         inside = np.ones(u.size, dtype=bool) if inside is None else inside
         k = np.full(u.size, float(factor)) if factor is not None else np.abs(d1)
         moving = inside & (k > 0)
@@ -102,7 +108,16 @@ def _least_arc_time(case: Case, setup: SwingSetup) -> float:
     caps = _caps(case, setup, u, h, d1)
     s = _envelope(case, caps, np.diff(u), h, d1)
     reach = 2 * (case.limits.crank_accel_rad_s2 or math.inf) * np.diff(u)
-    inside = np.minimum(np.maximum(caps[:-1], caps[1:]), np.minimum(s[:-1], s[1:]) + reach)
+    # within an interval: at most the largest of the caps at its ends that hold all along it (a cap with a
+    # domain only where both ends lie in it: h is monotone on the interval), and either end's envelope plus reach
+    free = _caps(case, setup, u, h, d1, everywhere=True)
+    domained = [limit for limit in limits_of(case) if isinstance(limit, SpeedCap) and limit.where(case, h) is not None]
+    both = np.ones(u.size - 1, dtype=bool)
+    for limit in domained:
+        within = limit.where(case, h)
+        both &= within[:-1] & within[1:]
+    ends = np.where(both, np.maximum(caps[:-1], caps[1:]), np.maximum(free[:-1], free[1:]))
+    inside = np.minimum(ends, np.minimum(s[:-1], s[1:]) + reach)
     return float(np.sum(np.diff(u) / np.sqrt(np.maximum(inside, TINY))))
 
 

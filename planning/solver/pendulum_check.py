@@ -43,14 +43,18 @@ OWN_CHECKS = ("transfer_time", "safety_height", "min_crank_speed", "die_speed", 
 def evaluate_pendulum(plan: PendulumPlan, case: Case, cam: bool = False) -> Evaluation:
     """The dense re-simulation of ``plan`` against ``case`` and every check (module docstring). ``cam``: the
     profile is a cam as its controller runs it (``planning.solver.cam_proof``): the law's own checks (continuous
-    at its knots, one way per swing to the last 1e-9 rpm, at rest at the turns, each draw at one speed) are not
-    the cam's; the cycle closes, never passes TDC, and every limit of the press and the process holds."""
+    at its knots, one way per swing and at rest at the turns to ``SPEED_TOL_RAD_S`` and ``HOLD_STILL_RAD_S``,
+    each draw at one speed) are not the cam's; the cycle closes, never passes TDC, and every limit of the press
+    and the process holds."""
     prof = plan.profile
     t, uniform = sample_times(plan.period, prof.knot_times)
     th, om, al, je = prof.at_time(t)
     h, d1, d2, d3 = case.machine.jets(th)
     _, v, a, slide_jerk = slider_motion(h, d1, d2, d3, om, al, je)
-    keys = plan.key_times("forward")
+    try:
+        keys = plan.key_times("forward")
+    except ValueError:  # a swing that turns before a key angle: _swing_checks fails it
+        keys = np.full(4, np.nan)
     dense = Dense(case, plan, t, th, om, al, je, h, v, a, keys, slide_jerk=slide_jerk, slope=d1, curvature=d2)
     checks = _cycle_checks(dense, cam) + _swing_checks(dense, cam)
     figures = None

@@ -34,6 +34,8 @@ from planning.model.profile import advance_segment
 from planning.solver.parameters import DRAW_SAMPLES_DRIVE
 from press.dynamics import crank_torque, link_terms, motor_torque
 
+DRAW_TORQUE_POINTS = 2001  # angles of a swing's draw on which the precheck takes the drive's torques
+
 
 @dataclass
 class DriveSamples:
@@ -73,7 +75,10 @@ def swing_drive(case: Case, swing: Any) -> DriveSamples:
     forming = forming_on_path(case, swing.setup.name, u, h)  # the draw's and, past theta3 before BDC, the return's
     tc = crank_torque(om, al, d1, d2, forming, model, _links(case, swing.setup.name, u))
     tm = motor_torque(tc, al, model)
-    return DriveSamples(tc, tm, model.i * om, times, tm[tm.shape[0] - 1])
+    # at rest at the swing's end the crank's torque is -T_u on the backward swing, through the gear as the
+    # verification takes a standing crank's (``press.dynamics.motor_torque``: standing counts as forward)
+    resting = tc[tc.shape[0] - 1] * (1.0 if swing.setup.name == "forward" else -1.0)
+    return DriveSamples(tc, tm, model.i * om, times, motor_torque(resting, 0.0, model))
 
 
 def _half_samples(starts: list, states: list, segs: list, fractions: ca.DM, offset: Any) -> list[tuple]:
@@ -120,16 +125,13 @@ def drive_rows(
     add(heat / period / limits["motor_rms_torque"] ** 2, -math.inf, 1.0)
 
 
-DRAW_TORQUE_POINTS = 2001  # angles of a swing's draw on which the precheck takes the motor's torque
-
-
-def draw_torque(case: Case, setup: Any, speed: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The motor's torque through a swing's draw at the constant crank ``speed`` [rad/s] (numbers): ``(u [rad],
-    motor torque on u [N m], motor speed [rad/s])`` (``setup``: the swing's ``SwingSetup``)."""
+def draw_torque(case: Case, setup: Any, speed: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The drive through a swing's draw at the constant crank ``speed`` [rad/s] (numbers): ``(u [rad], motor
+    torque on u [N m], motor speed [rad/s], crank torque on u [N m])`` (``setup``: the swing's ``SwingSetup``)."""
     model = case.drive_model
     u = np.linspace(setup.keys[1], setup.keys[2], DRAW_TORQUE_POINTS)
     h, d1, d2, _ = (np.asarray(x) for x in setup.jets(u))
     forming = forming_on_path(case, setup.name, u, h)
     omega = np.full(u.size, speed)
     tc = crank_torque(omega, 0.0 * u, d1, d2, forming, model, _links(case, setup.name, u))
-    return u, motor_torque(tc, 0.0 * u, model), model.i * omega
+    return u, motor_torque(tc, 0.0 * u, model), model.i * omega, tc

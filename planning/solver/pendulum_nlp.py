@@ -1,23 +1,25 @@
-"""The NLP of a pendulum stroke (``planning.model.pendulum``) under a law with halves, built per case.
+"""The NLP of a pendulum stroke (``planning.model.pendulum``) under a law with halves, built once a case.
 
 Both swings in one NLP, each on its own path coordinate u (the forward swing's u is the crank angle, the
 backward swing's ``2 pi - theta``, its mechanism ``h_b(u) = h(2 pi - u)``), each a forward motion with
 speeds >= 0. Variables (scaled to O(1) like the halves NLP's, ``planning.solver.halves_nlp.variable_scales``):
 per swing w2, wm1, wm2, the four halves' durations, the times ``t1`` (from the swing's start to theta1) and
-``t4`` (from theta3 to theta4), ``tx`` (from theta3 to where the slide leaves the die zone, when the draw ends
-inside it); the swing's ends theta_s and theta_e (bounded by :func:`~planning.model.pendulum.swing_bounds`),
-the standstills there, the law's shape parameter.
+``t4`` (from theta3 to theta4), the times from theta3 to the return's die-zone angles
+(``planning.model.pendulum.die_zone``); the swing's ends theta_s and theta_e (bounded by
+:func:`~planning.model.pendulum.swing_bounds`), the standstills there, the law's shape parameter. Parameters:
+the sampled limits' values (:func:`sampled_limit_values`; the search lowers one the dense check finds exceeded
+between samples and solves again, :meth:`PendulumNLP.at`).
 
 Rows per swing: the feed reaches theta2 and the return the swing's end (the halves' closed forms from rest and
-from theta3), the peaks at or above the speeds they join (each half monotone), one jerk per S-curve where the
-law says so (Eq. 14), t1 and t4 (and tx) at their angles, the peak acceleration and jerk of each half (closed
-form), the slide's acceleration and speed at ``law.samples`` points of every segment of the halves (held
-``ACCEL_BACKOFF`` inside; the search lowers a limit the dense check finds exceeded between samples), the die
-zone at the return's samples and its exit. In the draw the crank turns at the constant w2, so each limit
-there is a bound on w2 (:func:`draw_speed_bound`), a variable bound. Across the swings: the robot's two
-windows (theta4 through the turn at theta_e to the backward swing's theta1, and the backward swing's theta4
-through theta_s to theta1) each at least the transfer time. The objective: the cycle time (both swings and
-both standstills).
+from theta3; the speeds there hold by construction), the peaks at or above the speeds they join (each half
+monotone), one jerk per S-curve where the law says so (Eq. 14), t1 and t4 at their angles, the peak
+acceleration and jerk of each half (closed form), the slide's acceleration and speed at ``law.samples`` points
+of every segment of the halves (the acceleration held ``ACCEL_BACKOFF`` inside), the slide's speed at the
+return's die-zone angles. In the draw the crank turns at the constant w2, so each limit there is a bound on w2
+(``planning.model.pendulum.draw_speed_bound``), a variable bound. With a drive, the motor's and the crank's
+torque rows (``planning.solver.pendulum_drive``). Across the swings: the robot's two windows (theta4 through the
+turn at theta_e to the backward swing's theta1, and the backward swing's theta4 through theta_s to theta1) each
+at least the transfer time. The objective: the cycle time (both swings and both standstills).
 """
 
 from __future__ import annotations
@@ -36,6 +38,7 @@ from planning.model.limits import limits_of
 from planning.model.limits.capacity import torque_capacity_kNm
 from planning.model.pendulum import (
     DIE_ZONE_POINTS,
+    SWING_HALVES,
     SWINGS,
     TWO_PI,
     PendulumParameters,
@@ -52,7 +55,7 @@ from planning.model.profile import Profile, advance_segment, knot_states
 from planning.solver.halves_nlp import MIN_HALF_S, TOP_SPEED, VARIABLE_INDEX, angle_at, variable_scales
 from planning.solver.ipopt import NLPSolver
 from planning.solver.pendulum_drive import drive_rows, swing_drive
-from planning.tolerances import ACCEL_BACKOFF, DRIVE_BACKOFF, IPOPT_CONSTR_VIOL_TOL
+from planning.tolerances import ACCEL_BACKOFF, DRIVE_BACKOFF, IPOPT_CONSTR_VIOL_TOL, REFINE_MARGIN
 
 SWING_VARIABLES = (  # per swing, prefixed ``forward_`` / ``backward_``: (name, scale kind of the halves NLP)
     ("draw_speed", "draw_speed"),
@@ -145,7 +148,7 @@ def _swing_rows(rows: _Rows, s: _Swing, case: Case, limits: dict[str, float], un
     w2, wm1, wm2 = p.draw_speed, p.feed_peak_speed, p.return_peak_speed
     rows.add(ca.vertcat(wm1 - w2, wm2 - w2) / w_unit, 0.0, math.inf)
     if law.one_jerk_per_curve:  # Eq. 14: one jerk for both halves of each S-curve
-        d_fa, d_fd, d_ra, d_rd = (p.half(n)[0] for n in ("feed_accel", "feed_decel", "return_accel", "return_decel"))
+        d_fa, d_fd, d_ra, d_rd = (p.half(n)[0] for n in SWING_HALVES)
         one = ca.vertcat(wm1 * d_fd**2 - (wm1 - w2) * d_fa**2, (wm2 - w2) * d_rd**2 - wm2 * d_ra**2)
         rows.add(one / (t_unit**2 * w_unit), 0.0, 0.0)
     th1, _ = angle_at(v["closing_time"], *s.feed)
@@ -268,7 +271,7 @@ def _bounds(case: Case, names: tuple[str, ...], setups: tuple[SwingSetup, ...]) 
         elif name.endswith("draw_speed"):
             bound = next(s.draw_speed_bound for s in setups if name.startswith(s.name))
             lo[i] = case.limits.min_crank_speed_rpm * RPM
-            hi[i] = min(bound, top)
+            hi[i] = max(min(bound, top), lo[i])  # a refined limit below the least speed: the check says so
             if given is not None:
                 lo[i] = hi[i] = given * RPM
         elif name.endswith("_duration"):
@@ -413,7 +416,7 @@ def refined(limits: dict[str, float], failures: list) -> dict[str, float] | None
     for check in failures:
         if check.id not in SAMPLED_LIMITS:
             return None
-        out[check.id] = limits[check.id] * min(check.limit / check.value, 1 - ACCEL_BACKOFF)
+        out[check.id] = limits[check.id] * min(check.limit / check.value, 1.0) * (1 - REFINE_MARGIN)
     return out
 
 

@@ -62,7 +62,12 @@ from planning.web.cams import (
 )
 
 STATIC = Path(__file__).resolve().parent / "static"
-PENDULUM_BOUND_LEAVES_OUT = ("limits.crank_jerk_rad_s3", "the turns")  # what the pendulum's bound leaves out
+PENDULUM_BOUND_LEAVES_OUT = (  # what the pendulum's bound leaves out (``planning.solver.pendulum_bound``)
+    "limits.crank_jerk_rad_s3",
+    "limits.min_crank_speed_rpm",
+    "the motor's and the crank's torques",
+    "the turns",
+)
 MAX_REQUEST_BYTES = 2 * MAX_BYTES  # a case as JSON, with the page's own fields
 MAX_SESSIONS = 64
 CHART_POINTS = 600  # samples of a plan's curves sent to the page (the files keep the full 1 ms step)
