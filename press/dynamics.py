@@ -153,12 +153,23 @@ def forming_force(theta: Any, height_mm: Any, drive: DriveModel) -> Any:
         return 0 * theta
     turn = theta - 2 * np.pi * m.floor(theta / (2 * np.pi))  # in [0, 2 pi)
     active = (turn >= drive.draw_start) * (turn <= drive.bdc)
+    return table_force(height_mm, active, drive)
+
+
+def table_force(height_mm: Any, active: Any, drive: DriveModel) -> Any:
+    """The forming-force table's force [N] at slide heights ``height_mm`` [mm] (linear between rows, zero outside
+    them) where ``active`` (booleans or 0/1 symbols: where the forming window is), else 0; numbers or symbols
+    (each entry of a symbol vector looked up alone: CasADi's ``pw_lin`` takes a scalar)."""
+    m = math_module(height_mm)
     hs, fs = drive.force_heights, drive.force_values
+    if not hs:
+        return 0 * height_mm
     if m is np:
-        value = np.interp(height_mm, hs, fs, left=0.0, right=0.0)
-        inside = (np.asarray(height_mm) >= hs[0]) & (np.asarray(height_mm) <= hs[-1])
-        return np.where(active & inside, value, 0.0)
-    value = m.pw_lin(height_mm, m.DM(hs), m.DM(fs))
+        h = np.asarray(height_mm, dtype=float)
+        value = np.interp(h, hs, fs, left=0.0, right=0.0)
+        return np.where(np.asarray(active, dtype=bool) & (h >= hs[0]) & (h <= hs[-1]), value, 0.0)
+    table_h, table_f = m.DM(hs), m.DM(fs)
+    value = m.vertcat(*[m.pw_lin(height_mm[k], table_h, table_f) for k in range(height_mm.shape[0])])
     inside = (height_mm >= hs[0]) * (height_mm <= hs[-1])
     return m.if_else(active * inside, value, 0)
 

@@ -36,7 +36,7 @@ from planning.model.limits import limits_of
 from planning.model.limits.base import DRAW_GRID, Draw
 from planning.model.profile import Profile, Segment
 from planning.tolerances import ANGLE_ROUND_OFF_RAD, ANGLE_TOL_RAD, SAME_TIME_S, TINY
-from press.backend import math_module
+from press.dynamics import table_force
 
 TWO_PI = 2 * math.pi
 SWINGS = ("forward", "backward")
@@ -378,40 +378,21 @@ def draw_speed_bound(case: Any, keys: tuple[float, ...], jets: Any, limits: dict
 
 def swing_forming_N(case: Any, theta: np.ndarray, omega: np.ndarray, h: np.ndarray) -> np.ndarray:
     """The forming force [N, upward on the slide] on a pendulum stroke at crank angles ``theta`` [rad], speeds
-    ``omega`` [rad/s] and slide heights ``h`` [mm]: the case's table (height above BDC -> force, linear between
-    rows, zero outside) from theta2 to BDC turning forward, and on the backward swing over the same arc of the
-    slide's way down, from its theta2 back to BDC; zero elsewhere (``press.dynamics``: a rotary stroke's window,
-    on either swing)."""
-    table = sorted(case.process.forming_force_kN or [])
-    theta, omega, h = (np.asarray(x, dtype=float) for x in (theta, omega, h))
-    if not table:
-        return np.zeros(np.shape(theta))
-    hs = np.array([row[0] for row in table])
-    fs = np.array([row[1] for row in table]) * 1e3
+    ``omega`` [rad/s] and slide heights ``h`` [mm]: the case's table (``press.dynamics.table_force``) from theta2
+    to BDC turning forward, and on the backward swing over the same arc of the slide's way down, from its theta2
+    back to BDC; zero elsewhere (``press.dynamics``: a rotary stroke's window, on either swing). Needs a drive."""
+    theta, omega = np.asarray(theta, dtype=float), np.asarray(omega, dtype=float)
     bdc = float(case.machine.bdc_angle)
     th2, back2 = float(case.key_angles[1]), backward_key_angles(case)[1]
     forward = (omega > 0) & (theta >= th2) & (theta <= bdc)
     backward = (omega < 0) & (theta >= bdc) & (theta <= back2)
-    inside = (h >= hs[0]) & (h <= hs[-1]) & (forward | backward)
-    return np.where(inside, np.interp(h, hs, fs, left=0.0, right=0.0), 0.0)
+    return table_force(h, forward | backward, case.drive_model)
 
 
 def forming_on_path(case: Any, swing: str, u: Any, h: Any) -> Any:
     """The forming force [N] at path angles ``u`` [rad] of ``swing`` (numbers or symbols; the swing turning its
     way): the table's where u lies between theta2 and BDC on that swing's path (:func:`swing_forming_N`)."""
-    table = sorted(case.process.forming_force_kN or [])
-    if not table:
-        return 0 * u
-    m = math_module(u, h)
     bdc = float(case.machine.bdc_angle)
     u2 = float(case.key_angles[1]) if swing == "forward" else TWO_PI - backward_key_angles(case)[1]
     u_bdc = bdc if swing == "forward" else TWO_PI - bdc
-    hs = [row[0] for row in table]
-    fs = [row[1] * 1e3 for row in table]
-    if m is np:
-        value = np.interp(h, hs, fs, left=0.0, right=0.0)
-        return np.where((u >= u2) & (u <= u_bdc) & (h >= hs[0]) & (h <= hs[-1]), value, 0.0)
-    active = (u >= u2) * (u <= u_bdc) * (h >= hs[0]) * (h <= hs[-1])
-    table_h, table_f = m.DM(hs), m.DM(fs)
-    value = m.vertcat(*[m.pw_lin(h[k], table_h, table_f) for k in range(h.shape[0])])  # pw_lin takes a scalar
-    return m.if_else(active, value, 0)
+    return table_force(h, (u >= u2) * (u <= u_bdc), case.drive_model)
