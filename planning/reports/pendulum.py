@@ -166,11 +166,8 @@ def pendulum_laws(case: Case) -> dict[str, Any]:
             reason = exc.message if isinstance(exc, CaseError) else exc.reason
             rows.append({"law": law, "status": "no plan", "message": reason})
             continue
-        jerk = (
-            next(c.value for c in solution.evaluation.verification.checks if c.id == "crank_jerk")
-            if any(c.id == "crank_jerk" for c in solution.evaluation.verification.checks)
-            else None
-        )
+        check = solution.evaluation.verification.check("crank_jerk")
+        jerk = check.value if check is not None else None
         rows.append(
             {
                 "law": law,

@@ -28,12 +28,12 @@ import numpy as np
 
 from planning.model.case import RPM, Case
 from planning.model.laws import get_law
-from planning.model.limits.capacity import torque_capacity_kNm
 from planning.model.pendulum import TWO_PI, forming_on_path
 from planning.model.profile import advance_segment
 from planning.solver.parameters import DRAW_SAMPLES_DRIVE
 from press.dynamics import crank_torque, link_terms, motor_torque
 
+PEAK, RMS = "drive.motor.peak_torque_Nm", "drive.motor.rated_torque_Nm"  # the case fields of the motor's rows
 DRAW_TORQUE_POINTS = 2001  # angles of a swing's draw on which the precheck takes the drive's torques
 
 
@@ -109,20 +109,25 @@ def trapezoid_heat(samples: DriveSamples) -> Any:
 def drive_rows(
     case: Case, add: Any, drives: dict[str, DriveSamples], turns: tuple[Any, Any], period: Any, limits: dict[str, float]
 ) -> None:
-    """The drive's rows (``add(expr, lo, hi)``): the motor's peak torque within its envelope at every sample,
-    its RMS over the cycle (``turns``: the standstills at theta_e and theta_s, after the forward and the backward
-    swing), the crank's torque capacity."""
+    """The drive's rows (``add``: ``planning.solver.nlp.Rows.add``): the motor's peak torque within its envelope at
+    every sample, its RMS over the cycle (``turns``: the standstills at theta_e and theta_s, after the forward and
+    the backward swing), the crank's torque capacity (where the case gives one: ``limits`` holds it)."""
     motor = case.drive.motor
     base = motor.base_speed_rpm * RPM
     for samples in drives.values():
         above_base = ca.fmax(1.0, samples.speed / base)
-        add(samples.tm * above_base / limits["motor_peak_torque"], -1.0, 1.0)
-        cap = torque_capacity_kNm(case)
-        if cap is not None:
-            add(samples.tc / (1e3 * limits.get("crank_torque", cap)), -1.0, 1.0)
+        add("motor peak torque", samples.tm * above_base / limits["motor_peak_torque"], -1.0, 1.0, PEAK)
+        if "crank_torque" in limits:
+            add(
+                "crank torque",
+                samples.tc / (1e3 * limits["crank_torque"]),
+                -1.0,
+                1.0,
+                "press.capacity.crank_torque_kNm",
+            )
     f, b = drives["forward"], drives["backward"]
     heat = trapezoid_heat(f) + trapezoid_heat(b) + f.holding**2 * turns[0] + b.holding**2 * turns[1]
-    add(heat / period / limits["motor_rms_torque"] ** 2, -math.inf, 1.0)
+    add("motor RMS torque", heat / period / limits["motor_rms_torque"] ** 2, -math.inf, 1.0, RMS)
 
 
 def draw_torque(case: Case, setup: Any, speed: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

@@ -54,6 +54,7 @@ from planning.model.plan import SolverInfo
 from planning.model.profile import Profile, advance_segment, knot_states
 from planning.solver.halves_nlp import MIN_HALF_S, TOP_SPEED, VARIABLE_INDEX, angle_at, variable_scales
 from planning.solver.ipopt import NLPSolver
+from planning.solver.nlp import Rows
 from planning.solver.pendulum_drive import drive_rows, swing_drive
 from planning.tolerances import ACCEL_BACKOFF, DRIVE_BACKOFF, IPOPT_CONSTR_VIOL_TOL, REFINE_MARGIN
 
@@ -78,6 +79,7 @@ SHARED_VARIABLES = (
 )
 # held at samples (or, the RMS, by the trapezoidal rule): refined on a dense failure
 SAMPLED_LIMITS = ("slider_accel", "slider_speed", "die_speed", "motor_peak_torque", "motor_rms_torque", "crank_torque")
+ACCEL, JERK, SLIDE_ACCEL = "limits.crank_accel_rad_s2", "limits.crank_jerk_rad_s3", "limits.slider_accel_mm_s2"
 OPTIONS = {"ipopt.constr_viol_tol": IPOPT_CONSTR_VIOL_TOL, "ipopt.max_iter": 600}
 
 
@@ -124,46 +126,44 @@ def _swing(setup: SwingSetup, v: dict[str, Any], ends: tuple[Any, Any], law_name
     return _Swing(setup, p, v, feed, ret, feed_end, return_end)
 
 
-class _Rows:
-    def __init__(self) -> None:
-        self.g: list = []
-        self.lb: list[float] = []
-        self.ub: list[float] = []
-
-    def add(self, expr: Any, lo: float, hi: float) -> None:
-        expr = ca.vec(expr)
-        self.g.append(expr)
-        self.lb += [lo] * expr.shape[0]
-        self.ub += [hi] * expr.shape[0]
-
-
-def _swing_rows(rows: _Rows, s: _Swing, case: Case, limits: dict[str, float], units: dict[str, float]) -> None:
+def _swing_rows(rows: Rows, s: _Swing, case: Case, limits: dict[str, float], units: dict[str, float]) -> None:
     """One swing's rows (module docstring)."""
     p, v, keys = s.params, s.v, s.setup.keys
     law = get_law(p.motion_law)
     w_unit, t_unit = units["speed"], units["half"]
     end_feed, end_return = s.feed_end, s.return_end
-    rows.add(ca.vertcat(end_feed[0] - keys[1], end_return[0] - p.end), 0.0, 0.0)  # theta2 and the end reached
+    rows.add(
+        "theta2 and the swing's end reached",
+        ca.vertcat(end_feed[0] - keys[1], end_return[0] - p.end),
+        0.0,
+        0.0,
+        "key_points",
+    )
     # (the speeds at theta2 and at the end are w2 and 0 by construction: the halves' changes add up)
     w2, wm1, wm2 = p.draw_speed, p.feed_peak_speed, p.return_peak_speed
-    rows.add(ca.vertcat(wm1 - w2, wm2 - w2) / w_unit, 0.0, math.inf)
+    rows.add(
+        "peak speeds above the draw speed", ca.vertcat(wm1 - w2, wm2 - w2) / w_unit, 0.0, math.inf, "planner.motion_law"
+    )
     if law.one_jerk_per_curve:  # Eq. 14: one jerk for both halves of each S-curve
         d_fa, d_fd, d_ra, d_rd = (p.half(n)[0] for n in SWING_HALVES)
         one = ca.vertcat(wm1 * d_fd**2 - (wm1 - w2) * d_fa**2, (wm2 - w2) * d_rd**2 - wm2 * d_ra**2)
-        rows.add(one / (t_unit**2 * w_unit), 0.0, 0.0)
+        rows.add("one jerk per S-curve (Eq. 14)", one / (t_unit**2 * w_unit), 0.0, 0.0, "planner.motion_law")
     th1, _ = angle_at(v["closing_time"], *s.feed)
     th4, _ = angle_at(v["opening_time"], *s.ret)
-    rows.add(ca.vertcat(th1 - keys[0], th4 - keys[3]), 0.0, 0.0)
+    rows.add("key angles", ca.vertcat(th1 - keys[0], th4 - keys[3]), 0.0, 0.0, "key_points")
     order = ca.vertcat(p.feed_time - v["closing_time"], p.return_time - v["opening_time"]) / t_unit
-    rows.add(order, 0.0, math.inf)
-    if case.limits.crank_accel_rad_s2 is not None:
-        rows.add(ca.vertcat(*p.peak_accelerations()) / case.limits.crank_accel_rad_s2, -math.inf, 1.0)
-    if case.limits.crank_jerk_rad_s3 is not None:
-        rows.add(ca.vertcat(*p.peak_jerks()) / case.limits.crank_jerk_rad_s3, -math.inf, 1.0)
+    rows.add("key points in order", order, 0.0, math.inf, "key_points")
+    lim = case.limits
+    if lim.crank_accel_rad_s2 is not None:
+        rows.add(
+            "crank acceleration", ca.vertcat(*p.peak_accelerations()) / lim.crank_accel_rad_s2, -math.inf, 1.0, ACCEL
+        )
+    if lim.crank_jerk_rad_s3 is not None:
+        rows.add("crank jerk", ca.vertcat(*p.peak_jerks()) / lim.crank_jerk_rad_s3, -math.inf, 1.0, JERK)
     _sampled_rows(rows, s, case, limits)
 
 
-def _sampled_rows(rows: _Rows, s: _Swing, case: Case, limits: dict[str, float]) -> None:
+def _sampled_rows(rows: Rows, s: _Swing, case: Case, limits: dict[str, float]) -> None:
     """The slide's acceleration (and speed) at samples of every segment of the halves; the die zone at the
     return's samples and its exit."""
     law = get_law(s.params.motion_law)
@@ -174,14 +174,14 @@ def _sampled_rows(rows: _Rows, s: _Swing, case: Case, limits: dict[str, float]) 
         for seg, st in zip(segs, states, strict=True):
             th, om, al, _ = advance_segment(seg, *st, fractions * seg.duration)
             h, d1, d2, _ = s.setup.jets(th)
-            rows.add((d2 * om**2 + d1 * al) / limits["slider_accel"], -1.0, 1.0)
+            rows.add("slider acceleration", (d2 * om**2 + d1 * al) / limits["slider_accel"], -1.0, 1.0, SLIDE_ACCEL)
             if lim.slider_speed_mm_s is not None:
-                rows.add(d1 * om / limits["slider_speed"], -1.0, 1.0)
+                rows.add("slider speed", d1 * om / limits["slider_speed"], -1.0, 1.0, "limits.slider_speed_mm_s")
     for k, u in enumerate(s.setup.die_zone):  # the return in the die zone: at its fixed angles
         th_x, om_x = angle_at(s.v[f"die_time_{k}"], *s.ret)
         slope = abs(float(s.setup.jets(u)[1]))
-        rows.add(ca.vertcat(th_x - u), 0.0, 0.0)
-        rows.add(slope * om_x / v_die, -math.inf, 1.0)
+        rows.add("die zone angles", ca.vertcat(th_x - u), 0.0, 0.0, "limits.die_height_mm")
+        rows.add("die zone speed", slope * om_x / v_die, -math.inf, 1.0, "limits.die_speed_mm_s")
 
 
 @dataclass
@@ -236,7 +236,7 @@ def build(case: Case) -> PendulumNLP:
     theta_s, theta_e = phys["swing_start"], phys["swing_end"]
     ends = {"forward": (theta_s, theta_e), "backward": (TWO_PI - theta_e, TWO_PI - theta_s)}
     law = case.planner.motion_law
-    rows = _Rows()
+    rows = Rows()
     units = {"speed": scales[0], "half": scales[3]}
     swings = {}
     for setup in setups:
@@ -247,14 +247,14 @@ def build(case: Case) -> PendulumNLP:
     transfer = case.process.transfer_time_s
     window_e = f.params.return_time - f.v["opening_time"] + phys["turn_end_s"] + b.v["closing_time"]
     window_s = b.params.return_time - b.v["opening_time"] + phys["turn_start_s"] + f.v["closing_time"]
-    rows.add(ca.vertcat(window_e, window_s) / transfer - 1.0, 0.0, math.inf)
+    rows.add("robot windows", ca.vertcat(window_e, window_s) / transfer - 1.0, 0.0, math.inf, "process.transfer_time_s")
     period = PendulumParameters(f.params, b.params, phys["turn_end_s"], phys["turn_start_s"]).period
     if case.drive is not None:  # the motor's torques at the swings' samples (``planning.solver.pendulum_drive``)
         drives = {name: swing_drive(case, swing) for name, swing in swings.items()}
         drive_rows(case, rows.add, drives, (phys["turn_end_s"], phys["turn_start_s"]), period, limits)
     problem = {"x": x, "p": p, "f": period / transfer, "g": ca.vertcat(*rows.g)}
     solver = NLPSolver("pendulum", problem, OPTIONS, scales)
-    return PendulumNLP(case, solver, np.array(rows.lb), np.array(rows.ub), names, scales, limit_names)
+    return PendulumNLP(case, solver, *rows.bounds(), names, scales, limit_names)
 
 
 def _bounds(case: Case, names: tuple[str, ...], setups: tuple[SwingSetup, ...]) -> tuple[np.ndarray, np.ndarray]:
