@@ -839,8 +839,8 @@ def test_a_draw_at_slide_speed_is_planned_and_its_speed_edited_with_the_mouse_an
 
 @browser
 def test_a_pendulum_stroke_on_the_page(page) -> None:
-    """The shallow cup's press set to pendulum strokes with the mouse: the page's strokes are the CLI's pendulum
-    plan's, the summary says the swing's gain over the rotary stroke, both robot's windows and both draws are
+    """The shallow cup's press set to pendulum strokes with the mouse and the keys: the page's strokes are the CLI's
+    pendulum plan's, the summary says the swing's gain over the rotary stroke, both robot's windows and both draws are
     shaded on the chart against time, and the bracket's bound is the pendulum's certified bound."""
     from planning.solver.pendulum import solve_pendulum
     from planning.solver.pendulum_bound import pendulum_bound
@@ -848,9 +848,7 @@ def test_a_pendulum_stroke_on_the_page(page) -> None:
     pick_case(page, "small-fast-cup.yaml")
     data = load_yaml((CASES / "small-fast-cup.yaml").read_text(encoding="utf-8"))
     before = int(page.evaluate("document.body.dataset.rendered"))
-    select = page.locator('[data-field="planner.mode"]')
-    select.click()  # the mouse opens it
-    select.select_option("pendulum")
+    _choose_with_mouse_and_keys(page, '[data-field="planner.mode"]', "pendulum")
     wait_rendered(page, before)
     data["planner"]["mode"] = "pendulum"
     case = case_from_data(data, "cases/small-fast-cup.yaml")
@@ -862,7 +860,7 @@ def test_a_pendulum_stroke_on_the_page(page) -> None:
         "in pendulum strokes" in summary
         and f"the rotary stroke under the same limits: {solution.rotary_spm:.3f}" in summary
     )
-    page.locator("#x-axis").select_option("time")
+    _choose_with_mouse_and_keys(page, "#x-axis", "time")
     rects = "document.getElementById('motion-chart').layout.shapes.filter((s) => s.type === 'rect')"
     shapes = page.evaluate(rects + ".map((s) => [s.x0, s.x1])")
     f, b = solution.plan.key_times("forward"), solution.plan.key_times("backward")
@@ -873,3 +871,18 @@ def test_a_pendulum_stroke_on_the_page(page) -> None:
     assert share == pytest.approx(round(100 * solution.plan.spm / pendulum_bound(case).spm, 1))
     assert page.locator("#downloads button").first.is_disabled()  # its files: the CLI's (not the page's yet)
     screenshot(page, "web-pendulum")
+
+
+def _choose_with_mouse_and_keys(page, selector: str, value: str) -> None:  # noqa: ANN001 - a Playwright page
+    """Choose ``value`` in the select ``selector`` as a user does: scrolled into view, a mouse click at its
+    coordinates opens its list, the arrow keys move to the option, Enter takes it."""
+    page.locator(selector).scroll_into_view_if_needed()
+    box = page.locator(selector).bounding_box()
+    page.mouse.click(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+    options = page.locator(selector).evaluate("(s) => [...s.options].map((o) => o.value)")
+    current = page.locator(selector).evaluate("(s) => s.selectedIndex")
+    steps = options.index(value) - current
+    for _ in range(abs(steps)):
+        page.keyboard.press("ArrowDown" if steps > 0 else "ArrowUp")
+    page.keyboard.press("Enter")
+    assert page.locator(selector).input_value() == value
