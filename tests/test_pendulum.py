@@ -348,6 +348,7 @@ def test_what_a_swing_cannot_draw_is_refused_before_solving(capsys):
     assert len(err) == 1 and "process.draw_speed_rpm" in err[0] and "backward" in err[0]
 
 
+@pytest.mark.slow  # in the slow tier (CI runs it): the normal run stays under 5 minutes
 @pytest.mark.parametrize("name", ["pendulum-die-zone-after-draw.yaml", "pendulum-key-angle-at-the-turn.yaml"])
 def test_outside_trials_cases_verify(name, tmp_path):
     """From an outside trial: a draw that ends above the die height before BDC (the return comes down into the die
@@ -358,6 +359,7 @@ def test_outside_trials_cases_verify(name, tmp_path):
     assert json.loads((tmp_path / "result.json").read_text())["status"] == "verified"
 
 
+@pytest.mark.slow  # in the slow tier (CI runs it): the normal run stays under 5 minutes
 def test_one_folder_for_either_stroke(tmp_path, capsys):
     """A pendulum solve into a rotary solve's folder leaves none of the rotary's files (and back), and ``pressplan
     cam`` on a pendulum's folder asks for the case file in one line."""
