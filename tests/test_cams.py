@@ -113,19 +113,24 @@ def test_the_published_xyva_cam_is_the_plan(tmp_path, capsys):
 
 
 def test_fewer_points_keep_every_limit_with_their_deviation_stated():
-    """Published case: the fewest XYVA points within 1 micrometre (within 50 segments), and a cam of at most
+    """Published case: the fewest XYVA points within 0.2 micrometre (within 50 segments), and a cam of at most
     128 XYVA points (CODESYS's cam file reader's default), each keep every limit; the deviation is stated.
-    A 128-point spline table cannot: the plan's slide acceleration binds, the spline overshoots it by 0.2 %,
+    Within 1 micrometre the same 13 points break the slide acceleration by 0.002 %: the plan reaches that
+    limit in the feed and in the return (its segments refined apart), so a micrometre of slide is too much.
+    A 128-point spline table cannot: the plan's slide acceleration binds, the spline overshoots it by 0.4 %,
     and below the plan's master speed its crank falls under limits.min_crank_speed_rpm (which binds in the
     dwell), so it holds at no master speed (the conflict of the issue's table point, measured)."""
     case, plan = shipped(PUBLISHED_CASE), solved(PUBLISHED_CASE).plan
-    few = cam_for(plan, case, CamSpec(tolerance_mm=1e-3))
-    assert few.passed and few.cam.points == 13 and 0 < few.deviation_mm <= 1e-3  # 13: docs/cams.md
+    few = cam_for(plan, case, CamSpec(tolerance_mm=2e-4))
+    assert few.passed and few.cam.points == 13 and 0 < few.deviation_mm <= 2e-4  # 13: docs/cams.md
+    coarse = cam_for(plan, case, CamSpec(tolerance_mm=1e-3))
+    assert not coarse.passed and coarse.failure().id == "slider_accel"
+    assert coarse.failure().value == pytest.approx(3500.07, abs=0.01)  # docs/cams.md
     table = cam_for(plan, case, CamSpec(points=128))
     assert table.passed and table.cam.points <= 128
     spline = cam_for(plan, case, CamSpec(Interpolation.SPLINE, 128))
     assert not spline.passed and spline.failure().id == "slider_accel"
-    assert spline.failure().value == pytest.approx(3507.0, abs=1.0) and spline.highest_speed == 0.0
+    assert spline.failure().value == pytest.approx(3513.1, abs=1.0) and spline.highest_speed == 0.0
 
 
 def test_a_linear_table_too_coarse_is_refused_naming_the_limit(tmp_path, capsys):
@@ -136,7 +141,7 @@ def test_a_linear_table_too_coarse_is_refused_naming_the_limit(tmp_path, capsys)
     assert code == 3
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "|slider acceleration|" in err and "3600 points" in err
-    assert float(err.split("|slider acceleration| = ")[1].split()[0]) == pytest.approx(4713, abs=1)  # docs/cams.md
+    assert float(err.split("|slider acceleration| = ")[1].split()[0]) == pytest.approx(4719, abs=1)  # docs/cams.md
     assert not out.exists() or not any(out.iterdir())
 
 

@@ -42,6 +42,7 @@ DRIVE_CASES = [
 BALANCE_TOL = 1e-6  # relative, the issue's
 LP_TOL = 1e-6  # relative: two LP solvers on the same samples
 INTEGRATION_TOL = 1e-3  # relative: trapezoids on the 1 ms trajectory against the quadrature
+SWITCH_SHARE = 0.1  # a step of the grid power between two 1 ms samples above this share of its peak: a switch
 ELECTRICAL = {
     "converter_efficiency": 0.96,
     "regen_efficiency": 0.3,
@@ -221,7 +222,8 @@ def test_sizing_curve_is_non_increasing():
 
 def test_outputs_carry_the_chain_and_the_trajectory_gives_them(tmp_path):
     """A solved drive case with every electrical key: ``result.json``'s ``power`` block, the trajectory's new
-    columns integrated apart (trapezoids) give the energies and peaks to 0.1 %, and the checks pass."""
+    columns integrated apart (trapezoids) give the energies and peaks to 0.1 % (the grid power's switches of the
+    storage's schedule within half a step a sample apart), and the checks pass."""
     data = electrical(load_yaml(DRIVE_CASES[1].read_text()))
     path = tmp_path / "case.yaml"
     path.write_text(json.dumps(data))
@@ -240,7 +242,12 @@ def test_outputs_carry_the_chain_and_the_trajectory_gives_them(tmp_path):
 
     assert integral(rows["copper_loss_kW"]) == pytest.approx(p["copper_loss_kJ"], rel=INTEGRATION_TOL)
     assert integral(rows["bus_power_kW"]) == pytest.approx(p["bus_energy_kJ"], rel=INTEGRATION_TOL)
-    assert integral(rows["grid_power_kW"]) == pytest.approx(p["grid_energy_kJ"], rel=INTEGRATION_TOL)
+    # the grid power is the storage's schedule, which switches (the storage full or empty): a trapezoid over a
+    # step between two samples errs by at most half the step times the sample's spacing, the rest by 0.1 %
+    grid = rows["grid_power_kW"]
+    steps = np.abs(np.diff(grid)) > SWITCH_SHARE * np.max(np.abs(grid))
+    switching = float(np.sum(np.abs(np.diff(grid))[steps] * np.diff(t)[steps] / 2))
+    assert abs(integral(grid) - p["grid_energy_kJ"]) <= INTEGRATION_TOL * p["grid_energy_kJ"] + switching
     assert float(np.max(rows["bus_power_kW"])) == pytest.approx(p["bus_peak_kW"], rel=INTEGRATION_TOL)
     assert float(np.max(rows["grid_power_kW"])) == pytest.approx(p["grid_peak_kW"], rel=INTEGRATION_TOL)
     assert float(np.ptp(rows["storage_energy_kJ"])) == pytest.approx(p["storage_swing_kJ"], rel=INTEGRATION_TOL)
@@ -285,7 +292,9 @@ def test_without_the_new_keys_the_outputs_are_todays():
 
 
 
-GOLDEN = ROOT / "tests" / "data" / "golden_drive"  # written by the commit before the grid's work (ded1870)
+# written by the commit before the grid's work (ded1870); rewritten in the same form (the summary without the
+# words said since) when the slide acceleration's sampled limit came to be refined by segment (better plans)
+GOLDEN = ROOT / "tests" / "data" / "golden_drive"
 GOLDEN_RUNS = {  # folder: the command's arguments
     "cup-max-spm": ["solve", str(DRIVE_CASES[1])],
     "cup-min-energy-30": ["solve", str(DRIVE_CASES[1]), "--objective", "min-energy", "--spm", "30"],

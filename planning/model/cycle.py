@@ -32,6 +32,7 @@ HALVES = ("feed_accel", "feed_decel", "return_accel", "return_decel")
 BRAKE = "brake"  # the hold's half: the crank brakes from the draw speed to standstill
 BRAKE_PREFIX = "hold:decel"  # its segments' names (``hold:decel1`` ...)
 HOLD_SEGMENT = "hold:standstill"  # the crank standing at the hold
+DRAW_SEGMENT = "draw:constant"  # the draw at constant crank speed
 RISING = {"feed_accel": 1.0, "feed_decel": -1.0, "return_accel": 1.0, "return_decel": -1.0, BRAKE: -1.0}
 
 
@@ -144,5 +145,5 @@ def cycle_segments(p: CycleParameters) -> list[Segment]:
     segs.append(Segment("transfer:dwell", p.transfer_dwell, 0.0, 0.0))
     for name in ("feed_accel", "feed_decel"):
         segs += law.half(name.replace("_", ":"), *p.half(name), p.law_parameter)
-    segs.append(Segment("draw:constant", p.draw_time, 0.0, 0.0))
+    segs.append(Segment(DRAW_SEGMENT, p.draw_time, 0.0, 0.0))
     return segs

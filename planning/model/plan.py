@@ -76,9 +76,24 @@ class Plan:
         knot where the second sub-segment starts), also when ``t``
         lies within :data:`KNOT_TIME_S` after it (round-off)."""
         tk = self.profile.knot_times
-        k = int(np.clip(np.searchsorted(tk, t - KNOT_TIME_S, side="left") - 1, 0, len(self.profile.segments) - 1))
+        k = self._segment_index(t)
         share = (t - tk[k]) / max(tk[k + 1] - tk[k], TINY)
         return f"{segment_in_words(self.profile.segments[k].name)}, {100 * share:.0f} % in"
+
+    def segment_name_at(self, t: float) -> str:
+        """The name (``stage:part``) of the segment time ``t`` [s] lies in, a knot counted as :meth:`segment_at`
+        counts it."""
+        return self.profile.segments[self._segment_index(t)].name
+
+    def segment_indices(self, t: Any) -> np.ndarray:
+        """The indices in ``profile.segments`` of the segments times ``t`` [s] lie in, a knot counted as
+        :meth:`segment_at` counts it."""
+        tk = self.profile.knot_times
+        k = np.searchsorted(tk, np.asarray(t, dtype=float) - KNOT_TIME_S, side="left") - 1
+        return np.clip(k, 0, len(self.profile.segments) - 1)
+
+    def _segment_index(self, t: float) -> int:
+        return int(self.segment_indices(t))
 
     def holds_as(self, case: Any) -> bool:
         """Whether the plan holds at the bottom as ``case`` asks: no hold for a case without one, else the same

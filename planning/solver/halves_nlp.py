@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cache, partial
 from typing import Any
 
@@ -48,7 +48,7 @@ import casadi as ca
 import numpy as np
 
 from planning.model.case import RPM, Case, Placement
-from planning.model.cycle import HALVES, CycleParameters, cycle_segments
+from planning.model.cycle import DRAW_SEGMENT, HALVES, CycleParameters, cycle_segments
 from planning.model.laws import get_law
 from planning.model.limits.base import Extremes, Transcription
 from planning.model.plan import Plan, SolverInfo, plan_of
@@ -68,7 +68,14 @@ from planning.solver.nlp import (
     objective_terms,
     sample_states,
 )
-from planning.solver.parameters import DRAW_SAMPLES_DRIVE, EXIT_SAMPLES, ParameterLayout, drive_links, time_limit
+from planning.solver.parameters import (
+    DRAW_SAMPLES_DRIVE,
+    EXIT_SAMPLES,
+    ParameterLayout,
+    drive_links,
+    share_name,
+    time_limit,
+)
 from press.mechanism import Formula
 
 # Decision variables and the kind of scale each is measured in (see :func:`variable_scales`)
@@ -329,13 +336,14 @@ def _exit_rows(rows: Rows, c: _Cycle, first: int) -> list[tuple[ca.SX, ca.SX]]:
     return out
 
 
-def _sampled(c: _Cycle, law, drive: bool) -> tuple[tuple[ca.SX, ca.SX, ca.SX], ca.SX, int]:  # noqa: ANN001
+def _sampled(c: _Cycle, law, drive: bool) -> tuple[tuple[ca.SX, ca.SX, ca.SX], ca.SX, int, ca.SX]:  # noqa: ANN001
     """The states at sample points of every segment, one vector per quantity, and their times; the draw's
-    samples last (``drive`` only: otherwise every limit holds in the draw by the draw speed's bounds)."""
-    th_s, om_s, al_s, t_s = [], [], [], []
+    samples last (``drive`` only: otherwise every limit holds in the draw by the draw speed's bounds); the
+    share of the slide-acceleration limit at each sample outside the draw (its segment's parameter)."""
+    th_s, om_s, al_s, t_s, shares = [], [], [], [], []
     draw_count = 0
     for seg, st, t0 in zip(c.segs, c.states[:-1], c.starts, strict=True):
-        draw = seg.name == "draw:constant"
+        draw = seg.name == DRAW_SEGMENT
         if draw and not drive:
             continue  # every limit holds in the draw by the draw speed's bounds
         count = DRAW_SAMPLES_DRIVE if draw else SAMPLES_CONSTANT if seg.name == "transfer:dwell" else law.samples
@@ -350,10 +358,11 @@ def _sampled(c: _Cycle, law, drive: bool) -> tuple[tuple[ca.SX, ca.SX, ca.SX], c
         else:
             th, om, al, _ = advance_segment(seg, *st, ca.DM(fractions) * seg.duration)
             t_s.append(t0 + ca.DM(fractions) * seg.duration)
+            shares.append(ca.repmat(c.q[share_name(seg.name)], fractions.size, 1))
         th_s.append(th)
         om_s.append(om)
         al_s.append(al)
-    return (ca.vertcat(*th_s), ca.vertcat(*om_s), ca.vertcat(*al_s)), ca.vertcat(*t_s), draw_count
+    return (ca.vertcat(*th_s), ca.vertcat(*om_s), ca.vertcat(*al_s)), ca.vertcat(*t_s), draw_count, ca.vertcat(*shares)
 
 
 def _objective(
@@ -467,13 +476,16 @@ def _build(
     robots = "robots" in limit_ids
     variables = VARIABLES + ((PEAK_VARIABLE,) if peak else ()) + (EXIT_VARIABLES if die_exit else ())
     variables += ROBOT_VARIABLES if robots else ()
+    segments = _cycle(law_name, layout, variables).segs  # their names: one share of the slide's limit each
+    layout = replace(layout, shared_segments=tuple(seg.name for seg in segments if seg.name != DRAW_SEGMENT))
     c = _cycle(law_name, layout, variables)
     rows = Rows()
     _shape_rows(rows, c, law)
     published_rows, (omd, omu) = _key_point_rows(rows, c)
     exit_speeds = _exit_rows(rows, c, len(VARIABLES) + int(peak)) if die_exit else []
-    states, times, draw_count = _sampled(c, law, drive)
+    states, times, draw_count, shares = _sampled(c, law, drive)
     samples, torque, lift = sample_states(formula, layout, c.q, c.p_case, states, times, draw_count)
+    samples["accel_shares"] = shares
     nlp = _transcription(c, samples, (omd, omu), exit_speeds, zone, rate)
     refinable = add_limit_rows(rows, nlp, layout)
     objective = _objective(rows, c, torque, states, times, (rate, peak, losses))

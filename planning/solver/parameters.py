@@ -86,6 +86,8 @@ class ParameterLayout:
     links: tuple[str, ...] = ()
     die_exit: bool = False  # the die exit's angles (:data:`EXIT`; a halves NLP's denser variant)
     hold: bool = False  # the hold at the bottom (:data:`HOLD`)
+    # the segments whose slide-acceleration samples each carry a share of the limit (:func:`share_name`)
+    shared_segments: tuple[str, ...] = ()
 
     @property
     def limits(self) -> tuple[Limit, ...]:
@@ -97,6 +99,7 @@ class ParameterLayout:
         names = [f"geometry_{g}" for g in self.formula.geometry_names] + list(STRUCTURE)
         names += EXIT if self.die_exit else ()
         names += HOLD if self.hold else ()
+        names += [share_name(segment) for segment in self.shared_segments]
         for limit in self.limits:
             names += [p for p in limit.parameters if p not in names]
         if self.drive:
@@ -140,6 +143,7 @@ class ParameterLayout:
             values |= exit_values(case)
         if self.hold:
             values |= {"hold_time": case.process.hold_time_s, "hold_angle": case.hold_angle}
+        values |= {share_name(segment): 1.0 for segment in self.shared_segments}
         for limit in self.limits:
             values |= limit.parameter_values(case)
         if self.drive:
@@ -151,6 +155,13 @@ class ParameterLayout:
         if self.drive:
             out = np.concatenate([out, forming_values(case)])
         return out
+
+
+def share_name(segment: str) -> str:
+    """The parameter of segment ``segment``'s share of the sampled slide-acceleration limit: 1 in a case's
+    vector; the search lowers it where the dense check finds the limit exceeded between that segment's
+    samples (``planning.solver.search``), so that a refinement tightens the limit where it failed only."""
+    return f"share:{segment}"
 
 
 def structure_values(case: Case) -> dict[str, float]:

@@ -22,11 +22,14 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from planning.model.case import Case, Placement
+from planning.model.limits import BY_ID
+from planning.model.limits.base import Check, Dense
 from planning.model.plan import Plan, SolverInfo
 from planning.solver.halves_nlp import halves_nlp_for
 from planning.solver.ipopt import NLPResult, NLPStatus
 from planning.solver.nlp import CycleNLP
 from planning.solver.outcomes import Attempt, NoPlanFound, Unverified
+from planning.solver.parameters import share_name
 from planning.solver.precheck import precheck
 from planning.solver.solution import Solution
 from planning.solver.verify import Verification, evaluate, field_of_check, schedule_matters, with_least_energy
@@ -144,11 +147,37 @@ class Search:
                     name, factor, ceiling = c.refine_by
                     k = self.parameter(name)
                     q[k] = min(q[k], ceiling) * factor * (1 - REFINE_MARGIN)
+                elif shares := self._shares(c, plan, evaluation.samples):  # where it failed, by segment
+                    for index, factor in shares.items():
+                        q[index] *= factor * (1 - REFINE_MARGIN)
                 elif refine.upward:  # a lower limit (the optimal law's minimum crank speed) goes up
                     q[refine.index] *= (c.limit / max(c.value, 0.5 * c.limit)) * (1 + REFINE_MARGIN)
                 else:
                     q[refine.index] *= (c.limit / c.value) * (1 - REFINE_MARGIN)
         return found
+
+    def _shares(self, check: Check, plan: Plan, dense: Dense) -> dict[int, float]:
+        """``{parameter index: factor}``: the shares of ``check``'s limit (``planning.solver.parameters.
+        share_name``) to lower, each by the factor that brings its segment's highest value in ``dense`` to the
+        limit, for every segment of ``plan`` where the limit fails and the segment after it (whose first sample
+        closes the segment's last interval); empty where the limit has no shares here."""
+        limit = BY_ID.get(check.id)
+        segments = self.nlp.layout.shared_segments
+        if not getattr(limit, "shared", False) or not segments:
+            return {}
+        values = limit.dense_values(dense)
+        where = plan.segment_indices(dense.t)
+        factors: dict[int, float] = {}
+        for k in np.unique(where[values > check.limit]):
+            name = plan.profile.segments[k].name
+            if name not in segments:
+                continue
+            factor = check.limit / float(np.max(values[where == k]))
+            i = segments.index(name)
+            for s in segments[i : i + 2]:
+                index = self.parameter(share_name(s))
+                factors[index] = min(factors.get(index, 1.0), factor)
+        return factors
 
     def _densify(self, bad: list, q: np.ndarray) -> np.ndarray | None:
         """Turn to the NLP's denser variant (``CycleNLP.denser``) when it holds every failed check at its

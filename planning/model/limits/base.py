@@ -173,6 +173,8 @@ class Transcription:
     ``height_at(times)`` the slide's height [mm] at any times [s from theta3] (periodic), ``robot_starts`` their
     start variables, ``draw_start_time`` [s from theta3] when the next draw starts. The optimal law's free draw (a
     draw at constant slide speed) is sampled like its other phases, its samples the last ``free_draw_count``.
+    ``accel_shares``: at each sample outside the draw, its segment's share of the slide-acceleration limit
+    (``planning.solver.parameters.share_name``; None: the whole limit at every sample).
     """
 
     theta: Any
@@ -203,6 +205,8 @@ class Transcription:
     robot_starts: dict[str, Any] = field(default_factory=dict)  # each robot's start [s from theta3] (variables)
     draw_start_time: Any = None  # [s from theta3] the next draw's start, theta2 (the end of the cycle outside it)
     free_draw_count: int = 0  # a free draw's samples (a draw at constant slide speed): the last of the samples
+    # each sample outside the draw: its segment's share of the slide-acceleration limit (None: the whole limit)
+    accel_shares: Any = None
 
     def in_free_draw(self, values: Any) -> Any:
         """The entries of a sample vector in a free draw (its last :attr:`free_draw_count`)."""

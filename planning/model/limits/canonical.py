@@ -73,6 +73,7 @@ class AccelLimit(Limit):
     parameter: ClassVar[str]
     row_name: ClassVar[str]  # the name of its block of NLP rows
     crank_only: ClassVar[bool] = False
+    shared: ClassVar[bool] = False  # its samples' rows read the transcription's ``accel_shares``
 
     def coefficients(self, theta: Any, d1: Any, d2: Any) -> tuple[Any, Any]:
         """``(a, b)`` at crank angles ``theta`` with the height's derivatives ``d1`` [mm/rad], ``d2`` [mm/rad^2]."""
@@ -96,13 +97,19 @@ class AccelLimit(Limit):
             lo = -1.0 if peaks.signed else -np.inf
             return [Row(self.row_name, peaks.values / nlp.param(self.parameter), lo, 1.0)]
         a, b = self.coefficients(nlp.theta, nlp.slope, nlp.curvature)
-        value = nlp.outside_draw(_form(a, b, nlp.alpha, nlp.omega**2))
-        return [Row(self.row_name, value / nlp.param(self.parameter), -1.0, 1.0, sampled=True)]
+        value = nlp.outside_draw(_form(a, b, nlp.alpha, nlp.omega**2)) / nlp.param(self.parameter)
+        if self.shared and nlp.accel_shares is not None:  # each segment's share of the limit
+            value = value / nlp.accel_shares
+        return [Row(self.row_name, value, -1.0, 1.0, sampled=True)]
+
+    def dense_values(self, dense: Dense) -> np.ndarray:
+        """``|a alpha + b omega^2|`` at every sample of ``dense``, in the limit's unit."""
+        a, b = self.coefficients(dense.theta, dense.slope, dense.curvature)
+        return np.abs(_form(a, b, dense.alpha, dense.omega**2)) * np.ones_like(dense.t)
 
     def check(self, dense: Dense) -> list[Check]:
         limit = self.cap(dense.case)
-        a, b = self.coefficients(dense.theta, dense.slope, dense.curvature)
-        value = np.abs(_form(a, b, dense.alpha, dense.omega**2)) * np.ones_like(dense.t)
+        value = self.dense_values(dense)
         check = Check.of(self.id, self.name, float(np.max(value)), limit, self.unit, "max", LIMIT_REL_TOL * limit)
         return [check.located(dense.t, dense.theta, value, limit)]
 

@@ -37,6 +37,7 @@ class SliderAccelLimit(AccelLimit):
     parameter = "accel_limit"
     row_name = "slider acceleration"
     refined = "accel_limit"
+    shared = True
     backoff = ACCEL_BACKOFF
     harder_backoff = HARDER_BACKOFF
 
