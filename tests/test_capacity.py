@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 import pytest
+import yaml
 
 from planning.cli import main
 from planning.model.case_file import read_case
@@ -57,6 +58,25 @@ def test_a_forming_force_above_the_tonnage_curve_is_refused_in_one_line(tmp_path
         assert code == 2 and len(err.splitlines()) == 1, err
         assert "process.forming_force_kN" in err and "tonnage curve" in err and "767 kN" in err
     assert not (tmp_path / "o").exists()
+
+
+def test_a_tonnage_table_is_read_and_a_forming_force_above_it_refused(tmp_path, capsys):
+    """The builder's curve as a table (``press.capacity.force_table_kN``) instead of the rating: the cup's forming
+    force (773 kN at 60 mm) under a table that allows 700 kN there is refused in one line naming the field (an
+    outside trial found a traceback: the table made the press unhashable); under one that allows 2000 kN
+    everywhere the case is checked and solves, verified."""
+    data = yaml.safe_load(CUP.read_text(encoding="utf-8"))
+    low = [[0, 2000], [50, 2000], [60, 700], [500, 700]]
+    for table, expected in ((low, 2), ([[0, 2000], [500, 2000]], 0)):
+        data["press"]["capacity"] = {"force_table_kN": table}
+        path = tmp_path / "table.yaml"
+        path.write_text(yaml.safe_dump(data), encoding="utf-8")
+        assert main(["check", str(path)]) == expected
+        err = capsys.readouterr().err.strip()
+        if expected:
+            assert len(err.splitlines()) == 1 and "process.forming_force_kN" in err and "(700 kN;" in err, err
+    assert main(["solve", str(path), "--out", str(tmp_path / "o"), "--no-plots"]) == 0
+    assert "verified" in capsys.readouterr().out
 
 
 def test_the_crank_torque_capacity_binds_on_the_knuckle_joint_and_the_verification_sees_it():

@@ -1037,18 +1037,27 @@ def _objective_checks(case: Case) -> None:
         )
 
 
-@cache
 def _machine(press: PressModel) -> Mechanism:
-    """One mechanism object per geometry (its derived figures are computed once); raises
+    """One mechanism object per geometry (its derived figures are computed once; keyed on the geometry alone, so
+    that the press's other sections, a tonnage table among them, need not be hashable); raises
     ``press.linkage.LinkageError`` for a linkage that cannot be a press (:func:`_press_checks` names the
     field)."""
     if press.mechanism == "crank-slider":
-        return CrankSlider(press.crank_radius_mm, press.rod_length_mm, press.offset_mm)
-    section, kind = LINKAGES[press.mechanism]
-    values = getattr(press, section).model_dump()
+        return _mechanism(press.mechanism, (press.crank_radius_mm, press.rod_length_mm, press.offset_mm))
+    section, _ = LINKAGES[press.mechanism]
+    return _mechanism(press.mechanism, tuple(getattr(press, section).model_dump().items()))
+
+
+@cache
+def _mechanism(mechanism: str, geometry: tuple) -> Mechanism:
+    """The mechanism of kind ``mechanism`` with ``geometry``: a crank-slider's (radius, rod, offset) [mm], a
+    linkage's section as (key, value) pairs."""
+    if mechanism == "crank-slider":
+        return CrankSlider(*geometry)
+    _, kind = LINKAGES[mechanism]
     dimensions = {
         key.removesuffix("_mm").removesuffix("_deg"): math.radians(v) if key.endswith("_deg") else v
-        for key, v in values.items()
+        for key, v in geometry
     }
     return kind(**dimensions)
 
