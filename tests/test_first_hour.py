@@ -271,3 +271,43 @@ def test_compare_says_undecided_where_the_printed_digits_decide_nothing():
     assert swept.consistent and swept.allowance > 90 and swept.verdict == "undecided"
     assert checks["T9 (draw time)"].verdict == "consistent"
     assert checks["x3 (return peak)"].verdict == "inconsistent"
+
+
+def test_the_help_texts_and_messages_say_what_they_mean(tmp_path, capsys):
+    """Issue 37's words: the top-level help names every mechanism, `bound --help` does not call the grid bound an
+    upper bound, `check` labels a crank speed limit "crank speed" (a motor's limit "motor speed (on the crank)"),
+    `safety_height_mm` put under `limits:` is told where it belongs, and docs/reference.md has the glossary."""
+    for argv, words in ((["--help"], ("link drive", "knuckle joint")), (["bound", "--help"], ("no upper bound",))):
+        with pytest.raises(SystemExit):
+            main(argv)
+        out = " ".join(capsys.readouterr().out.split())
+        assert all(w in out for w in words), (argv, out)
+    assert main(["check", str(ROOT / "tests" / "data" / "cases" / "link2500.yaml")]) == 0
+    highest = next(x for x in capsys.readouterr().out.splitlines() if "highest draw speed" in x)
+    assert "crank speed 45.0000" in highest and "motor speed" not in highest
+    data = yaml.safe_load((ROOT / "cases" / "wang2023-side-panel.yaml").read_text(encoding="utf-8"))
+    data["limits"]["safety_height_mm"] = data["process"].pop("safety_height_mm")
+    path = tmp_path / "misplaced.yaml"
+    path.write_text(yaml.safe_dump(data), encoding="utf-8")
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "limits.safety_height_mm" in err and "belongs under process:" in err
+    glossary = (ROOT / "docs" / "reference.md").read_text(encoding="utf-8").split("## Glossary")[1]
+    assert all(w in glossary for w in ("θ1", "θ4", "robot window", "dwell", "feed", "draw", "return"))
+
+
+def test_the_summary_says_whose_the_draw_speed_is():
+    """Issue 37's draw speed words: given by the case, the highest the limits allow (link2500, cold), or the
+    planner's choice below that highest, which it then names with digits that `--set` takes back."""
+    from planning.reports.report import result_dict, summary_text
+
+    from .conftest import shipped, solved
+
+    link = ROOT / "tests" / "data" / "cases" / "link2500.yaml"
+    free = summary_text(result_dict(solved(link), shipped(link))).splitlines()[2]
+    assert "draw 14.266 rpm (the highest the limits allow)" in free, free
+    published = ROOT / "cases" / "wang2023-side-panel.yaml"
+    assert "draw 6.700 rpm (given)" in summary_text(result_dict(solved(published), shipped(published)))
+    r = result_dict(solved(link), shipped(link)) | {"draw_speed_rpm": 9.0}
+    words = summary_text(r).splitlines()[2]
+    assert "(the planner's choice; the limits allow up to 14.2664)" in words, words
