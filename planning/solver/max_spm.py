@@ -89,7 +89,8 @@ def _multi_start(search: Search, neighbour: Plan | None, ran: tuple[Ran, ...] = 
     """The published placement's starts (but those ``ran`` before), then (free placement) the free starts
     from its best plan."""
     w2 = search.draw_speed_range[1]
-    published = search.multi_start(published_starts(search.case, w2, neighbour), "published", ran=ran)
+    confirm = search.placement != "free"  # the free starts confirm their own optimum: one published plan seeds them
+    published = search.multi_start(published_starts(search.case, w2, neighbour), "published", confirm, ran=ran)
     if search.placement == "free":
         search.multi_start(free_starts(search.case, w2, neighbour, published), "free")
 
