@@ -346,7 +346,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 PENDULUM_COMMANDS = frozenset(
-    {"check", "solve", "bound", "sweep", "laws"}
+    {"check", "solve", "bound", "sweep", "laws", "tradeoff"}
 )  # the commands that take planner.mode: pendulum
 
 
@@ -421,13 +421,13 @@ def _solve_pendulum(case, args) -> int:
     from planning.reports.cam_export import proof_lines
     from planning.reports.outputs import Written
     from planning.reports.pendulum import pendulum_result, pendulum_summary, pendulum_writers
-    from planning.solver.pendulum import solve_pendulum
+    from planning.solver.pendulum_rate import solve_swings
 
     if args.placement == "published":
         raise CommandError(f"{args.case}: --placement published: not with planner.mode: pendulum")
     owned = _solve_files()
     out = _output_folder(case, args, owned)
-    solution = solve_pendulum(case)
+    solution = solve_swings(case)
     figures = not args.no_plots
     if figures:
         _load_plots()
@@ -479,9 +479,9 @@ def _cam(args) -> int:
         case = _read(args)
         out = _output_folder(case, args, ())
         if case.pendulum:  # the swings' cams: the crank goes forward and back on a master turning once a cycle
-            from planning.solver.pendulum import solve_pendulum
+            from planning.solver.pendulum_rate import solve_swings
 
-            solution = solve_pendulum(case, compare=False)
+            solution = solve_swings(case, compare=False)
         else:
             solution = solve(case)
     options = {o.kwargs["dest"]: getattr(args, o.kwargs["dest"]) for o in OPTIONS}

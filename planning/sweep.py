@@ -164,9 +164,9 @@ def solve_block(
 
 def _pendulum_row(case: Case) -> dict[str, Any]:
     """A pendulum point's row: its verified plan's figures (``planning.solver.pendulum``)."""
-    from planning.solver.pendulum import solve_pendulum
+    from planning.solver.pendulum_rate import solve_swings
 
-    sol = solve_pendulum(case, compare=False)
+    sol = solve_swings(case, compare=False)
     binding = [c.name for c in sol.evaluation.verification.binding()]
     return {
         "spm": sol.plan.spm,

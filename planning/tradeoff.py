@@ -26,6 +26,8 @@ from planning.solver.solution import ENERGY, GRID_PEAK
 from planning.sweep import SweepError, _cell, execute, verified
 from planning.timeline import Timeline, stamp
 
+# the drive's figures of a cycle that are energies (a stroke's in the rows)
+ENERGY_FIELDS = ("energy_drawn_kJ", "energy_returned_kJ", "energy_net_kJ", "supply_energy_kJ")
 # one row per rate: the plan's figures, the baseline's, the savings
 FIGURE_FIELDS = (
     "rms_motor_torque_Nm",
@@ -105,6 +107,7 @@ def rate_block(case: Case, placement: Placement | None, fastest: Any, rates: lis
     more (2.5e-5 relative on the side panel at 5 strokes/min), so it is not tried."""
     from planning.solver.objectives import solve_at_rate
     from planning.solver.outcomes import PlanningError
+    from planning.solver.pendulum_rate import solve_pendulum_at_rate
 
     rows = []
     for index, rate in rates:
@@ -112,7 +115,11 @@ def rate_block(case: Case, placement: Placement | None, fastest: Any, rates: lis
         t, started = time.perf_counter(), time.time()
         try:
             at_rate = case.with_objective(None, rate)
-            row.update(solved_row(solve_at_rate(at_rate, placement, fastest=fastest), at_rate))
+            if case.pendulum:
+                solution = solve_pendulum_at_rate(at_rate, fastest)
+            else:
+                solution = solve_at_rate(at_rate, placement, fastest=fastest)
+            row.update(solved_row(solution, at_rate))
         except PlanningError as exc:
             row.update(status=exc.outcome, message=exc.reason)
         row["solve_time_s"] = time.perf_counter() - t
@@ -122,11 +129,14 @@ def rate_block(case: Case, placement: Placement | None, fastest: Any, rates: lis
 
 
 def solved_row(sol: Any, case: Case) -> dict[str, Any]:
-    """The figures of a solution at a rate and of its baseline (the drive's figures each carries)."""
+    """The figures of a solution at a rate and of its baseline (the drive's figures each carries; the energies a
+    stroke's, a pendulum cycle's over its two strokes)."""
     a = sol.at_rate
     row: dict[str, Any] = {"status": Outcome.VERIFIED, "message": "", "improved_on_baseline": a.improved}
     for prefix, solution in (("", sol), ("baseline_", a.baseline)):
+        strokes = solution.plan.strokes_per_cycle
         figures = {**solution.drive.as_dict(), "transfer_window_s": solution.plan.transfer_window()}
+        figures.update({k: figures[k] / strokes for k in ENERGY_FIELDS})
         figures["energy_kJ"] = solution.energy_kJ
         row.update({f"{prefix}{k}": figures[k] for k in FIGURE_FIELDS})
     row["saving_rms_pct"] = sol.saving_pct("rms_motor_torque_Nm")
@@ -179,14 +189,8 @@ def run_tradeoff(
 ) -> TradeoffResult:
     """One plan per rate at ``case.planner.objective`` (min-rms-torque, min-energy or min-grid-peak); ``meanwhile``: see
     ``planning.sweep.execute``."""
-    from planning.solver.halves_nlp import halves_nlp_for
-    from planning.solver.optimize import solve
-
     timeline = Timeline()
-    fastest = solve(case.with_objective("max-spm"), placement)
-    halves_nlp_for(case, drive=True, rate=True)  # built once here, inherited by forked workers
-    if case.planner.objective == "min-grid-peak":
-        halves_nlp_for(case, drive=True, rate=True, peak=True)
+    fastest = _fastest_and_nlps(case, placement)
     values = rates.values(fastest.plan.spm)
     order = list(enumerate(values.tolist()))[::-1]  # from the fastest rate down
     # each rate a task of its own (each is solved cold, independent of the others): the workers take the
@@ -201,6 +205,25 @@ def run_tradeoff(
     timeline.mark("end")
     ordered = [rows[i] for i in sorted(rows)]
     return TradeoffResult(ordered, fastest, case.planner.objective, timeline.as_dict(ordered))
+
+
+def _fastest_and_nlps(case: Case, placement: Placement | None) -> Any:
+    """The case's max-SPM solution (a pendulum's swings without the rotary comparison), its rate NLP built
+    here, once, inherited by forked workers."""
+    if case.pendulum:
+        from planning.solver.pendulum import solve_pendulum
+        from planning.solver.pendulum_rate import rate_nlp
+
+        rate_nlp(case)
+        return solve_pendulum(case.with_objective("max-spm"), compare=False)
+    from planning.solver.halves_nlp import halves_nlp_for
+    from planning.solver.optimize import solve
+
+    fastest = solve(case.with_objective("max-spm"), placement)
+    halves_nlp_for(case, drive=True, rate=True)
+    if case.planner.objective == "min-grid-peak":
+        halves_nlp_for(case, drive=True, rate=True, peak=True)
+    return fastest
 
 
 def write_rows(path: Path, rows: list[dict[str, Any]], columns: tuple[str, ...]) -> None:

@@ -955,10 +955,9 @@ PENDULUM_NOT_WITH = (  # what a pendulum stroke does not plan with yet: (field, 
     ),
     (
         "planner.objective",
-        lambda c: c.planner.objective if c.planner.objective != "max-spm" else None,
-        "a swing plans the most strokes",
+        lambda c: c.planner.objective if c.planner.objective == "min-grid-peak" else None,
+        "the grid's peak needs the drive's electrical side, not planned for swings yet",
     ),
-    ("planner.target_spm", lambda c: c.planner.target_spm, "a swing plans the most strokes"),
     ("process.hold_time_s", lambda c: c.process.hold_time_s, "no hold in a swing yet"),
     (
         "process.transfer_time_s",

@@ -271,11 +271,33 @@ class PendulumPlan:
         tb0 = tf + float(self.parameters.turn_end_s)
         return {"forward": (0.0, tf / k), "backward": (tb0 / k, (tb0 + float(b.duration)) / k)}
 
+    @property
+    def strokes_per_cycle(self) -> int:
+        """The strokes of one cycle: its two swings."""
+        return STROKES_PER_CYCLE
+
+    def windows(self) -> dict[str, tuple[float, float]]:
+        """The robot's two windows, ``name -> (start, end)`` [s from the forward swing's start]: from the forward
+        swing's theta4 through the turn at theta_e to the backward swing's theta1, and from the backward swing's
+        theta4 through the turn at theta_s to the next forward theta1 (past the period)."""
+        return windows_of(self.key_times("forward"), self.key_times("backward"), self.period)
+
+    def transfer_window(self) -> float:
+        """The shorter of the robot's two windows [s]."""
+        return min(end - start for start, end in self.windows().values())
+
     def key_times(self, swing: str) -> np.ndarray:
         """Times [s from the forward swing's start] at which ``swing`` passes its four key angles."""
         keys = self.forward_keys if swing == "forward" else self.backward_keys
         lo, hi = self.swing_spans()[swing]
         return np.array([time_at(self.profile, float(a), lo, hi) for a in keys])
+
+
+def windows_of(forward: np.ndarray, backward: np.ndarray, period: float) -> dict[str, tuple[float, float]]:
+    """The robot's two windows of a cycle whose swings pass their key angles at times ``forward`` and
+    ``backward`` [s] (:meth:`PendulumPlan.windows`)."""
+    f, b = forward, backward
+    return {"at theta_e": (float(f[3]), float(b[0])), "at theta_s": (float(b[3]), float(f[0]) + period)}
 
 
 def time_at(profile: Profile, theta: float, lo: float, hi: float) -> float:

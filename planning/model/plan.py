@@ -66,6 +66,11 @@ class Plan:
         """[deg] the crank's turn over one cycle (a cam's slave after one master turn): a rotary stroke's 360."""
         return 360.0
 
+    @property
+    def strokes_per_cycle(self) -> int:
+        """The strokes of one cycle: a rotary stroke's one."""
+        return 1
+
     def key_times(self) -> np.ndarray:
         """Times [s] from TDC at which the crank reaches theta1..theta4."""
         return np.array([self.profile.time_at_angle(a) for a in self.key_angles])

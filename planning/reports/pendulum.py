@@ -15,6 +15,7 @@ from planning.model.pendulum import SWINGS
 from planning.reports.folder import write_json, write_table
 from planning.reports.report import MAX_ROWS, columns_at, trajectory_columns
 from planning.solver.pendulum import PendulumSolution
+from planning.solver.solution import ENERGY
 
 KEY_NAMES = ("closing", "draw_start", "draw_end", "opening")
 PENDULUM_FILES = ("result.json", "summary.txt", "trajectory.csv", "swing.*")  # what a pendulum solve owns
@@ -64,6 +65,7 @@ def pendulum_result(solution: PendulumSolution, case: Case) -> dict[str, Any]:
         "swings": swings,
         "rotary": rotary,
         **({"drive": {**drive.as_dict(), "per": "cycle of two strokes"}} if drive is not None else {}),
+        **({"at_rate": _at_rate(solution)} if solution.at_rate is not None else {}),
         "verification": {
             "passed": verification.passed,
             "samples": verification.samples,
@@ -77,6 +79,35 @@ def pendulum_result(solution: PendulumSolution, case: Case) -> dict[str, Any]:
             "wall_time_s": plan.solver.wall_time_s,
         },
     }
+
+
+def _at_rate(solution: PendulumSolution) -> dict[str, Any]:
+    """``result.json``'s ``at_rate`` block: the objective, the rate, the fastest swing's, the figure weighed (the
+    RMS motor torque [N m], or the supply energy a stroke [kJ]) of the plan and of the baseline."""
+    at = solution.at_rate
+    key = "rms_motor_torque_Nm" if at.objective == "min-rms-torque" else ENERGY
+    return {
+        "objective": at.objective,
+        "target_spm": at.target_spm,
+        "fastest_spm": at.fastest_spm,
+        "figure": key,
+        "value": solution.figure(key),
+        "baseline_value": at.baseline.figure(key),
+        "baseline": "the fastest swings, the crank standing longer at the turns",
+        "saving_pct": solution.saving_pct(key),
+        "improved_on_baseline": at.improved,
+    }
+
+
+def _rate_line(a: dict[str, Any]) -> str:
+    """The summary's line of a plan at the line's rate."""
+    rms = a["figure"] == "rms_motor_torque_Nm"
+    what, unit = ("RMS motor torque", "N m") if rms else ("supply energy", "kJ a stroke")
+    return (
+        f"  {a['objective']} at {a['target_spm']:g} strokes/min (the swings make at most {a['fastest_spm']:.3f}): "
+        f"{what} {a['value']:.1f} {unit} against {a['baseline_value']:.1f} of the fastest swings standing longer at "
+        f"the turns, {a['saving_pct']:.1f} % less"
+    )
 
 
 def pendulum_summary(r: dict[str, Any]) -> str:
@@ -96,7 +127,9 @@ def pendulum_summary(r: dict[str, Any]) -> str:
             f"{sw['feed_peak_rpm']:.3f} / {sw['return_peak_rpm']:.3f} rpm; {keys}"
         )
     rot = r["rotary"]
-    if rot["spm"] is not None:
+    if "at_rate" in r:
+        lines.append(_rate_line(r["at_rate"]))
+    elif rot["spm"] is not None:
         lines.append(
             f"  the rotary stroke under the same limits: {rot['spm']:.3f} strokes/min; the swing makes "
             f"{abs(rot['gain_percent']):.1f} % {'more' if rot['gain_percent'] >= 0 else 'fewer'} strokes"

@@ -74,7 +74,7 @@ def solve_at_rate(
         fastest = solve_max_spm(case.with_objective("max-spm"), placement)
     if case.electrical and fastest.drive.power is None:  # the max-SPM case leaves the grid out: its figures here
         fastest = replace(fastest, evaluation=evaluate(fastest.plan, case))
-    _check_reachable(target, fastest, case)
+    check_reachable(target, fastest, case)
     period = 60.0 / target
     baseline = _baseline(case, placement, fastest, period, neighbour_baseline, confirm)
     scale = objective_value(baseline, objective)
@@ -114,7 +114,7 @@ def solve_at_rate(
     return replace(answer, at_rate=AtRate(objective, target, fastest.plan.spm, baseline, improved))
 
 
-def _check_reachable(target: float, fastest: Solution, case: Case) -> None:
+def check_reachable(target: float, fastest: Solution, case: Case) -> None:
     """:class:`Infeasible` when the target rate is above what the limits allow, naming the ones that bind."""
     if target <= fastest.plan.spm * (1 + RATE_TOLERANCE):
         return
@@ -152,7 +152,7 @@ def solve_at_period(case: Case, period_s: float, fastest: Solution | None = None
     placement = case.planner.placement
     if fastest is None:
         fastest = solve_max_spm(case, placement)
-    _check_reachable(60.0 / period_s, fastest, case)
+    check_reachable(60.0 / period_s, fastest, case)
     at_rate = case.with_objective(None, 60.0 / period_s)
     guesses = guesses_at_period(case, fastest.plan.nlp_values["draw_speed"], period_s)
     try:

@@ -21,7 +21,7 @@ import numpy as np
 
 from planning.model.case import Case
 from planning.model.limits.capacity import torque_capacity_kNm
-from planning.model.pendulum import TWO_PI, PendulumPlan, swing_setups
+from planning.model.pendulum import STROKES_PER_CYCLE, TWO_PI, PendulumPlan, swing_setups
 from planning.model.units import RPM, rounded_down
 from planning.solver.outcomes import Infeasible, NoPlanFound, PlanningError, Unverified
 from planning.solver.pendulum_check import evaluate_pendulum
@@ -35,7 +35,7 @@ from planning.solver.pendulum_nlp import (
     solve_once,
     starts,
 )
-from planning.solver.verify import Evaluation
+from planning.solver.solution import Solution
 from planning.tolerances import SAME_RELATIVE
 from press.dynamics import envelope_torque
 
@@ -43,14 +43,21 @@ REFINE_ROUNDS = 4  # the NLP solved again with the sampled limits lowered, at mo
 
 
 @dataclass(frozen=True)
-class PendulumSolution:
+class PendulumSolution(Solution):
     """A verified pendulum plan: the ``plan``, its ``evaluation``; ``rotary_spm``: the same case as a rotary
-    stroke (None when that has no verified plan, ``rotary_reason`` says why)."""
+    stroke (None when that has no verified plan, ``rotary_reason`` says why); ``at_rate``: a plan at the line's
+    rate (``planning.solver.pendulum_rate``), its baseline a pendulum solution too. The drive's figures are a
+    cycle's (two strokes); :attr:`energy_kJ` is a stroke's, as a rotary solution's."""
 
     plan: PendulumPlan
-    evaluation: Evaluation
     rotary_spm: float | None = None
     rotary_reason: str = ""
+
+    @property
+    def energy_kJ(self) -> float:
+        """The supply energy a stroke [kJ]: a cycle's over its two strokes (at the motors' shaft: the drive's
+        electrical side is not planned for swings)."""
+        return self.drive.supply_energy_kJ / STROKES_PER_CYCLE
 
     @property
     def gain(self) -> float | None:
@@ -170,6 +177,6 @@ def _with_rotary(case: Case, best: tuple, t0: float, iterations: int, tried: int
 
     rotary = case.model_copy(update={"planner": case.planner.model_copy(update={"mode": "rotary"})})
     try:
-        return PendulumSolution(plan, evaluation, solve(rotary).plan.spm)
+        return PendulumSolution(plan, evaluation, rotary_spm=solve(rotary).plan.spm)
     except PlanningError as exc:
-        return PendulumSolution(plan, evaluation, None, exc.reason)
+        return PendulumSolution(plan, evaluation, rotary_reason=exc.reason)

@@ -23,7 +23,7 @@ from planning.model.case import RPM, Case
 from planning.model.drive import cycle_integrals, drive_figures
 from planning.model.limits import limits_of
 from planning.model.limits.base import Check, Dense
-from planning.model.pendulum import SWINGS, PendulumPlan, swing_forming_N, swing_of, time_at
+from planning.model.pendulum import SWINGS, PendulumPlan, swing_forming_N, swing_of, time_at, windows_of
 from planning.model.profile import sample_times
 from planning.solver.verify import CheckId, Evaluation, Verification, continuity_checks, energy_balance
 from planning.tolerances import (
@@ -194,8 +194,7 @@ def _window_checks(d: Dense, times: dict[str, np.ndarray]) -> list[Check]:
     """The robot's two windows, each through a turn: at least the transfer time, the slide at or above the
     safety height all through it (the ends exactly)."""
     case, period = d.case, d.plan.period
-    f, b = times["forward"], times["backward"]
-    windows = {"at theta_e": (f[3], b[0]), "at theta_s": (b[3], f[0] + period)}
+    windows = windows_of(times["forward"], times["backward"], period)
     out = []
     shortest, lowest = math.inf, math.inf
     for start, end in windows.values():

@@ -30,7 +30,9 @@ from planning.model.case import RPM, Case
 from planning.model.laws import get_law
 from planning.model.pendulum import TWO_PI, forming_on_path
 from planning.model.profile import advance_segment
-from planning.solver.parameters import DRAW_SAMPLES_DRIVE
+from planning.solver.nlp import DriveSamples as NLPDriveSamples
+from planning.solver.nlp import objective_terms
+from planning.solver.parameters import DRAW_SAMPLES_DRIVE, objective_values
 from press.dynamics import crank_torque, link_terms, motor_torque
 
 PEAK, RMS = "drive.motor.peak_torque_Nm", "drive.motor.rated_torque_Nm"  # the case fields of the motor's rows
@@ -40,11 +42,13 @@ DRAW_TORQUE_POINTS = 2001  # angles of a swing's draw on which the precheck take
 @dataclass
 class DriveSamples:
     """One swing's samples in time order: crank torque ``tc`` and motor torque ``tm`` on u [N m], motor speed
-    [rad/s], their ``times`` from the swing's start [s]; ``holding``: the motor torque at rest at its end."""
+    [rad/s], the crank's acceleration on u ``alpha`` [rad/s^2], their ``times`` from the swing's start [s];
+    ``holding``: the motor torque at rest at its end."""
 
     tc: Any
     tm: Any
     speed: Any
+    alpha: Any
     times: Any
     holding: Any
 
@@ -78,7 +82,7 @@ def swing_drive(case: Case, swing: Any) -> DriveSamples:
     # at rest at the swing's end the crank's torque is -T_u on the backward swing, through the gear as the
     # verification takes a standing crank's (``press.dynamics.motor_torque``: standing counts as forward)
     resting = tc[tc.shape[0] - 1] * (1.0 if swing.setup.name == "forward" else -1.0)
-    return DriveSamples(tc, tm, model.i * om, times, motor_torque(resting, 0.0, model))
+    return DriveSamples(tc, tm, model.i * om, al, times, motor_torque(resting, 0.0, model))
 
 
 def _half_samples(starts: list, states: list, segs: list, fractions: ca.DM, offset: Any) -> list[tuple]:
@@ -104,6 +108,22 @@ def trapezoid_heat(samples: DriveSamples) -> Any:
     t, sq = samples.times, samples.tm**2
     n = t.shape[0]
     return ca.sum1((t[1:n] - t[0 : n - 1]) * (sq[1:n] + sq[0 : n - 1]) / 2)
+
+
+def rate_terms(case: Case, drives: dict[str, DriveSamples], turns: tuple[Any, Any]) -> tuple[Any, Any]:
+    """``(heat [N^2 m^2 s], supply energy [J])`` of a cycle of two swings, as the rotary rate NLP takes them
+    (``planning.solver.nlp.objective_terms``: the gear's loss rounded where T_c changes sign, the supply
+    ``r P + (1 - r) smoothmax(P, 0)`` of the shaft power ``P = T_m omega_m``, the same on u as on theta), each
+    standstill's holding torque squared times its time added to the heat (at rest no power flows)."""
+    q = objective_values(case)
+    q["motor_base_speed"] = case.drive.motor.base_speed_rpm * RPM
+    heat, energy = 0.0, 0.0
+    for samples in drives.values():
+        torque = NLPDriveSamples(case.drive_model, samples.tc, samples.tm, samples.speed)
+        h, e = objective_terms(q, torque, samples.alpha, samples.times)
+        heat, energy = heat + h, energy + e
+    f, b = drives["forward"], drives["backward"]
+    return heat + f.holding**2 * turns[0] + b.holding**2 * turns[1], energy
 
 
 def drive_rows(

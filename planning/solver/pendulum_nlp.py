@@ -19,7 +19,10 @@ return's die-zone angles. In the draw the crank turns at the constant w2, so eac
 (``planning.model.pendulum.draw_speed_bound``), a variable bound. With a drive, the motor's and the crank's
 torque rows (``planning.solver.pendulum_drive``). Across the swings: the robot's two windows (theta4 through the
 turn at theta_e to the backward swing's theta1, and the backward swing's theta4 through theta_s to theta1) each
-at least the transfer time. The objective: the cycle time (both swings and both standstills).
+at least the transfer time. The objective: the cycle time (both swings and both standstills); at a target rate
+(``planner.objective`` with ``planner.target_spm``, a drive) the cycle held at that rate's time and the weighed
+heat and supply energy of the motor (``planning.solver.pendulum_drive.rate_terms``) instead, their weights
+parameters (:data:`RATE_PARAMETERS`).
 """
 
 from __future__ import annotations
@@ -54,8 +57,8 @@ from planning.model.plan import SolverInfo
 from planning.model.profile import Profile, advance_segment, knot_states
 from planning.solver.halves_nlp import MIN_HALF_S, TOP_SPEED, VARIABLE_INDEX, angle_at, variable_scales
 from planning.solver.ipopt import NLPSolver
-from planning.solver.nlp import Rows
-from planning.solver.pendulum_drive import drive_rows, swing_drive
+from planning.solver.nlp import RATE_OPTIONS, Rows
+from planning.solver.pendulum_drive import drive_rows, rate_terms, swing_drive
 from planning.tolerances import ACCEL_BACKOFF, DRIVE_BACKOFF, IPOPT_CONSTR_VIOL_TOL, REFINE_MARGIN
 
 SWING_VARIABLES = (  # per swing, prefixed ``forward_`` / ``backward_``: (name, scale kind of the halves NLP)
@@ -81,6 +84,9 @@ SHARED_VARIABLES = (
 SAMPLED_LIMITS = ("slider_accel", "slider_speed", "die_speed", "motor_peak_torque", "motor_rms_torque", "crank_torque")
 ACCEL, JERK, SLIDE_ACCEL = "limits.crank_accel_rad_s2", "limits.crank_jerk_rad_s3", "limits.slider_accel_mm_s2"
 OPTIONS = {"ipopt.constr_viol_tol": IPOPT_CONSTR_VIOL_TOL, "ipopt.max_iter": 600}
+# at a target rate: the cycle's time [s] and the weights of the heat [1/(N^2 m^2 s)] and the energy [1/J]
+RATE_PARAMETERS = ("target_period", "weight_heat", "weight_energy")
+TARGET = "planner.target_spm"
 
 
 @dataclass
@@ -201,12 +207,20 @@ class PendulumNLP:
     ubx: np.ndarray | None = None
     setups: tuple[SwingSetup, SwingSetup] | None = None
     limits: dict[str, float] | None = None
+    rate: dict[str, float] | None = None
 
-    def at(self, limits: dict[str, float]) -> PendulumNLP:
-        """The NLP held at the sampled limits' values ``limits`` (by id, inside units)."""
+    def at(self, limits: dict[str, float], rate: dict[str, float] | None = None) -> PendulumNLP:
+        """The NLP held at the sampled limits' values ``limits`` (by id, inside units); at a target rate ``rate``
+        gives :data:`RATE_PARAMETERS`' values (kept from before when None)."""
         setups = swing_setups(self.case, limits)
         lbx, ubx = _bounds(self.case, self.names, setups)
-        return replace(self, lbx=lbx, ubx=ubx, setups=setups, limits=dict(limits))
+        rate = self.rate if rate is None else dict(rate)
+        return replace(self, lbx=lbx, ubx=ubx, setups=setups, limits=dict(limits), rate=rate)
+
+    def parameters(self) -> np.ndarray:
+        """The parameter vector: the sampled limits' values, then the rate's (at a target rate)."""
+        values = [self.limits[name] for name in self.limit_names]
+        return np.array(values + ([self.rate[name] for name in RATE_PARAMETERS] if self.rate else []))
 
 
 def _variables(case: Case) -> tuple[tuple[str, ...], np.ndarray]:
@@ -230,8 +244,9 @@ def build(case: Case) -> PendulumNLP:
     x = ca.SX.sym("x", len(names))
     phys = {name: x[i] * scales[i] for i, name in enumerate(names)}
     limit_names = tuple(sampled_limit_values(case))
-    p = ca.SX.sym("limits", len(limit_names))
-    limits = {name: p[k] for k, name in enumerate(limit_names)}
+    rate = case.planner.objective != "max-spm"  # at a target rate: the heat or the energy weighed
+    p = ca.SX.sym("limits", len(limit_names) + (len(RATE_PARAMETERS) if rate else 0))
+    limits = {name: p[k] for k, name in enumerate(limit_names + (RATE_PARAMETERS if rate else ()))}
     setups = swing_setups(case, {})  # their key angles, mechanism and die exit (the bounds follow in ``at``)
     theta_s, theta_e = phys["swing_start"], phys["swing_end"]
     ends = {"forward": (theta_s, theta_e), "backward": (TWO_PI - theta_e, TWO_PI - theta_s)}
@@ -249,11 +264,19 @@ def build(case: Case) -> PendulumNLP:
     window_s = b.params.return_time - b.v["opening_time"] + phys["turn_start_s"] + f.v["closing_time"]
     rows.add("robot windows", ca.vertcat(window_e, window_s) / transfer - 1.0, 0.0, math.inf, "process.transfer_time_s")
     period = PendulumParameters(f.params, b.params, phys["turn_end_s"], phys["turn_start_s"]).period
+    objective = period / transfer
     if case.drive is not None:  # the motor's torques at the swings' samples (``planning.solver.pendulum_drive``)
         drives = {name: swing_drive(case, swing) for name, swing in swings.items()}
-        drive_rows(case, rows.add, drives, (phys["turn_end_s"], phys["turn_start_s"]), period, limits)
-    problem = {"x": x, "p": p, "f": period / transfer, "g": ca.vertcat(*rows.g)}
-    solver = NLPSolver("pendulum", problem, OPTIONS, scales)
+        turns = (phys["turn_end_s"], phys["turn_start_s"])
+        drive_rows(case, rows.add, drives, turns, period, limits)
+        if rate:
+            rows.add("the cycle at the target rate", period / limits["target_period"] - 1.0, 0.0, 0.0, TARGET)
+            heat, energy = rate_terms(case, drives, turns)
+            objective = limits["weight_heat"] * heat + limits["weight_energy"] * energy
+    problem = {"x": x, "p": p, "f": objective, "g": ca.vertcat(*rows.g)}
+    solver = NLPSolver(
+        "pendulum_rate" if rate else "pendulum", problem, {**OPTIONS, **(RATE_OPTIONS if rate else {})}, scales
+    )
     return PendulumNLP(case, solver, *rows.bounds(), names, scales, limit_names)
 
 
@@ -386,8 +409,7 @@ def plan_of_values(case: Case, values: dict[str, float], info: SolverInfo) -> Pe
 def solve_once(case: Case, nlp: PendulumNLP, start: dict[str, float]) -> tuple[dict[str, float] | None, Any]:
     """One IPOPT solve from ``start``: the variable values when it converged (else None) and the result."""
     x0 = np.array([start[name] for name in nlp.names])
-    p = np.array([nlp.limits[name] for name in nlp.limit_names])
-    res = nlp.solver.solve(x0, nlp.lbx, nlp.ubx, nlp.lbg, nlp.ubg, p=p)
+    res = nlp.solver.solve(x0, nlp.lbx, nlp.ubx, nlp.lbg, nlp.ubg, p=nlp.parameters())
     values = {name: float(res.x[i]) for i, name in enumerate(nlp.names)} if res.success else None
     return values, res
 

@@ -638,10 +638,10 @@ def _pendulum_answer(case: Case, label: str, session: Session) -> dict[str, Any]
     from planning.reports.pendulum import pendulum_page_result, pendulum_summary
     from planning.reports.report import columns_at
     from planning.solver.outcomes import Infeasible, PlanningError
-    from planning.solver.pendulum import solve_pendulum
+    from planning.solver.pendulum_rate import solve_swings
 
     try:
-        solution = solve_pendulum(case)
+        solution = solve_swings(case)
     except PlanningError as exc:
         limit = exc.limit if isinstance(exc, Infeasible) else None
         return {"status": exc.outcome, "message": f"{label}: {exc}", "field": limit, "confirmed": True, **_warned(case)}

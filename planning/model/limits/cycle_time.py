@@ -1,4 +1,4 @@
-"""At the line's rate the cycle time is the target's, ``60 / planner.target_spm``."""
+"""At the line's rate the cycle time is the target's, ``60 / planner.target_spm`` a stroke (a pendulum's cycle: two)."""
 
 from __future__ import annotations
 
@@ -40,6 +40,6 @@ class CycleTimeLimit(Limit):
         planner = dense.case.planner
         if planner.objective == "max-spm" or planner.target_spm is None:
             return []
-        return [
-            Check.of(self.id, self.name, dense.plan.period, 60.0 / planner.target_spm, self.unit, "equal", TIME_TOL_S)
-        ]
+        plan = dense.plan  # the target's cycle: as many strokes as the plan makes a cycle (a pendulum's two)
+        target_s = plan.period * plan.spm / planner.target_spm
+        return [Check.of(self.id, self.name, plan.period, target_s, self.unit, "equal", TIME_TOL_S)]
