@@ -671,6 +671,8 @@ def _tradeoff(case, args) -> int:
     from planning.tradeoff import columns, parse_rates, run_tradeoff, table_text, write_rows
 
     rates = parse_rates(args.spm)
+    if case.pendulum and args.placement == "published":
+        raise CommandError(f"{args.case}: --placement published: not with planner.mode: pendulum")
     if case.drive is None:
         raise CommandError(f"{args.case}: drive: the trade-off weighs the motor: the case needs a drive: section")
     case = _with_law(case, args)

@@ -163,18 +163,11 @@ def solve_block(
 
 
 def _pendulum_row(case: Case) -> dict[str, Any]:
-    """A pendulum point's row: its verified plan's figures (``planning.solver.pendulum``)."""
+    """A pendulum point's row: its verified plan's figures (``planning.solver.pendulum_rate.solve_swings``: the
+    most strokes, or at the case's target rate)."""
     from planning.solver.pendulum_rate import solve_swings
 
-    sol = solve_swings(case, compare=False)
-    binding = [c.name for c in sol.evaluation.verification.binding()]
-    return {
-        "spm": sol.plan.spm,
-        "cycle_time_s": sol.plan.period,
-        "status": Outcome.VERIFIED,
-        "binding": ";".join(binding),
-        "message": "",
-    }
+    return _solved_row(solve_swings(case, compare=False), case)
 
 
 def _solved_row(sol, case) -> dict[str, Any]:  # noqa: ANN001 - a Solution and its Case
@@ -187,9 +180,10 @@ def _solved_row(sol, case) -> dict[str, Any]:  # noqa: ANN001 - a Solution and i
         "binding": ";".join(binding(sol)),
         "message": "",
     }
-    if sol.drive is not None:
+    if sol.drive is not None:  # the energies a stroke's (a pendulum cycle's over its two strokes)
         figures = sol.drive.as_dict()
-        row.update({k: figures[k] for k in DRIVE_ROW_FIELDS})
+        strokes = sol.plan.strokes_per_cycle
+        row.update({k: figures[k] / strokes if k.endswith("_kJ") else figures[k] for k in DRIVE_ROW_FIELDS})
         if sol.drive.power is not None:
             power = sol.drive.power.as_dict()
             row.update({k: power[k] for k in POWER_ROW_FIELDS})

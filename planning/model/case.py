@@ -975,8 +975,9 @@ PENDULUM_NOT_WITH = (  # what a pendulum stroke does not plan with yet: (field, 
 
 
 def _pendulum_checks(case: Case) -> None:
-    """A pendulum stroke (``planner.mode: pendulum``) plans with a law with halves, at the most strokes, against
-    the safety height and the transfer time; what it does not plan with yet is refused naming the field."""
+    """A pendulum stroke (``planner.mode: pendulum``) plans with a law with halves, at the most strokes or at a
+    line's rate (the motor's heat or energy), against the safety height and the transfer time; what it does not
+    plan with yet is refused naming the field."""
     if not case.pendulum:
         return
     for name, value_of, why in PENDULUM_NOT_WITH:

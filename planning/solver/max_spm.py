@@ -86,8 +86,8 @@ def converged_plan(case: Case) -> Plan | None:
 
 
 def _multi_start(search: Search, neighbour: Plan | None, ran: tuple[Ran, ...] = ()) -> None:
-    """The published placement's starts (but those ``ran`` before), then (free placement) the free starts
-    from its best plan."""
+    """The published placement's starts (but those ``ran`` before; in free placement until one verifies), then
+    (free placement) the free starts from that plan."""
     w2 = search.draw_speed_range[1]
     confirm = search.placement != "free"  # the free starts confirm their own optimum: one published plan seeds them
     published = search.multi_start(published_starts(search.case, w2, neighbour), "published", confirm, ran=ran)

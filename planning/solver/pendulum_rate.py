@@ -53,14 +53,19 @@ def solve_swings(case: Case, compare: bool = True) -> PendulumSolution:
 
 
 def rate_nlp(case: Case) -> PendulumNLP:
-    """The rate NLP of ``case``, built once for every rate of it (the rate and the weights its parameters):
-    kept by the case's fields but the target rate."""
-    key = case.model_dump_json(exclude={"planner": {"target_spm"}})
+    """The rate NLP of ``case``, built once for every rate and either objective of it (the rate and the weights
+    its parameters): kept by the fields the NLP reads (not the case's name, title or source, the target rate or
+    which objective), the last :data:`KEPT_RATE_NLPS` only (each holds tens of MB)."""
+    key = case.model_dump_json(exclude={"name": True, "title": True, "source": True, "planner": {"target_spm"}})
+    key = key.replace(f'"objective":"{case.planner.objective}"', '"objective":"at a rate"')
     if key not in _RATE_NLPS:
+        while len(_RATE_NLPS) >= KEPT_RATE_NLPS:
+            _RATE_NLPS.pop(next(iter(_RATE_NLPS)))
         _RATE_NLPS[key] = build(case)
     return _RATE_NLPS[key]
 
 
+KEPT_RATE_NLPS = 2  # the rate NLPs a process keeps (a trade-off's one case; a page's last edits)
 _RATE_NLPS: dict[str, PendulumNLP] = {}
 
 
@@ -94,7 +99,8 @@ def solve_pendulum_at_rate(case: Case, fastest: PendulumSolution | None = None) 
             break
     at_rate = AtRate(objective, target, fastest.plan.spm, baseline, best is not baseline)
     plan = replace(best.plan, solver=elapsed_info(t0, iterations, tried, best.plan.solver.status))
-    return replace(best, plan=plan, at_rate=at_rate)
+    evaluation = replace(best.evaluation, samples=replace(best.evaluation.samples, plan=plan))
+    return replace(best, plan=plan, evaluation=evaluation, at_rate=at_rate)
 
 
 def _baseline(case: Case, fastest: PendulumSolution, period: float) -> PendulumSolution:
@@ -132,8 +138,8 @@ def _starts(case: Case, nlp: PendulumNLP, baseline: PendulumSolution, period: fl
 def _run(
     case: Case, nlp: PendulumNLP, x0s: list[dict[str, float]], counts: tuple[float, int, int]
 ) -> tuple[PendulumSolution | None, PendulumSolution | None, int, int]:
-    """Each start solved and verified: the verified plan with the least figure, the failed plan with the least
-    (or None), and the counts of starts and iterations."""
+    """Each start solved and verified: the verified plan with the least figure, the first plan that failed its
+    check (or None), and the counts of starts and iterations."""
     t0, tried, iterations = counts
     found, failed = None, None
     objective = case.planner.objective

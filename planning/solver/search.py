@@ -4,9 +4,10 @@ A search holds one case, its compiled NLP (``planning.solver.nlp``; either trans
 parameters and the variables' bounds and scales, and the best verified plan so far. Each start
 (:meth:`Search.attempt`) is solved, made a plan, verified densely (``planning.solver.verify``); where only
 limits the NLP holds at samples fail between them, their sampled limits are tightened by the measured
-overshoot and the start re-solved warm; where an NLP row that can overstate its figure is active while
-the exact figure leaves room, that row is loosened once by the room. Starts run until two agree on the
-optimum (:meth:`Search.multi_start`). Without a verified plan the answer is a typed outcome
+overshoot (the slide's acceleration segment by segment: :meth:`Search._shares`) and the start re-solved
+warm; where an NLP row that can overstate its figure is active while the exact figure leaves room, that row
+is loosened once by the room. Starts run until two agree on the optimum (:meth:`Search.multi_start`; with
+``confirm`` False until one verifies). Without a verified plan the answer is a typed outcome
 (``planning.solver.outcomes``). The max-SPM solve of the laws (``planning.solver.max_spm``), the
 optimal law (``planning.solver.optimal``) and the objectives at a rate (``planning.solver.objectives``)
 all run on it.
@@ -36,6 +37,7 @@ from planning.solver.verify import Verification, evaluate, field_of_check, sched
 from planning.tolerances import (
     AGREE_S,
     BINDING_SHARE,
+    LIMIT_REL_TOL,
     REFINE_MARGIN,
     ROW_ACTIVE,
     SAME_ANGLE_RAD,
@@ -168,7 +170,7 @@ class Search:
         values = limit.dense_values(dense)
         where = plan.segment_indices(dense.t)
         factors: dict[int, float] = {}
-        for k in np.unique(where[values > check.limit]):
+        for k in np.unique(where[values > check.limit * (1 + LIMIT_REL_TOL)]):  # the segments that fail
             name = plan.profile.segments[k].name
             if name not in segments:
                 continue

@@ -146,9 +146,9 @@ def constant_speed(case: Case, w2: float, inside: float) -> dict[str, float]:
 def free_starts(
     case: Case, w2: float, neighbour: Plan | None, published: dict[str, float] | None
 ) -> list[dict[str, float]]:
-    """Starts of the free placement: the neighbour's values when it has that placement, the best
-    published-placement plan, the die exit's start where the draw ends in the die zone (:func:`die_exit`),
-    then guesses from the case."""
+    """Starts of the free placement: the neighbour's values when it has that placement, the published
+    placement's plan (a free solve's first verified one), the die exit's start where the draw ends in the die
+    zone (:func:`die_exit`), then guesses from the case."""
     w_transfer, w_min = transfer_speeds(case)
     starts = [neighbour.nlp_values] if neighbour is not None and neighbour.placement == "free" else []
     starts += [published] if published is not None else []

@@ -633,8 +633,9 @@ def solve_case(data: Any, label: str, session: Session, confirm: bool = True) ->
 
 
 def _pendulum_answer(case: Case, label: str, session: Session) -> dict[str, Any]:
-    """The page's answer for a pendulum case (``planning.solver.pendulum``): a cold solve each time (no fast
-    answer from the last plan yet), the rotary stroke's rate beside it in the summary; no downloads yet."""
+    """The page's answer for a pendulum case (``planning.solver.pendulum_rate.solve_swings``): a cold solve each
+    time (no fast answer from the last plan yet), in the summary the rotary stroke's rate beside it (at a line's
+    rate: the baseline's figure instead); no downloads yet."""
     from planning.reports.pendulum import pendulum_page_result, pendulum_summary
     from planning.reports.report import columns_at
     from planning.solver.outcomes import Infeasible, PlanningError
