@@ -873,6 +873,44 @@ def test_a_pendulum_stroke_on_the_page(page) -> None:
     screenshot(page, "web-pendulum")
 
 
+@pytest.mark.slow
+@browser
+def test_a_pendulum_stroke_at_the_lines_rate_on_the_page(page) -> None:
+    """The cup's drive case set to pendulum strokes and to the least energy at 30 strokes/min with the mouse, the
+    keys and the rate typed in: the page's answer is the CLI's (``solve_swings``): 30 strokes/min, and the summary
+    states the energy a stroke against the baseline's and the saving, the same numbers; the motor's chart drawn
+    (a swing's answer once lacked the motor's data: a script error, no answer shown as done)."""
+    from planning.solver.pendulum_rate import solve_swings
+
+    errors = []
+    page.on("pageerror", lambda e: errors.append(str(e)))  # a script error stops the page's answer
+    pick_case(page, "cup-2000kN-drive.yaml")
+    before = int(page.evaluate("document.body.dataset.rendered"))
+    _choose_with_mouse_and_keys(page, '[data-field="planner.mode"]', "pendulum")
+    wait_rendered(page, before)
+    before = int(page.evaluate("document.body.dataset.rendered"))
+    _choose_with_mouse_and_keys(page, '[data-field="planner.objective"]', "min-energy")
+    wait_rendered(page, before)
+    assert "needs the line's rate" in page.locator('.msg[data-for="planner.target_spm"]').inner_text()
+    page.locator('[data-field="planner.target_spm"]').click()
+    page.keyboard.type("30")
+    before = int(page.evaluate("document.body.dataset.rendered"))
+    page.keyboard.press("Tab")
+    wait_rendered(page, before)
+    data = load_yaml((CASES / "cup-2000kN-drive.yaml").read_text(encoding="utf-8"))
+    data["planner"].update(mode="pendulum", objective="min-energy", target_spm=30.0)
+    solution = solve_swings(case_from_data(data, "cases/cup-2000kN-drive.yaml"))
+    assert page.locator("#spm").inner_text() == "30.000"
+    page.locator("#summary").locator("xpath=..").locator("summary").click()  # the summary unfolded
+    summary = " ".join(page.locator("#summary").inner_text().split())
+    energy, baseline = solution.energy_kJ, solution.at_rate.baseline.energy_kJ
+    expected = f"supply energy {energy:.1f} kJ a stroke against {baseline:.1f} of the fastest swings"
+    assert "min-energy at 30 strokes/min" in summary and expected in summary, summary
+    assert f"{solution.saving_pct('energy_kJ'):.1f} % less" in summary
+    assert page.locator("#drive-chart .main-svg").count() > 0 and not errors  # the motor's chart drawn for swings
+    screenshot(page, "web-pendulum-rate")
+
+
 def _choose_with_mouse_and_keys(page, selector: str, value: str) -> None:  # noqa: ANN001 - a Playwright page
     """Choose ``value`` in the select ``selector`` as a user does: scrolled into view, a mouse click at its
     coordinates opens its list, the arrow keys move to the option, Enter takes it."""

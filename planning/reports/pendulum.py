@@ -13,7 +13,7 @@ import numpy as np
 from planning.model.case import RPM, Case
 from planning.model.pendulum import SWINGS
 from planning.reports.folder import write_json, write_table
-from planning.reports.report import MAX_ROWS, columns_at, trajectory_columns
+from planning.reports.report import MAX_ROWS, columns_at, drive_block, trajectory_columns
 from planning.solver.pendulum import PendulumSolution
 from planning.solver.solution import ENERGY
 
@@ -64,7 +64,7 @@ def pendulum_result(solution: PendulumSolution, case: Case) -> dict[str, Any]:
         },
         "swings": swings,
         "rotary": rotary,
-        **({"drive": {**drive.as_dict(), "per": "cycle of two strokes"}} if drive is not None else {}),
+        **({"drive": {**drive_block(solution, case), "per": "cycle of two strokes"}} if drive is not None else {}),
         **({"at_rate": _at_rate(solution)} if solution.at_rate is not None else {}),
         "verification": {
             "passed": verification.passed,
@@ -266,7 +266,7 @@ def pendulum_page_result(solution: PendulumSolution, case: Case) -> dict[str, An
         "binding_over_cycle": [],
         "key_points": points,
         "stages": _swing_stages(solution, d),
-        "transfer_window_s": min(b[0] - f[3], f[0] + plan.period - b[3]),
+        "transfer_window_s": plan.transfer_window(),
         "windows": {"time": windows_time, "angle": [[low, s["end_deg"]], [s["start_deg"], high]]},
         "draws": {
             "time": [[float(f[1]), float(f[2])], [float(b[1]), float(b[2])]],
