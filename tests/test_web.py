@@ -908,6 +908,8 @@ def test_a_pendulum_stroke_at_the_lines_rate_on_the_page(page) -> None:
     assert "min-energy at 30 strokes/min" in summary and expected in summary, summary
     assert f"{solution.saving_pct('energy_kJ'):.1f} % less" in summary
     assert page.locator("#drive-chart .main-svg").count() > 0 and not errors  # the motor's chart drawn for swings
+    envelope = page.evaluate("document.getElementById('drive-chart').data.find((t) => t.name === 'peak envelope').x")
+    assert min(envelope) < 0 < max(envelope)  # drawn for both ways the motor turns (backward on the backward swing)
     screenshot(page, "web-pendulum-rate")
 
 

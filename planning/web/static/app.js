@@ -877,9 +877,13 @@ function drawDrive(r, c, x, axis) {
   el.style.display = "block";
   const m = r.drive.motor;
   const torque = c.motor_torque_Nm.map((v) => v / 1e3);
-  const speeds = [0, m.base_speed_rpm];
-  for (let k = 1; k <= 20; k++) speeds.push(m.base_speed_rpm + (k / 20) * (m.max_speed_rpm - m.base_speed_rpm));
-  const envelope = speeds.map((n) => (m.peak_torque_Nm / 1e3) * Math.min(1, m.base_speed_rpm / Math.max(n, 1e-9)));
+  // the envelope over the motor's speeds, both ways when it turns backward (a pendulum's backward swing)
+  const forward = [0, m.base_speed_rpm];
+  for (let k = 1; k <= 20; k++) forward.push(m.base_speed_rpm + (k / 20) * (m.max_speed_rpm - m.base_speed_rpm));
+  const backward = c.motor_speed_rpm.some((n) => n < 0);
+  const speeds = backward ? forward.slice(1).reverse().map((n) => -n).concat(forward) : forward;
+  const envelope = speeds.map((n) => (m.peak_torque_Nm / 1e3) * Math.min(1, m.base_speed_rpm / Math.max(Math.abs(n), 1e-9)));
+  const lowest = backward ? -m.max_speed_rpm : 0;
   // the torque's limits where the motor is: the peak envelope at its speed (falling above the base speed)
   // and the rated torque (the RMS limit), both signs
   const atSpeed = c.motor_speed_rpm.map((n) => (m.peak_torque_Nm / 1e3) * Math.min(1, m.base_speed_rpm / Math.max(Math.abs(n), 1e-9)));
@@ -895,8 +899,8 @@ function drawDrive(r, c, x, axis) {
     { x: c.motor_speed_rpm, y: torque, xaxis: "x2", yaxis: "y3", mode: "lines", name: "cycle in the torque–speed plane", line: { color: "#d62728" }, showlegend: false },
     { x: speeds, y: envelope, xaxis: "x2", yaxis: "y3", name: "peak envelope", line: { dash: "dash", color: "#b22222" }, showlegend: false },
     { x: speeds, y: envelope.map((v) => -v), xaxis: "x2", yaxis: "y3", showlegend: false, line: { dash: "dash", color: "#b22222" } },
-    { x: [0, m.max_speed_rpm], y: [rated, rated], xaxis: "x2", yaxis: "y3", showlegend: false, name: "rated torque", line: { dash: "dash", color: "#e08000" } },
-    { x: [0, m.max_speed_rpm], y: [-rated, -rated], xaxis: "x2", yaxis: "y3", showlegend: false, name: "rated torque", line: { dash: "dash", color: "#e08000" } },
+    { x: [lowest, m.max_speed_rpm], y: [rated, rated], xaxis: "x2", yaxis: "y3", showlegend: false, name: "rated torque", line: { dash: "dash", color: "#e08000" } },
+    { x: [lowest, m.max_speed_rpm], y: [-rated, -rated], xaxis: "x2", yaxis: "y3", showlegend: false, name: "rated torque", line: { dash: "dash", color: "#e08000" } },
   ];
   const round = ROUND_TICKS;
   const layout = {
