@@ -476,3 +476,21 @@ def test_the_tradeoff_takes_swings(tmp_path, capsys):
     assert float(slow["saving_energy_pct"]) > 10 and float(fastest["saving_energy_pct"]) == 0.0
     assert float(fastest["energy_kJ"]) == pytest.approx(float(fastest["supply_energy_kJ"]), rel=1e-12)
     assert "min-energy at the line's rate" in capsys.readouterr().out
+
+
+def test_the_rate_nlp_is_built_once_a_case_and_few_are_kept(monkeypatch):
+    """The swings' rate NLP (tens of MB) is kept by what it reads: one for every rate and objective of a case, a
+    new one for another limit, and no more than ``KEPT_RATE_NLPS`` at once (a sweep builds one a point)."""
+    from planning.solver import pendulum_rate
+
+    monkeypatch.setattr(pendulum_rate, "build", lambda case: object())
+    monkeypatch.setattr(pendulum_rate, "_RATE_NLPS", {})
+    cup = ROOT / "cases" / "cup-2000kN-drive.yaml"
+    case = read_case(cup, {"planner.mode": "pendulum", "name": "a"})
+    first = pendulum_rate.rate_nlp(case.with_objective("min-energy", 20.0))
+    renamed = read_case(cup, {"planner.mode": "pendulum", "name": "b"}).with_objective("min-rms-torque", 30.0)
+    assert pendulum_rate.rate_nlp(renamed) is first
+    for accel in (15000, 16000, 17000):
+        other = read_case(cup, {"planner.mode": "pendulum", "limits.slider_accel_mm_s2": accel})
+        assert pendulum_rate.rate_nlp(other.with_objective("min-energy", 20.0)) is not first
+    assert len(pendulum_rate._RATE_NLPS) == pendulum_rate.KEPT_RATE_NLPS

@@ -3,15 +3,15 @@
 
 The fastest swing (``planning.solver.pendulum.solve_pendulum``) is solved first; a target above its strokes is
 refused (``Infeasible``, naming the limits that bind there, as for a rotary stroke); at its rate it is the
-answer. The **baseline** is what a press does at a lower rate
-without planning for it: the fastest swings unchanged, the crank standing longer at the turns (the extra time
-shared between them), verified like any plan. The rate NLP (``planning.solver.pendulum_nlp``, its cycle held at
-``120 / target_spm`` s: two strokes a cycle) weighs the heat (``integral T_m^2 dt``) or the supply energy,
-normalised by the baseline's figure (the energy with the heat's :data:`HEAT_TIE_BREAK` share breaking ties, as the
-rotary rate NLP does). Its starts: the baseline's values and the NLP's own starts with their standstills
-lengthened to the rate. Every converged plan is verified densely; the answer is the verified plan with the least
-figure (``planning.solver.solution.objective_value``: the verification's exact RMS or supply energy), the
-baseline when none beats it. Where no start verifies, the sampled limits are lowered by their overshoot as in the
+answer. The **baseline** is what a press does at a lower rate without planning for it: the fastest swings
+unchanged, the crank standing longer at the turns (the extra time shared between them), verified like any plan.
+The rate NLP (``planning.solver.pendulum_nlp``, its cycle held at ``120 / target_spm`` s: two strokes a cycle)
+weighs the heat (``integral T_m^2 dt``) or the supply energy, normalised by the baseline's figure (the energy
+with the heat's :data:`HEAT_TIE_BREAK` share breaking ties, as the rotary rate NLP does). Its starts: the
+baseline's values and the NLP's own starts with their standstills lengthened to the rate. Every converged plan
+is verified densely; the answer is the verified plan with the least figure
+(``planning.solver.solution.objective_value``: the verification's exact RMS or supply energy), the baseline
+when none beats it. Where no start verifies, the sampled limits are lowered by their overshoot as in the
 max-SPM solve.
 """
 
@@ -56,8 +56,8 @@ def rate_nlp(case: Case) -> PendulumNLP:
     """The rate NLP of ``case``, built once for every rate and either objective of it (the rate and the weights
     its parameters): kept by the fields the NLP reads (not the case's name, title or source, the target rate or
     which objective), the last :data:`KEPT_RATE_NLPS` only (each holds tens of MB)."""
-    key = case.model_dump_json(exclude={"name": True, "title": True, "source": True, "planner": {"target_spm"}})
-    key = key.replace(f'"objective":"{case.planner.objective}"', '"objective":"at a rate"')
+    planner = case.planner.model_copy(update={"objective": "min-rms-torque", "target_spm": None})  # any at a rate
+    key = case.model_copy(update={"planner": planner}).model_dump_json(exclude={"name", "title", "source"})
     if key not in _RATE_NLPS:
         while len(_RATE_NLPS) >= KEPT_RATE_NLPS:
             _RATE_NLPS.pop(next(iter(_RATE_NLPS)))
