@@ -27,6 +27,7 @@ from planning.solver.outcomes import Infeasible, NoPlanFound, PlanningError, Unv
 from planning.solver.pendulum_check import evaluate_pendulum
 from planning.solver.pendulum_drive import draw_torque
 from planning.solver.pendulum_nlp import (
+    PendulumNLP,
     build,
     elapsed_info,
     plan_of_values,
@@ -78,19 +79,13 @@ def solve_pendulum(case: Case, compare: bool = True) -> PendulumSolution:
     compiled = build(case)  # once: the sampled limits are its parameters
     for _ in range(REFINE_ROUNDS + 1):
         nlp = compiled.at(limits)
+        x0s = starts(case, nlp) + ([previous] if previous else [])
+        solved, tried, iterations = solved_starts(case, nlp, x0s, (t0, tried, iterations))
         best, best_failed = None, None
-        for start in starts(case, nlp) + ([previous] if previous else []):
-            values, res = solve_once(case, nlp, start)
-            tried, iterations = tried + 1, iterations + res.iterations
-            if values is None:
-                continue
-            plan = plan_of_values(case, values, elapsed_info(t0, iterations, tried, res.return_status))
-            evaluation = evaluate_pendulum(plan, case)
-            if evaluation.verification.passed:
-                if best is None or plan.spm > best[0].spm:
-                    best = (plan, evaluation)
-            elif best_failed is None or plan.spm > best_failed[0].spm:
-                best_failed = (plan, evaluation)
+        for passed in (True, False):  # the most strokes among the verified plans, and among the failed
+            group = [(s.plan, s.evaluation) for s in solved if s.evaluation.verification.passed == passed]
+            top = max(group, key=lambda item: item[0].spm, default=None)
+            best, best_failed = (top, best_failed) if passed else (best, top)
         if best is not None:
             best, more = _loosened(case, compiled, limits, best)
             return _with_rotary(case, best, t0, iterations + more, tried + int(more > 0), compare)
@@ -105,6 +100,23 @@ def solve_pendulum(case: Case, compare: bool = True) -> PendulumSolution:
             break
     check = failure[0]
     raise Unverified(f"{check.name} = {check.value:.6g} {check.unit} (limit {check.limit:.6g})", check)
+
+
+def solved_starts(
+    case: Case, nlp: PendulumNLP, x0s: list[dict[str, float]], counts: tuple[float, int, int]
+) -> tuple[list[PendulumSolution], int, int]:
+    """Each start of ``nlp`` solved; every converged plan with its dense evaluation (verified or not), in the
+    starts' order, and the counts ``(t0, starts tried, iterations)`` carried on (the latter two returned)."""
+    t0, tried, iterations = counts
+    out = []
+    for x0 in x0s:
+        values, res = solve_once(case, nlp, x0)
+        tried, iterations = tried + 1, iterations + res.iterations
+        if values is None:
+            continue
+        plan = plan_of_values(case, values, elapsed_info(t0, iterations, tried, res.return_status))
+        out.append(PendulumSolution(plan, evaluate_pendulum(plan, case)))
+    return out, tried, iterations
 
 
 def _loosened(case: Case, compiled, limits: dict[str, float], best: tuple) -> tuple[tuple, int]:  # noqa: ANN001

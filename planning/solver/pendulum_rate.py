@@ -25,7 +25,7 @@ from planning.model.case import Case
 from planning.model.pendulum import STROKES_PER_CYCLE
 from planning.solver.objectives import HEAT_TIE_BREAK, check_reachable
 from planning.solver.outcomes import Unverified
-from planning.solver.pendulum import PendulumSolution, solve_pendulum
+from planning.solver.pendulum import PendulumSolution, solve_pendulum, solved_starts
 from planning.solver.pendulum_check import evaluate_pendulum
 from planning.solver.pendulum_nlp import (
     PendulumNLP,
@@ -34,7 +34,6 @@ from planning.solver.pendulum_nlp import (
     plan_of_values,
     refined,
     sampled_limit_values,
-    solve_once,
     starts,
 )
 from planning.solver.solution import AtRate, objective_value
@@ -143,21 +142,10 @@ def _starts(case: Case, nlp: PendulumNLP, baseline: PendulumSolution, period: fl
 def _run(
     case: Case, nlp: PendulumNLP, x0s: list[dict[str, float]], counts: tuple[float, int, int]
 ) -> tuple[PendulumSolution | None, PendulumSolution | None, int, int]:
-    """Each start solved and verified: the verified plan with the least figure, the first plan that failed its
-    check (or None), and the counts of starts and iterations."""
-    t0, tried, iterations = counts
-    found, failed = None, None
-    objective = case.planner.objective
-    for x0 in x0s:
-        values, res = solve_once(case, nlp, x0)
-        tried, iterations = tried + 1, iterations + res.iterations
-        if values is None:
-            continue
-        plan = plan_of_values(case, values, elapsed_info(t0, iterations, tried, res.return_status))
-        solution = PendulumSolution(plan, evaluate_pendulum(plan, case))
-        if solution.evaluation.verification.passed:
-            if found is None or objective_value(solution, objective) < objective_value(found, objective):
-                found = solution
-        elif failed is None:
-            failed = solution
+    """Each start solved and verified (``planning.solver.pendulum.solved_starts``): the verified plan with the
+    least figure, the first plan that failed its check (or None), and the counts of starts and iterations."""
+    solved, tried, iterations = solved_starts(case, nlp, x0s, counts)
+    verified = [s for s in solved if s.evaluation.verification.passed]
+    found = min(verified, key=lambda s: objective_value(s, case.planner.objective), default=None)
+    failed = next((s for s in solved if not s.evaluation.verification.passed), None)
     return found, failed, tried, iterations
