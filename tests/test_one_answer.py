@@ -160,3 +160,46 @@ def test_the_page_shows_the_cold_plan_or_better_whatever_the_order_of_edits():
 @pytest.mark.slow
 def test_fifty_edit_sequences_show_the_cold_plan_or_better():
     _run_sequences(SLOW_SEQUENCES, seed=1123)
+
+
+def _counting_solves(monkeypatch) -> list[int]:  # noqa: ANN001 - pytest's monkeypatch
+    """Every IPOPT call of the cycle NLPs from here on, by its iteration count."""
+    from planning.solver import ipopt
+
+    calls: list[int] = []
+    solve_nlp = ipopt.NLPSolver.solve
+
+    def counted(self, *args, **kwargs):  # noqa: ANN001, ANN002, ANN003, ANN202
+        result = solve_nlp(self, *args, **kwargs)
+        calls.append(result.iterations)
+        return result
+
+    monkeypatch.setattr(ipopt.NLPSolver, "solve", counted)
+    return calls
+
+
+def test_a_start_that_reaches_an_optimum_refined_before_takes_that_plan_without_refining_again(monkeypatch):
+    """Two free starts of the published case reach one first optimum: the second takes the first's refined plan
+    (issue 42) and the answer is the one with every start refined, to the last digit, in fewer IPOPT calls; a
+    neighbour's start that reaches a cold start's optimum likewise, the answer the cold solve's to the last digit."""
+    from planning.solver import search
+
+    case = read_case(PUBLISHED)
+    calls = _counting_solves(monkeypatch)
+    shared = solve(case)
+    shared_calls = len(calls)
+    with monkeypatch.context() as m:
+        m.setattr(search.Search, "_known", lambda self, key, x: None)  # every start refined on its own
+        calls.clear()
+        alone = solve(case)
+        alone_calls = len(calls)
+    assert shared.plan.spm == alone.plan.spm and shared.plan.nlp_values == alone.plan.nlp_values
+    assert shared_calls < alone_calls, (shared_calls, alone_calls)
+    calls.clear()
+    near = _edited(case, process={"transfer_time_s": 2.05})
+    cold = solve(near)
+    cold_calls = len(calls)
+    calls.clear()
+    from_neighbour = solve(near, neighbour=shared.plan)
+    assert from_neighbour.plan.nlp_values == cold.plan.nlp_values
+    assert len(calls) == cold_calls + 1, (len(calls), cold_calls)  # the neighbour's start: its first solve only

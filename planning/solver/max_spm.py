@@ -17,7 +17,7 @@ from planning.model.limits import BY_ID
 from planning.model.plan import Plan
 from planning.solver.halves_nlp import halves_nlp_for
 from planning.solver.neighbour import can_answer, can_start, known_evaluation, plan_of
-from planning.solver.search import Ran, Search, prepare
+from planning.solver.search import Optimum, Ran, Search, prepare
 from planning.solver.solution import Solution
 from planning.solver.starts import constant_speed, free_starts, published_starts
 from planning.solver.verify import evaluate
@@ -25,11 +25,17 @@ from planning.solver.verify import evaluate
 MOTOR_LIMITS = frozenset(limit.id for limit in BY_ID.values() if limit.motor)  # the motor's limits
 
 
-def solve_max_spm(case: Case, placement: Placement | None = None, neighbour: Plan | Solution | None = None) -> Solution:
+def solve_max_spm(
+    case: Case,
+    placement: Placement | None = None,
+    neighbour: Plan | Solution | None = None,
+    optima: list[Optimum] | None = None,
+) -> Solution:
     """The fastest verified cycle of ``case`` under its law with halves; ``neighbour``: a plan whose values
     start the multi-start (and which answers when it verifies here and beats the starts). Without a
-    neighbour: the cold solve (``planning.solver.optimize.solve`` compares the two)."""
-    search = prepare(case, placement or case.planner.placement)
+    neighbour: the cold solve (``planning.solver.optimize.solve`` compares the two). ``optima``: the first
+    optima another search of this case reached (``planning.solver.search.Optimum``; shared, added to)."""
+    search = prepare(case, placement or case.planner.placement, optima=optima)
     neighbour = adopt(search, neighbour)
     ran: tuple[Ran, ...] = ()
     if case.drive is not None and search.best is None:
@@ -63,7 +69,7 @@ def _kinematic_first(search: Search, neighbour: Plan | None, ran: tuple[Ran, ...
     ran = tuple(r for r in ran if r.found is not None)  # a probe that found no plan: its start runs again here
     nlp = halves_nlp_for(search.case, drive=False)
     # its own bounds and scales (the probe's NLP may be the denser variant by now); the probe's work and plan kept
-    carried = {k: getattr(search, k) for k in ("t_start", "iterations", "starts", "best", "best_score")}
+    carried = {k: getattr(search, k) for k in ("t_start", "iterations", "starts", "best", "best_score", "optima")}
     kinematic = replace(prepare(search.case, search.placement, nlp), **carried, stop_on=MOTOR_LIMITS)
     _multi_start(kinematic, neighbour, ran)
     search.iterations, search.starts = kinematic.iterations, kinematic.starts
@@ -133,11 +139,13 @@ def adopt(search: Search, neighbour: Plan | Solution | None) -> Plan | None:
     return plan if can_start(plan, search.case, search.placement) else None
 
 
-def from_neighbour(case: Case, placement: Placement | None, neighbour: Plan | Solution) -> Solution | None:
+def from_neighbour(
+    case: Case, placement: Placement | None, neighbour: Plan | Solution, optima: list[Optimum] | None = None
+) -> Solution | None:
     """The answer from ``neighbour`` alone: its plan when it holds here, and one start from its values
     (same placement rule); None when neither verifies. Fast, but not confirmed: the cold multi-start may
-    find a better optimum (``planning.solver.optimize.solve``)."""
-    search = prepare(case, placement or case.planner.placement)
+    find a better optimum (``planning.solver.optimize.solve``). ``optima``: as :func:`solve_max_spm`'s."""
+    search = prepare(case, placement or case.planner.placement, optima=optima)
     _follow(search, adopt(search, neighbour))
     return search.answer() if search.best is not None else None
 

@@ -47,16 +47,19 @@ def solve(
         return solve_at_rate(case, placement, plan_of(neighbour))
     if neighbour is None:
         return _cold(case, placement)
-    warm = _from_neighbour(case, placement, neighbour)
-    if follow and warm is not None:
+    if follow and (warm := _from_neighbour(case, placement, neighbour)) is not None:
         return warm
+    # the cold solve first, as if there were no neighbour (its plan the same to the last digit); the
+    # neighbour's start then takes over what a cold start already refined from the same first optimum
+    optima: list = []
     try:
-        cold = _cold(case, placement)
+        cold = _cold(case, placement, optima)
     except PlanningError:
+        warm = _from_neighbour(case, placement, neighbour, optima)
         if warm is None:
             raise
         return warm
-    return _better(cold, warm)
+    return _better(cold, _from_neighbour(case, placement, neighbour, optima))
 
 
 def solve_from(case: Case, neighbour: Plan | Solution, placement: Placement | None = None) -> Solution | None:
@@ -69,21 +72,27 @@ def solve_from(case: Case, neighbour: Plan | Solution, placement: Placement | No
     return _from_neighbour(case, placement, neighbour)
 
 
-def _cold(case: Case, placement: Placement | None) -> Solution:
-    """The cold solve of the case's law's transcription."""
-    return TRANSCRIPTIONS[get_law(case.planner.motion_law).transcription][0](case, placement)
+def _cold(case: Case, placement: Placement | None, optima: list | None = None) -> Solution:
+    """The cold solve of the case's law's transcription (``optima``: shared with the neighbour's search)."""
+    return TRANSCRIPTIONS[get_law(case.planner.motion_law).transcription][0](case, placement, None, optima)
 
 
-def _from_neighbour(case: Case, placement: Placement | None, neighbour: Plan | Solution) -> Solution | None:
+def _from_neighbour(
+    case: Case, placement: Placement | None, neighbour: Plan | Solution, optima: list | None = None
+) -> Solution | None:
     """The answer from a neighbour alone, by the case's law's transcription."""
-    return TRANSCRIPTIONS[get_law(case.planner.motion_law).transcription][1](case, placement, neighbour)
+    return TRANSCRIPTIONS[get_law(case.planner.motion_law).transcription][1](case, placement, neighbour, optima)
 
 
-# each transcription's cold solve and its answer from a neighbour (the optimal law's free profile is planned
-# whole, in free placement: it takes no placement)
+# each transcription's cold solve and its answer from a neighbour, both ``(case, placement, neighbour, optima)``
+# (the optimal law's free profile is planned whole, in free placement: it takes no placement, and its searches
+# share no optima)
 TRANSCRIPTIONS = {
     HALVES: (solve_max_spm, from_neighbour),
-    FREE: (lambda case, _: solve_optimal(case), lambda case, _, neighbour: from_neighbour_optimal(case, neighbour)),
+    FREE: (
+        lambda case, _, __, ___: solve_optimal(case),
+        lambda case, _, neighbour, __: from_neighbour_optimal(case, neighbour),
+    ),
 }
 
 

@@ -75,6 +75,7 @@ class Search:
     best_score: float = math.inf
     stop_on: frozenset[str] = frozenset()
     stopped: bool = False
+    optima: list[Optimum] = field(default_factory=list)  # the attempts' first optima (shared by one solve's searches)
 
     def parameter(self, name: str) -> int:
         """The position of the NLP parameter ``name`` in :attr:`parameters`."""
@@ -96,8 +97,10 @@ class Search:
         values = x0
         multipliers = None
         found: tuple[dict[str, float], float] | None = None
+        kept: Solution | None = None  # the plan of found
         loosened = False
         self.starts += 1
+        first: tuple[tuple, np.ndarray] | None = None
         for _ in range(REFINEMENTS + 2):
             res = self.nlp.solve(values, q, self.lbx, self.ubx, placement, self.scale, multipliers, self.fixed_period)
             self.iterations += res.iterations
@@ -115,7 +118,11 @@ class Search:
             if not res.success:
                 block, amount = self.nlp.worst_block(placement, res.g, self.fixed_period)
                 self.attempts.append(Attempt(res.return_status, block.name, amount, case_field=block.field))
-                return found
+                return self._remember(first, found, kept)
+            if first is None:  # the attempt's first optimum: one an earlier attempt reached refines the same way
+                first = (self._problem_key(q, placement), res.x)
+                if (known := self._known(*first)) is not None:
+                    return known
             plan = self.plan_of(values, placement, res.return_status)
             evaluation = evaluate(plan, self.case, least_energy=False)  # the answer's in full
             verification = evaluation.verification
@@ -124,10 +131,10 @@ class Search:
                 score = self.score_of(solution)
                 self.consider(solution, score)
                 if found is None or score < found[1]:
-                    found = (values, score)
+                    found, kept = (values, score), solution
                 room = None if loosened else self._room(res, verification)
                 if room is None:
-                    return found
+                    return self._remember(first, found, kept)
                 index, factor = room
                 q[index] *= factor * (1 - REFINE_MARGIN)
                 loosened = True
@@ -136,11 +143,11 @@ class Search:
             self.attempts.append(Attempt(check=bad[0], case_field=field_of_check(bad[0].id)))
             if any(c.id in self.stop_on for c in bad):
                 self.stopped = True
-                return found
+                return self._remember(first, found, kept)
             if any(c.id not in self.nlp.refinable for c in bad):
                 q = self._densify(bad, q)
                 if q is None:
-                    return found
+                    return self._remember(first, found, kept)
                 multipliers = None  # the denser NLP from the same values, its sampled limits as they were
                 continue
             for c in bad:  # tighten the NLP's sampled limit by the measured overshoot
@@ -156,6 +163,34 @@ class Search:
                     q[refine.index] *= (c.limit / max(c.value, 0.5 * c.limit)) * (1 + REFINE_MARGIN)
                 else:
                     q[refine.index] *= (c.limit / c.value) * (1 - REFINE_MARGIN)
+        return self._remember(first, found, kept)
+
+    def _problem_key(self, q: np.ndarray, placement: Placement) -> tuple:
+        """What makes one NLP problem: the compiled NLP, its parameters ``q``, bounds and scales, the placement
+        and whether the period is held (two attempts with the same key and first optimum refine alike)."""
+        arrays = (q, self.lbx, self.ubx, self.scale)
+        return (id(self.nlp), placement, self.fixed_period, *(np.asarray(a, dtype=float).tobytes() for a in arrays))
+
+    def _known(self, key: tuple, x: np.ndarray) -> tuple[dict[str, float], float] | None:
+        """What an earlier attempt found (verified values and score) from the same first optimum ``x`` of the
+        same problem (``key``), its plan now a candidate of this search too; None where none did. From one
+        optimum the refinements are the same re-solves: they would find the same plan again."""
+        for other in self.optima:
+            if other.key == key and other.x.size == x.size and _same_start(x, other.x):
+                self.consider(other.solution, other.found[1])
+                return other.found
+        return None
+
+    def _remember(
+        self,
+        first: tuple[tuple, np.ndarray] | None,
+        found: tuple[dict[str, float], float] | None,
+        kept: Solution | None,
+    ) -> tuple[dict[str, float], float] | None:
+        """Keep the attempt's first optimum with what it ``found`` and that verified plan ``kept`` (an attempt
+        that found none, or that stopped the search, is not kept: it runs again); returns ``found``."""
+        if first is not None and found is not None and kept is not None and not self.stopped:
+            self.optima.append(Optimum(*first, found, kept))
         return found
 
     def _shares(self, check: Check, plan: Plan, dense: Dense) -> dict[int, float]:
@@ -288,6 +323,17 @@ def _same_start(a: np.ndarray, b: np.ndarray) -> bool:
 
 
 @dataclass(frozen=True)
+class Optimum:
+    """An attempt's first optimum ``x`` (before any refinement) of the problem ``key``
+    (:meth:`Search._problem_key`), what the attempt ``found`` from it (verified values, score) and that plan."""
+
+    key: tuple
+    x: np.ndarray
+    found: tuple[dict[str, float], float]
+    solution: Solution
+
+
+@dataclass(frozen=True)
 class Ran:
     """A start already solved: its ``start`` values and what it ``found`` (verified values and score), or None."""
 
@@ -295,12 +341,18 @@ class Ran:
     found: tuple[dict[str, float], float] | None
 
 
-def prepare(case: Case, placement: Placement, nlp: CycleNLP | None = None) -> Search:
+def prepare(
+    case: Case, placement: Placement, nlp: CycleNLP | None = None, optima: list[Optimum] | None = None
+) -> Search:
     """Prechecks, the case's parameters, the variable bounds and scales of the compiled NLP: ``nlp``, or by
-    default the case's law's halves NLP (with the motor's rows when it has a drive)."""
+    default the case's law's halves NLP (with the motor's rows when it has a drive). ``optima``: the first
+    optima of another search of the same solve (a neighbour's start and the cold solve share them)."""
     t_start = time.perf_counter()
     w2_lo, w2_hi = precheck(case)
     nlp = nlp or halves_nlp_for(case)
     p = nlp.layout.values(case)
     lbx, ubx = nlp.variable_bounds(case, nlp.layout, w2_lo, w2_hi, p)
-    return Search(case, placement, nlp, p, lbx, ubx, nlp.variable_scales(case), (w2_lo, w2_hi), t_start)
+    search = Search(case, placement, nlp, p, lbx, ubx, nlp.variable_scales(case), (w2_lo, w2_hi), t_start)
+    if optima is not None:
+        search.optima = optima
+    return search
