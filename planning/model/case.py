@@ -989,7 +989,7 @@ def _pendulum_checks(case: Case) -> None:
 
 def _slide_draw_checks(case: Case) -> None:
     """A draw at constant slide speed: planned by the optimal law (its draw a free profile; a law's halves end at
-    a constant crank speed), without a given draw speed, a hold or (not yet) a drive or robots."""
+    a constant crank speed), without a given draw speed, a hold or (not yet) robots."""
     speed = case.process.draw_slide_speed_mm_s
     if speed is None:
         return
@@ -1003,10 +1003,8 @@ def _slide_draw_checks(case: Case) -> None:
             "limits.crank_jerk_rad_s3); a law with halves draws at a constant crank speed"
         )
         raise CaseError("planner.motion_law", reason, case.planner.motion_law)
-    for section in ("drive", "robots"):
-        if getattr(case, section) is not None:
-            reason = f"a draw at constant slide speed is planned without a {section}: section yet"
-            raise CaseError(section, reason, "given")
+    if case.robots is not None:
+        raise CaseError("robots", "a draw at constant slide speed is planned without a robots: section yet", "given")
 
 
 def _law_checks(case: Case) -> None:

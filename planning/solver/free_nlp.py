@@ -45,7 +45,13 @@ from planning.solver.nlp import (
     nlp_limits,
     sample_states,
 )
-from planning.solver.parameters import DRAW_SAMPLES_DRIVE, ParameterLayout, drive_links, time_limit
+from planning.solver.parameters import (
+    DRAW_SAMPLES_DRIVE,
+    FORMING_SAMPLES,
+    ParameterLayout,
+    drive_links,
+    time_limit,
+)
 from planning.tolerances import IPOPT_FREE_WARM_MU_INIT
 from press.mechanism import Formula
 
@@ -224,9 +230,9 @@ def _structure_rows(rows: Rows, s: dict[str, Any], v: dict, unit: dict, q: dict)
 
 
 def _all_samples(s: dict[str, Any], q: dict, w2: ca.MX, drive: bool) -> tuple[tuple, ca.MX, int, ca.MX]:
-    """The free profile's samples, then, with a drive, the draw's (the forming force is given at them; every
-    limit holds in the draw by the draw speed's bounds): the states, their times, the draw's count, and the
-    free profile's speeds alone."""
+    """The free profile's samples, then, with a drive and a draw at the constant w2, the draw's (the forming force
+    is given at them; every limit holds in the draw by the draw speed's bounds; a free draw's samples are the
+    profile's own): the states, their times, the draw's count, and the free profile's speeds alone."""
     th = ca.vertcat(*[sm[0] for sm in s["samples"]])
     om = ca.vertcat(*[sm[1] for sm in s["samples"]])
     al = ca.vertcat(*[sm[2] for sm in s["samples"]])
@@ -234,12 +240,23 @@ def _all_samples(s: dict[str, Any], q: dict, w2: ca.MX, drive: bool) -> tuple[tu
     if s["free_draw"]:  # a free draw's end, theta3 (a turn on), is a sample too: the last
         end = s["end"]
         states, t_all = tuple(ca.vertcat(x, e) for x, e in zip(states, end, strict=True)), ca.vertcat(t_all, s["t_end"])
-    if drive:
+    elif drive:
         count = DRAW_SAMPLES_DRIVE + 1
         th_d, om_d, al_d, since = draw_states(q, w2, ca.DM(np.linspace(0.0, 1.0, count)))
         states = (ca.vertcat(th, th_d), ca.vertcat(om, om_d), ca.vertcat(al, al_d))
         t_all = ca.vertcat(t_all, s["t_end"] + since)
     return states, t_all, count, om
+
+
+def _free_draw_forming(theta: ca.MX, count: int, layout: ParameterLayout, p_case: ca.MX, q: dict) -> ca.MX:
+    """The forming force [N] at every sample of a free draw (its last ``count`` samples; zero before them): the
+    case's force at the draw's fixed angles (the parameters ``layout.forming``, theta2 ... theta3 evenly), read
+    at each sample's share of the draw's angle by linear interpolation (the dense check reads the case's own)."""
+    drawn = theta[theta.shape[0] - count :]
+    share = ca.fmin(ca.fmax((drawn - drawn[0]) / (q["theta3"] - q["theta2"]), 0.0), 1.0)
+    table = ca.interpolant("forming_force", "linear", [np.linspace(0.0, 1.0, FORMING_SAMPLES)], 1)
+    force = table.map(count)(share.T, ca.repmat(p_case[layout.forming], 1, count)).T
+    return ca.vertcat(ca.DM.zeros(theta.shape[0] - count), force)
 
 
 def _robot_terms(
@@ -291,7 +308,9 @@ def _build(
     omu, omd = _structure_rows(rows, shot, v, unit, q)
     states, t_all, count, speeds = _all_samples(shot, q, w2, drive)
     free = draws_freely(phases)  # the draw a phase (sampled: its samples the last) or at the constant w2
-    samples, _, lift = sample_states(formula, layout, q, p_case, states, t_all, count)
+    free_count = dict(phases).get("draw", 0) * SAMPLES_PER_SEGMENT["draw"] + int(free)  # a free draw's, and its end
+    forming = _free_draw_forming(states[0], free_count, layout, p_case, q) if free and drive else None
+    samples, _, lift = sample_states(formula, layout, q, p_case, states, t_all, count, forming)
     period = shot["t_end"] if free else shot["t_end"] + (q["theta3"] - q["theta2"]) / w2
     nlp = Transcription(
         **samples,
@@ -305,7 +324,7 @@ def _build(
         crossings=[(omu, q["die_up_slope"]), (omd, q["die_down_slope"])],
         zone=True,
         rate=False,
-        free_draw_count=dict(phases).get("draw", 0) * SAMPLES_PER_SEGMENT["draw"] + int(free),  # and its end
+        free_draw_count=free_count,
         speed_unit=unit["draw_speed"],
     )
     refinable = add_limit_rows(rows, nlp, layout)

@@ -230,12 +230,15 @@ def drive_samples(
     al: Any,
     d1: Any,
     d2: Any,
+    forming: Any = None,
 ) -> DriveSamples:
     """The drive's torque at the samples; the forming force enters at the draw's samples, the last
-    :data:`~planning.solver.parameters.FORMING_SAMPLES`; the mechanism's massive links (``layout.links``) at
-    every sample through its ``frames`` (the lifted mechanism's, at its series' order; else computed here).
+    :data:`~planning.solver.parameters.FORMING_SAMPLES` (``forming``: the force [N] at every sample instead, a
+    free draw's); the mechanism's massive links (``layout.links``) at every sample through its ``frames`` (the
+    lifted mechanism's, at its series' order; else computed here).
     """
-    forming = ca.vertcat(ca.DM.zeros(om.shape[0] - FORMING_SAMPLES), p_case[layout.forming])
+    if forming is None:
+        forming = ca.vertcat(ca.DM.zeros(om.shape[0] - FORMING_SAMPLES), p_case[layout.forming])
     # the forming force enters as parameters at the draw's samples: no table, no forming window here
     links = tuple(LinkMass(name, *(q[link_parameter(name, part)] for part in LINK)) for name in layout.links)
     model = DriveModel(
@@ -263,7 +266,14 @@ def drive_samples(
 
 
 def sample_states(
-    formula: Formula, layout: ParameterLayout, q: dict, p_case: Any, states: tuple, times: Any, draw_count: int
+    formula: Formula,
+    layout: ParameterLayout,
+    q: dict,
+    p_case: Any,
+    states: tuple,
+    times: Any,
+    draw_count: int,
+    forming: Any = None,
 ) -> tuple[dict[str, Any], DriveSamples | None, Lift | None]:
     """What every transcription hands the limits of its samples (the crank's ``states`` ``(theta, omega,
     alpha)`` and their ``times``, the draw's ``draw_count`` last): with the mechanism's height and its first
@@ -280,7 +290,9 @@ def sample_states(
     else:
         h, d1, d2, _ = formula.jets(theta, geometry)
         frames = None  # computed where the drive's links need them
-    torque = drive_samples(q, p_case, layout, theta, lift, frames, omega, alpha, d1, d2) if layout.drive else None
+    torque = None
+    if layout.drive:
+        torque = drive_samples(q, p_case, layout, theta, lift, frames, omega, alpha, d1, d2, forming)
     fields = {
         "theta": theta,
         "omega": omega,
