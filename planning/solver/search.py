@@ -6,11 +6,13 @@ parameters and the variables' bounds and scales, and the best verified plan so f
 limits the NLP holds at samples fail between them, their sampled limits are tightened by the measured
 overshoot (the slide's acceleration segment by segment: :meth:`Search._shares`) and the start re-solved
 warm; where an NLP row that can overstate its figure is active while the exact figure leaves room, that row
-is loosened once by the room. Starts run until two agree on the optimum (:meth:`Search.multi_start`; with
-``confirm`` False until one verifies). Without a verified plan the answer is a typed outcome
-(``planning.solver.outcomes``). The max-SPM solve of the laws (``planning.solver.max_spm``), the
-optimal law (``planning.solver.optimal``) and the objectives at a rate (``planning.solver.objectives``)
-all run on it.
+is loosened once by the room. A start whose first optimum (before any refinement) an earlier start of the same
+problem reached takes that start's refined plan (:class:`Optimum`): the refinements from one optimum repeat
+themselves; the searches of one solve may share them (a neighbour's start and the cold solve's starts). Starts
+run until two agree on the optimum (:meth:`Search.multi_start`; with ``confirm`` False until one verifies).
+Without a verified plan the answer is a typed outcome (``planning.solver.outcomes``). The max-SPM solve of
+the laws (``planning.solver.max_spm``), the optimal law (``planning.solver.optimal``) and the objectives at a
+rate (``planning.solver.objectives``) all run on it.
 """
 
 from __future__ import annotations
