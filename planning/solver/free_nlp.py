@@ -378,8 +378,9 @@ def free_nlp(
     return _build(formula, limit_ids, drive, links, phases)
 
 
-def free_nlp_for(case: Case, phases: Layout = PHASES) -> CycleNLP:
-    """The optimal law's NLP of ``case``'s mechanism and limits, with the motor's rows when it has a drive."""
-    drive = case.drive is not None
+def free_nlp_for(case: Case, phases: Layout = PHASES, drive: bool = True) -> CycleNLP:
+    """The optimal law's NLP of ``case``'s mechanism and limits, with the motor's rows when it has a drive (and
+    ``drive``)."""
+    drive = drive and case.drive is not None
     links = drive_links(case) if drive else ()
     return free_nlp(case.machine.formula, nlp_limits(case, drive), drive, links, phases)

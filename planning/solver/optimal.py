@@ -102,10 +102,11 @@ def _layout_of(plan: Plan, case: Case) -> Layout:
     return layout
 
 
-def _search(case: Case, phases: Layout | None = None) -> Search:
+def _search(case: Case, phases: Layout | None = None, drive: bool = True) -> Search:
     """The optimal law's search on the phases' ``layout`` (the case's first by default): prechecks, parameters,
-    bounds, scales; the minimum crank speed backed off."""
-    search = prepare(case, "free", free_nlp_for(case, phases or first_layout(case.free_draw)))
+    bounds, scales; the minimum crank speed backed off. ``drive`` False: the NLP without the motor's rows (its
+    plans verified against the whole case, motor included)."""
+    search = prepare(case, "free", free_nlp_for(case, phases or first_layout(case.free_draw), drive))
     search.parameters = search.parameters.copy()
     search.parameters[search.parameter("min_crank_speed")] *= 1 + MIN_SPEED_BACKOFF
     return search
@@ -154,8 +155,31 @@ def solve_optimal(case: Case, neighbour: Plan | Solution | None = None) -> Solut
     seed = converged_plan(seeded) or solve_max_spm(seeded, "free").plan
     search.iterations += seed.solver.iterations
     search.starts += seed.solver.starts
-    search.multi_start([seed_values(seed, first_layout(case.free_draw))], "free", confirm=False)
+    start = seed_values(seed, first_layout(case.free_draw))
+    starts = [start] + ([] if case.drive is None else _kinematic_candidate(search, start))
+    for values in starts:  # each start runs (the better verified plan kept)
+        search.multi_start([values], "free", confirm=False)
     return _on_the_finer_layout(case, search)
+
+
+def _kinematic_candidate(search: Search, start: dict[str, float]) -> list[dict[str, float]]:
+    """A case with a drive: the optimum of the NLP without the motor's rows from ``start``, a candidate of
+    ``search`` where the motor can drive it (its verification, motor included, passes), and a start of the drive
+    NLP (one item; none where that NLP found no optimum). The motor's limits only take plans away: where they
+    do not bind, the kinematic optimum is the drive problem's too, which the drive NLP's own start may miss
+    (another local optimum); where they bind, a start from it may reach a plan the seed's does not."""
+    kinematic = _search(search.case, drive=False)
+    res = kinematic.nlp.solve(start, kinematic.parameters, kinematic.lbx, kinematic.ubx, "free", kinematic.scale)
+    search.iterations += res.iterations
+    if not res.success:
+        return []
+    values = kinematic.nlp.values_of(res)
+    kinematic.attempt(values, "free")
+    search.iterations += kinematic.iterations
+    search.starts += kinematic.starts
+    if kinematic.best is not None:
+        search.consider(kinematic.best, kinematic.best_score)
+    return [values]
 
 
 def _on_the_finer_layout(case: Case, search: Search) -> Solution:
