@@ -221,3 +221,18 @@ def test_a_plan_the_motor_can_drive_is_not_lost_to_the_drive_nlp():
     assert evaluate(kinematic.plan, drive).verification.passed
     answer = solve(drive)
     assert answer.verification.passed and answer.plan.spm >= kinematic.plan.spm * (1 - 1e-9)
+
+
+def test_robots_with_a_slide_speed_draw_are_refused_in_one_line_naming_the_section(tmp_path, capsys):
+    """Not yet planned together: ``robots:`` with ``process.draw_slide_speed_mm_s``, one line, exit 2."""
+    import yaml
+
+    data = yaml.safe_load((ROOT / "cases" / "wang2023-side-panel-robots.yaml").read_text())
+    data["process"] = {"draw_slide_speed_mm_s": 100}
+    data["planner"] = {"motion_law": "optimal"}
+    data["limits"]["crank_jerk_rad_s3"] = 40
+    path = tmp_path / "robots.yaml"
+    path.write_text(yaml.safe_dump(data))
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == f"pressplan: {path}: robots: a draw at constant slide speed is planned without a robots: section yet"

@@ -1004,7 +1004,8 @@ def _slide_draw_checks(case: Case) -> None:
         )
         raise CaseError("planner.motion_law", reason, case.planner.motion_law)
     if case.robots is not None:
-        raise CaseError("robots", "a draw at constant slide speed is planned without a robots: section yet", "given")
+        reason = "a draw at constant slide speed is planned without a robots: section yet"
+        raise CaseError("robots", reason, None, False)
 
 
 def _law_checks(case: Case) -> None:
