@@ -236,3 +236,31 @@ def test_robots_with_a_slide_speed_draw_are_refused_in_one_line_naming_the_secti
     assert main(["check", str(path)]) == 2
     err = capsys.readouterr().err.strip()
     assert err == f"pressplan: {path}: robots: a draw at constant slide speed is planned without a robots: section yet"
+
+
+def test_what_caps_the_draw_names_the_motor_where_its_torque_meets_its_envelope():
+    """``capping``: the limits within 0.1 % of their value in the draw outside the stretch held; with a drive the
+    motor's torque against its envelope (``peak x base / speed`` above the base speed) and its top speed. On a
+    made-up dense grid: the torque at 99.95 % of the envelope above the base speed inside the spans is named, at
+    99.8 % it is not, and outside the spans never."""
+    from types import SimpleNamespace
+
+    from planning.reports.report import capping
+
+    case = shipped(DRIVE_CUP)
+    motor = case.drive.motor
+    t = np.linspace(0.0, 1.0, 101)
+    speed = np.full(t.size, 1.5 * motor.base_speed_rpm * RPM)  # above the base speed: the envelope is peak / 1.5
+    zeros = np.zeros(t.size)
+
+    def dense(share: float, at: int) -> SimpleNamespace:
+        torque = zeros.copy()
+        torque[at] = share * motor.peak_torque_Nm / 1.5
+        state = {"motor_speed_rad_s": speed, "motor_torque_Nm": torque}
+        return SimpleNamespace(t=t, omega=zeros, alpha=zeros, jerk=zeros, a=zeros, h=zeros + 50.0, v=zeros,
+                               drive_state=state)
+
+    spans = [(0.0, 0.2), (0.6, 1.0)]
+    assert capping(dense(0.9995, 10), case, spans) == ["drive.motor.peak_torque_Nm"]
+    assert capping(dense(0.998, 10), case, spans) == []
+    assert capping(dense(0.9995, 40), case, spans) == []

@@ -313,13 +313,14 @@ def _plan_lines(r: dict[str, Any]) -> list[str]:
 
 
 def _slide_draw_lines(r: dict[str, Any]) -> list[str]:
-    """A draw at constant slide speed: where the plan holds it, and what caps it beyond (none without one)."""
+    """A draw at constant slide speed: where the plan holds it, and what caps it in the rest of the draw (none
+    without one)."""
     d = r.get("draw_slide_speed")
     if not d:
         return []
     if d["held_from_deg"] is None:
         return [f"  draw at {d['set_mm_s']:g} mm/s slide speed: never within 0.1 % of it (the crank's limits)"]
-    capped = f"; beyond, {', '.join(d['capped_by'])} cap it" if d["capped_by"] else ""
+    capped = f"; elsewhere in the draw, {', '.join(d['capped_by'])} cap it" if d["capped_by"] else ""
     return [
         f"  draw at {d['set_mm_s']:g} mm/s slide speed: within 0.1 % from {d['held_from_deg']:.2f} to "
         f"{d['held_to_deg']:.2f} deg ({d['held_share_pct']:.0f} % of the draw's angle){capped}"
@@ -363,37 +364,50 @@ def hold_block(plan: Plan, case: Case) -> dict[str, float]:
 def slide_draw_block(solution: Any, case: Case) -> dict[str, Any]:
     """``result.json``'s draw at constant slide speed: the set speed [mm/s], the longest stretch of the draw the
     plan holds it within :data:`~planning.tolerances.DRAW_SPEED_BAND` (``held_from_deg`` ... ``held_to_deg``, its
-    share of the draw's angle) and the limits binding in the draw after it (the crank's, which cap it)."""
+    share of the draw's angle) and the limits binding in the rest of the draw (the crank's and the motor's, which
+    cap it there)."""
     dense = solution.evaluation.samples
     run = held_band(case, dense.theta, dense.v)
     _, th2, th3, _ = case.key_angles
-    t3 = float(dense.key_times[2])
+    t2, t3 = float(dense.key_times[1]), float(dense.key_times[2])
     if run is None:
-        held, share, after = (None, None), 0.0, float(dense.key_times[1])
+        held, share, rest = (None, None), 0.0, [(t2, t3)]
     else:
         ends = np.mod(dense.theta[list(run)], 2 * math.pi)
-        held, share, after = tuple(np.degrees(ends).tolist()), 100 * (ends[1] - ends[0]) / (th3 - th2), dense.t[run[1]]
+        held, share = tuple(np.degrees(ends).tolist()), 100 * (ends[1] - ends[0]) / (th3 - th2)
+        rest = [(t2, float(dense.t[run[0]])), (float(dense.t[run[1]]), t3)]
     return {
         "set_mm_s": case.process.draw_slide_speed_mm_s,
         "held_from_deg": held[0],
         "held_to_deg": held[1],
         "held_share_pct": float(share),
-        "capped_by": capping(dense, case, after, t3),
+        "capped_by": capping(dense, case, rest),
     }
 
 
-def capping(dense: Any, case: Case, start_s: float, end_s: float) -> list[str]:
-    """The crank's and the slide's limits (case fields) within :data:`~planning.tolerances.CAP_SHARE` of their
-    value somewhere from ``start_s`` to ``end_s`` [s from TDC]: what caps a draw at constant slide speed."""
+def capping(dense: Any, case: Case, spans: list[tuple[float, float]]) -> list[str]:
+    """The crank's, the slide's and the motor's limits (case fields) within :data:`~planning.tolerances.CAP_SHARE`
+    of their value somewhere in the ``spans`` ``(start, end)`` [s from TDC]: what caps a draw at constant slide
+    speed (the motor's torque against its envelope, which falls as ``base / speed`` above the base speed)."""
     lim = case.limits
-    window = (dense.t >= start_s) & (dense.t <= end_s)
-    figures = (
+    window = np.zeros(dense.t.shape, dtype=bool)
+    for start_s, end_s in spans:
+        window |= (dense.t >= start_s) & (dense.t <= end_s)
+    figures = [
         ("limits.crank_speed_rpm", np.abs(dense.omega) / RPM, lim.crank_speed_rpm),
         ("limits.crank_accel_rad_s2", np.abs(dense.alpha), lim.crank_accel_rad_s2),
         ("limits.crank_jerk_rad_s3", np.abs(dense.jerk), lim.crank_jerk_rad_s3),
         ("limits.slider_accel_mm_s2", np.abs(dense.a), lim.slider_accel_mm_s2),
         ("limits.die_speed_mm_s", np.where(dense.h <= lim.die_height_mm, np.abs(dense.v), 0.0), lim.die_speed_mm_s),
-    )
+    ]
+    if dense.drive_state is not None:
+        motor, speed = case.drive.motor, np.abs(dense.drive_state["motor_speed_rad_s"])
+        above_base = np.maximum(1.0, speed / (motor.base_speed_rpm * RPM))
+        torque = np.abs(dense.drive_state["motor_torque_Nm"]) * above_base
+        figures += [
+            ("drive.motor.peak_torque_Nm", torque, motor.peak_torque_Nm),
+            ("drive.motor.max_speed_rpm", speed / RPM, motor.max_speed_rpm),
+        ]
     return [
         name
         for name, values, limit in figures
