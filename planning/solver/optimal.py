@@ -5,7 +5,9 @@ that converges, neither verified nor confirmed as the optimum: a start needs no 
 phases' grids (the bound's profile has no jerk limit and is a poorer start); a neighbouring case's
 optimal plan (a sweep, a looser limit) starts first and, when it holds here, is a candidate answer. The
 minimum crank speed is held :data:`MIN_SPEED_BACKOFF` above its limit at the samples. The plans are
-verified densely like every other.
+verified densely like every other. A draw at constant slide speed with a drive is seeded without the drive,
+and its NLP is also solved without the motor's rows: that plan is a candidate where the motor can drive it,
+and a second start of the drive NLP (the motor's limits only take plans away).
 
 The layout of equal segments per phase (``planning.model.free_profile.PHASES``) cannot follow the arcs
 where the slider acceleration sits at its limit when the jerk limit is high (there the optimum's
@@ -73,7 +75,8 @@ def seed_values(seed: Plan, phases: Layout = PHASES) -> dict[str, float]:
 def seed_case(case: Case) -> Case:
     """The case the seed law plans the start of: ``case`` under :data:`SEED_LAW`; a draw at constant slide
     speed v drawn instead at the constant crank speed at which the slide reaches v where the draw's ``|h'|`` is
-    largest (never faster than v; at least the least crank speed, at most the highest the limits allow)."""
+    largest (never faster than v; at least the least crank speed, at most the highest the limits allow), and
+    without its drive (a start only: a motor that cannot draw at one crank speed may draw at the slide's)."""
     if not case.free_draw:
         return case.with_law(SEED_LAW)
     draw = Draw.of(case)
@@ -82,7 +85,7 @@ def seed_case(case: Case) -> Case:
     speed = max(min(speed, highest), case.limits.min_crank_speed_rpm * RPM)
     process = case.process.model_copy(update={"draw_slide_speed_mm_s": None, "draw_speed_rpm": speed / RPM})
     planner = case.planner.model_copy(update={"motion_law": SEED_LAW, "law_parameter": None})
-    return case.model_copy(update={"process": process, "planner": planner})
+    return case.model_copy(update={"process": process, "planner": planner, "drive": None})
 
 
 def from_neighbour_optimal(case: Case, neighbour: Plan | Solution) -> Solution | None:
@@ -156,14 +159,15 @@ def solve_optimal(case: Case, neighbour: Plan | Solution | None = None) -> Solut
     search.iterations += seed.solver.iterations
     search.starts += seed.solver.starts
     start = seed_values(seed, first_layout(case.free_draw))
-    starts = [start] + ([] if case.drive is None else _kinematic_candidate(search, start))
+    starts = [start] + (_kinematic_candidate(search, start) if case.drive is not None and case.free_draw else [])
     for values in starts:  # each start runs (the better verified plan kept)
         search.multi_start([values], "free", confirm=False)
     return _on_the_finer_layout(case, search)
 
 
 def _kinematic_candidate(search: Search, start: dict[str, float]) -> list[dict[str, float]]:
-    """A case with a drive: the optimum of the NLP without the motor's rows from ``start``, a candidate of
+    """A draw at constant slide speed with a drive: the optimum of the NLP without the motor's rows from ``start``
+    (whose seed law planned the case without its drive), a candidate of
     ``search`` where the motor can drive it (its verification, motor included, passes), and a start of the drive
     NLP (one item; none where that NLP found no optimum). The motor's limits only take plans away: where they
     do not bind, the kinematic optimum is the drive problem's too, which the drive NLP's own start may miss

@@ -47,9 +47,10 @@ def solve(
         return solve_at_rate(case, placement, plan_of(neighbour))
     if neighbour is None:
         return _cold(case, placement)
-    if follow and (warm := _from_neighbour(case, placement, neighbour)) is not None:
-        return warm
-    # the cold solve first, as if there were no neighbour (its plan the same to the last digit); the
+    if follow:  # the neighbour's answer alone, else the cold solve's
+        warm = _from_neighbour(case, placement, neighbour)
+        return warm if warm is not None else _cold(case, placement)
+    # the cold solve first, as if there were no neighbour (its plan the one it finds alone, to round-off); the
     # neighbour's start then takes over what a cold start already refined from the same first optimum
     optima: list = []
     try:

@@ -168,17 +168,19 @@ class Search:
         return self._remember(first, found, kept)
 
     def _problem_key(self, q: np.ndarray, placement: Placement) -> tuple:
-        """What makes one NLP problem: the compiled NLP, its parameters ``q``, bounds and scales, the placement
-        and whether the period is held (two attempts with the same key and first optimum refine alike)."""
+        """What makes one NLP problem and its search: the compiled NLP (the object: compared by identity), its
+        parameters ``q``, bounds and scales, the placement, whether the period is held, the checks that stop the
+        search and the score (two attempts with the same key and first optimum refine alike)."""
         arrays = (q, self.lbx, self.ubx, self.scale)
-        return (id(self.nlp), placement, self.fixed_period, *(np.asarray(a, dtype=float).tobytes() for a in arrays))
+        settings = (placement, self.fixed_period, self.stop_on, self.score)
+        return (self.nlp, *settings, *(np.asarray(a, dtype=float).tobytes() for a in arrays))
 
     def _known(self, key: tuple, x: np.ndarray) -> tuple[dict[str, float], float] | None:
         """What an earlier attempt found (verified values and score) from the same first optimum ``x`` of the
         same problem (``key``), its plan now a candidate of this search too; None where none did. From one
         optimum the refinements are the same re-solves: they would find the same plan again."""
         for other in self.optima:
-            if other.key == key and other.x.size == x.size and _same_start(x, other.x):
+            if _same_key(other.key, key) and _same_start(x, other.x):
                 self.consider(other.solution, other.found[1])
                 return other.found
         return None
@@ -316,6 +318,11 @@ class Search:
             plan = replace(plan, placement="free")
         info = SolverInfo(self.iterations, time.perf_counter() - self.t_start, self.starts, plan.solver.status)
         return replace(self.best, plan=replace(plan, solver=info))
+
+
+def _same_key(a: tuple, b: tuple) -> bool:
+    """Two problem keys (:meth:`Search._problem_key`) the same: the one NLP object, equal settings and arrays."""
+    return len(a) == len(b) and a[0] is b[0] and all(x == y for x, y in zip(a[1:], b[1:], strict=True))
 
 
 def _same_start(a: np.ndarray, b: np.ndarray) -> bool:

@@ -157,9 +157,12 @@ class CrankTorqueLimit(Limit):
 
     def precheck(self, case: Any, given: float | None, lowest: float) -> Impossible | None:
         """At constant speed the draw needs the forming force's torque (and the slide's weight less the
-        counterbalance): the crank cannot give it even at the lowest draw speed the case allows."""
+        counterbalance): the crank cannot give it even at the lowest draw speed the case allows. A draw at
+        constant slide speed (a free draw) need not turn at one speed: no bound from it (the dense check decides)."""
         from planning.model.limits.motor import draw_drive_state
 
+        if case.free_draw:
+            return None
         w2 = given if given is not None else lowest
         theta, state = draw_drive_state(case, w2)
         torque = np.abs(state["crank_torque_Nm"]) / 1e3

@@ -101,7 +101,10 @@ class MotorPeakTorqueLimit(Limit):
 
     def precheck(self, case: Any, given: float | None, lowest: float) -> Impossible | None:
         """At constant speed the draw needs the most torque where the forming force acts on the longest
-        lever: the motor cannot make the draw even at the lowest draw speed the case allows."""
+        lever: the motor cannot make the draw even at the lowest draw speed the case allows. A draw at constant
+        slide speed (a free draw) need not turn at one speed: no bound from it (the dense check decides)."""
+        if case.free_draw:
+            return None
         motor = case.drive.motor
         w2 = given if given is not None else lowest
         theta, state = draw_drive_state(case, w2)
