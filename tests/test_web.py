@@ -926,3 +926,31 @@ def _choose_with_mouse_and_keys(page, selector: str, value: str) -> None:  # noq
         page.keyboard.press("ArrowDown" if steps > 0 else "ArrowUp")
     page.keyboard.press("Enter")
     assert page.locator(selector).input_value() == value
+
+
+@browser
+def test_a_confirmed_answer_with_the_fast_answers_charts_is_not_drawn_again(site, page) -> None:
+    """An edit's fast answer is drawn; its confirmed answer, when its charts are the same (curves, limit lines,
+    strokes, key points), only marks the plan confirmed: the charts are drawn once for the edit, and what they
+    show is the confirmed answer's (the server's confirmed solve of the same case, asked again here)."""
+    import urllib.request
+
+    url, _ = site
+    draws = page.evaluate("window.chartDraws")
+    edit(page, "key_points.draw_start_deg", "132.2")
+    data = published_data()
+    data["key_points"]["draw_start_deg"] = 132.2
+    body = json.dumps({"session": "a-check", "seq": 1, "case": data, "confirm": True}).encode()
+    request = urllib.request.Request(url + "/api/solve", body, {"Content-Type": "application/json"})
+    with urllib.request.urlopen(request, timeout=60) as response:
+        confirmed = json.load(response)
+    assert confirmed["confirmed"] and page.evaluate("document.body.dataset.state") == "ready"
+    shown = page.evaluate("document.getElementById('motion-chart').data.map((t) => [t.name, t.y])")
+    curves = [v for v in confirmed["curves"].values() if isinstance(v, list)]
+
+    def same(y: list, v: list) -> bool:  # the page's own rule: within 1e-9 of the larger value (or of 1)
+        return len(y) == len(v) and all(abs(a - b) <= 1e-9 * max(1, abs(a), abs(b)) for a, b in zip(y, v, strict=True))
+
+    plotted = [(name, y) for name, y in shown if y and len(y) == len(curves[0]) and "=" not in name]  # not limits
+    assert len(plotted) >= 3 and all(any(same(y, v) for v in curves) for _, y in plotted), [n for n, _ in plotted]
+    assert page.evaluate("window.chartDraws") - draws == 1
