@@ -167,11 +167,11 @@ def solve_optimal(case: Case, neighbour: Plan | Solution | None = None) -> Solut
 
 def _kinematic_candidate(search: Search, start: dict[str, float]) -> list[dict[str, float]]:
     """A draw at constant slide speed with a drive: the optimum of the NLP without the motor's rows from ``start``
-    (whose seed law planned the case without its drive), a candidate of
-    ``search`` where the motor can drive it (its verification, motor included, passes), and a start of the drive
-    NLP (one item; none where that NLP found no optimum). The motor's limits only take plans away: where they
-    do not bind, the kinematic optimum is the drive problem's too, which the drive NLP's own start may miss
-    (another local optimum); where they bind, a start from it may reach a plan the seed's does not."""
+    (whose seed law planned the case without its drive), refined and verified against the whole case, motor
+    included: a candidate of ``search`` where it passes; returned as a start of the drive NLP (one item; none
+    where that NLP found no optimum). The motor's limits only take plans away: where they do not bind, the
+    kinematic optimum is the drive problem's too, which the drive NLP's own start may miss (another local
+    optimum); where they bind, a start from it may reach a plan the seed's does not."""
     kinematic = _search(search.case, drive=False)
     res = kinematic.nlp.solve(start, kinematic.parameters, kinematic.lbx, kinematic.ubx, "free", kinematic.scale)
     search.iterations += res.iterations

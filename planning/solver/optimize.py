@@ -91,8 +91,8 @@ def _from_neighbour(
 TRANSCRIPTIONS = {
     HALVES: (solve_max_spm, from_neighbour),
     FREE: (
-        lambda case, _, __, ___: solve_optimal(case),
-        lambda case, _, neighbour, __: from_neighbour_optimal(case, neighbour),
+        lambda case, _placement, _neighbour, _optima: solve_optimal(case),
+        lambda case, _placement, neighbour, _optima: from_neighbour_optimal(case, neighbour),
     ),
 }
 
