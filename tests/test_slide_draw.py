@@ -263,3 +263,16 @@ def test_what_caps_the_draw_names_the_motor_where_its_torque_meets_its_envelope(
     assert capping(dense(0.9995, 10), case, spans) == ["drive.motor.peak_torque_Nm"]
     assert capping(dense(0.998, 10), case, spans) == []
     assert capping(dense(0.9995, 40), case, spans) == []
+
+
+def test_check_lets_a_slide_enter_a_draw_faster_than_its_start_limit_at_that_limit(capsys):
+    """A set slide speed above ``limits.draw_start_speed_mm_s``: the slide enters the draw at that limit and speeds
+    up (the plan does: an outside trial's 400 mm/s cup planned verified while ``check`` printed a FAIL); ``check``
+    passes the draw start at the limit, says so, and gives the crank's speed at theta2 for it, ``350 / |h'|``."""
+    assert main(["check", str(DRIVE_CUP), "--set", "process.draw_slide_speed_mm_s=400"]) == 0
+    out = capsys.readouterr().out
+    assert "PASS  slider speed at draw start <= limits.draw_start_speed_mm_s: 350.0 mm/s" in out
+    assert "draw at 400 mm/s slide speed (the slide enters at the draw-start limit, 350 mm/s, and speeds up" in out
+    case = shipped(DRIVE_CUP)
+    slope = abs(float(case.machine.derivatives(case.key_angles[1])[0]))
+    assert f"the crank at {350 / slope / RPM:.3f} rpm at theta2" in out

@@ -27,8 +27,10 @@ def check_case(case: Case) -> dict[str, Any]:
     bounds = draw_speed_bounds(case)
     w_max = min(bounds.values())
     w2 = case.process.draw_speed_rpm * RPM if case.process.draw_speed_rpm is not None else w_max
-    if case.free_draw:  # the crank's speed at theta2 where the slide enters the draw at its set speed
-        w2 = case.process.draw_slide_speed_mm_s / abs(float(m.derivatives(case.key_angles[1])[0]))
+    if case.free_draw:  # the crank's speed at theta2 where the slide enters the draw at its set speed, or at the
+        # draw-start limit where that is lower (the draw then speeds up to its set speed: the plan's NLP holds both)
+        entry = min(x for x in (case.process.draw_slide_speed_mm_s, case.limits.draw_start_speed_mm_s) if x)
+        w2 = entry / abs(float(m.derivatives(case.key_angles[1])[0]))
     th = case.key_angles
     h, v, _, _ = m.slider(th, w2)
     points = [
@@ -91,16 +93,19 @@ def _pendulum(case: Case) -> dict[str, Any]:
 
 
 def _slide_draw(case: Case, draw: Draw) -> dict[str, Any]:
-    """A draw at constant slide speed v: the crank's speed it asks, ``v / |dh/dtheta|``, at theta2 and its
-    highest over the draw [rpm], and the first angle [deg] where that is above the crank's top speed (the
+    """A draw at constant slide speed v: the slide's speed at theta2 (v, or the draw-start limit where that is
+    lower: the draw then speeds up to v) and the crank's there [rpm], the crank's speed v asks, ``v / |dh/dtheta|``,
+    at its highest over the draw [rpm], and the first angle [deg] where that is above the crank's top speed (the
     limits' lowest, ``Limit.top_crank_speed``), or None: from there the crank's limits cap the slide's speed."""
     v = case.process.draw_slide_speed_mm_s
     asked = v / np.maximum(np.abs(draw.d1), TINY)
     tops = [t for limit in limits_of(case) if (t := limit.top_crank_speed(case)) is not None]
     over = np.flatnonzero(asked > min(tops)) if tops else np.array([], dtype=int)
+    enters = min(v, case.limits.draw_start_speed_mm_s or v)  # the slide at theta2: at most the draw-start limit
     return {
         "set_mm_s": v,
-        "crank_at_draw_start_rpm": float(asked[0]) / RPM,
+        "enters_mm_s": enters,
+        "crank_at_draw_start_rpm": float(asked[0] * enters / v) / RPM,
         "highest_asked_rpm": float(np.max(asked)) / RPM,
         "capped_from_deg": float(math.degrees(draw.theta[over[0]])) if over.size else None,
     }
@@ -184,9 +189,15 @@ def check_text(report: dict[str, Any]) -> str:
             if slide["capped_from_deg"] is not None
             else ""
         )
+        enters = (
+            f" (the slide enters at the draw-start limit, {slide['enters_mm_s']:g} mm/s, and speeds up to it)"
+            if slide["enters_mm_s"] < slide["set_mm_s"]
+            else ""
+        )
         lines.append(
-            f"  draw at {slide['set_mm_s']:g} mm/s slide speed: the crank at {slide['crank_at_draw_start_rpm']:.3f} rpm"
-            f" at theta2, asked up to {slide['highest_asked_rpm']:.4g} rpm in the draw{capped}"
+            f"  draw at {slide['set_mm_s']:g} mm/s slide speed{enters}: the crank at "
+            f"{slide['crank_at_draw_start_rpm']:.3f} rpm at theta2, asked up to {slide['highest_asked_rpm']:.4g} rpm "
+            f"in the draw{capped}"
         )
     swing = report.get("pendulum")
     if swing:
