@@ -28,6 +28,7 @@ from planning.reports.stages import stage_table
 from planning.solver.solution import ENERGY, GRID_PEAK, Solution
 from planning.solver.verify import Evaluation
 from planning.tolerances import BINDING_SHARE, CAP_SHARE, KNOT_TIME_S, SAME_RELATIVE
+from press.dynamics import envelope_torque
 from press.mechanism import Mechanism
 
 TRAJECTORY_COLUMNS = (
@@ -402,8 +403,8 @@ def capping(dense: Any, case: Case, spans: list[tuple[float, float]]) -> list[st
     ]
     if dense.drive_state is not None:
         motor, speed = case.drive.motor, np.abs(dense.drive_state["motor_speed_rad_s"])
-        above_base = np.maximum(1.0, speed / (motor.base_speed_rpm * RPM))
-        torque = np.abs(dense.drive_state["motor_torque_Nm"]) * above_base
+        envelope = envelope_torque(speed, motor.peak_torque_Nm, motor.base_speed_rpm * RPM)
+        torque = np.abs(dense.drive_state["motor_torque_Nm"]) * motor.peak_torque_Nm / envelope  # the envelope's use
         figures += [
             ("drive.motor.peak_torque_Nm", torque, motor.peak_torque_Nm),
             ("drive.motor.max_speed_rpm", speed / RPM, motor.max_speed_rpm),

@@ -3,7 +3,8 @@
 The draw runs at constant crank speed, so every limit that holds in the draw bounds the draw speed
 (``Limit.draw_speed_bound``); the lowest of those bounds is the highest draw speed, the minimum crank
 speed the lowest. A case whose range is empty, or whose limits fail their own prechecks
-(``Limit.precheck``), is :class:`~planning.solver.outcomes.Infeasible` before any solve.
+(``Limit.precheck``; for a draw at constant slide speed not those that read the draw at one crank speed,
+``Limit.precheck_at_one_draw_speed``), is :class:`~planning.solver.outcomes.Infeasible` before any solve.
 """
 
 from __future__ import annotations
@@ -23,6 +24,8 @@ def precheck(case: Case) -> tuple[float, float]:
     given = case.process.draw_speed_rpm * RPM if case.process.draw_speed_rpm is not None else None
     highest = min(bounds.values())
     for limit in limits_of(case):
+        if case.free_draw and limit.precheck_at_one_draw_speed:
+            continue  # a draw at constant slide speed: its crank need not turn at one speed
         impossible = limit.precheck(case, given, w_min)
         if impossible is not None:
             raise Infeasible(

@@ -344,7 +344,9 @@ class Limit:
     the samples: drive NLPs only), ``refuses_draw_speed_above_bound`` (a draw speed given in the case above
     the limit's bound is an error in the case, exit 2, rather than an infeasible plan), ``goal`` (a goal of
     the plan, such as a target rate, rather than a limit of the press or the process: a cam, which an
-    operator may run faster or slower, is not held to it). Every method has a default that does nothing."""
+    operator may run faster or slower, is not held to it), ``precheck_at_one_draw_speed`` (its precheck reads the
+    draw at one crank speed: it does not run for a draw at constant slide speed, whose crank need not turn at one
+    speed; the dense check decides there). Every method has a default that does nothing."""
 
     id: ClassVar[str]
     name: ClassVar[str]
@@ -362,6 +364,7 @@ class Limit:
     uses_drive: ClassVar[bool] = False
     refuses_draw_speed_above_bound: ClassVar[bool] = False
     goal: ClassVar[bool] = False
+    precheck_at_one_draw_speed: ClassVar[bool] = False
 
     def applies(self, case: Any) -> bool:
         """Whether ``case`` sets this limit (an NLP of the case has its rows only then)."""

@@ -123,6 +123,7 @@ class CrankTorqueLimit(Limit):
     unit = "kN m"
     field = "press.capacity.crank_torque_kNm"
     order = 85
+    precheck_at_one_draw_speed = True
     parameters = ("crank_torque_cap",)
     refined = "crank_torque_cap"
     backoff = DRIVE_BACKOFF
@@ -157,12 +158,9 @@ class CrankTorqueLimit(Limit):
 
     def precheck(self, case: Any, given: float | None, lowest: float) -> Impossible | None:
         """At constant speed the draw needs the forming force's torque (and the slide's weight less the
-        counterbalance): the crank cannot give it even at the lowest draw speed the case allows. A draw at
-        constant slide speed (a free draw) need not turn at one speed: no bound from it (the dense check decides)."""
+        counterbalance): the crank cannot give it even at the lowest draw speed the case allows."""
         from planning.model.limits.motor import draw_drive_state
 
-        if case.free_draw:
-            return None
         w2 = given if given is not None else lowest
         theta, state = draw_drive_state(case, w2)
         torque = np.abs(state["crank_torque_Nm"]) / 1e3

@@ -45,6 +45,7 @@ class GridPeakLimit(Limit):
     unit = "kW"
     field = "drive.grid.peak_power_kW"
     order = 110
+    precheck_at_one_draw_speed = True
     parameters = ("grid_cap", "grid_copper", "grid_converter", "grid_limit", "grid_allowance")
     refined = "grid_cap"
     backoff = GRID_BACKOFF
@@ -96,10 +97,7 @@ class GridPeakLimit(Limit):
         """The draw runs at constant speed, so its bus power is known before any plan; at the lowest draw
         speed the case allows it is the least (the power grows with the speed, and so does the energy above
         the limit, ``integral (P - L) dtheta / w2``). Above the limit the storage must carry the excess: its
-        power, and its energy within ``eta_s`` times the usable energy (it cannot start fuller). A draw at constant
-        slide speed (a free draw) need not turn at one speed: no bound from it (the dense check decides)."""
-        if case.free_draw:
-            return None
+        power, and its energy within ``eta_s`` times the usable energy (it cannot start fuller)."""
         d = case.drive
         limit = d.grid.peak_power_kW * 1e3
         w2 = given if given is not None else lowest

@@ -90,6 +90,7 @@ class MotorPeakTorqueLimit(Limit):
     unit = "of the envelope"
     field = "drive.motor.peak_torque_Nm"
     order = 90
+    precheck_at_one_draw_speed = True
     parameters = ("motor_peak",)
     refined = "motor_peak"
     backoff = DRIVE_BACKOFF
@@ -101,10 +102,7 @@ class MotorPeakTorqueLimit(Limit):
 
     def precheck(self, case: Any, given: float | None, lowest: float) -> Impossible | None:
         """At constant speed the draw needs the most torque where the forming force acts on the longest
-        lever: the motor cannot make the draw even at the lowest draw speed the case allows. A draw at constant
-        slide speed (a free draw) need not turn at one speed: no bound from it (the dense check decides)."""
-        if case.free_draw:
-            return None
+        lever: the motor cannot make the draw even at the lowest draw speed the case allows."""
         motor = case.drive.motor
         w2 = given if given is not None else lowest
         theta, state = draw_drive_state(case, w2)
