@@ -930,14 +930,23 @@ def _choose_with_mouse_and_keys(page, selector: str, value: str) -> None:  # noq
 
 @browser
 def test_a_confirmed_answer_with_the_fast_answers_charts_is_not_drawn_again(site, page) -> None:
-    """An edit's fast answer is drawn; its confirmed answer, when its charts are the same (curves, limit lines,
-    strokes, key points), only marks the plan confirmed: the charts are drawn once for the edit, and what they
-    show is the confirmed answer's (the server's confirmed solve of the same case, asked again here)."""
+    """An edit (a mouse click into θ2, the value typed, Tab): its fast answer is drawn; its confirmed answer, when
+    its charts are the same (curves, limit lines, strokes, key points), only marks the plan confirmed: the charts
+    are drawn once for the edit, and what they show is the confirmed answer's (the server's confirmed solve of the
+    same case, asked again here)."""
     import urllib.request
 
     url, _ = site
     draws = page.evaluate("window.chartDraws")
-    edit(page, "key_points.draw_start_deg", "132.2")
+    before = int(page.evaluate("document.body.dataset.rendered"))
+    field = page.locator('[data-field="key_points.draw_start_deg"]')
+    field.scroll_into_view_if_needed()
+    box = field.bounding_box()
+    page.mouse.click(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)  # a real click in the field
+    page.keyboard.press("Control+A")
+    page.keyboard.type("132.2")
+    page.keyboard.press("Tab")  # Tab solves at once (docs/web.md)
+    wait_rendered(page, before)
     data = published_data()
     data["key_points"]["draw_start_deg"] = 132.2
     body = json.dumps({"session": "a-check", "seq": 1, "case": data, "confirm": True}).encode()
