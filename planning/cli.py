@@ -454,7 +454,8 @@ def _pendulum_cam_writers(written, with_table: bool) -> dict:  # noqa: ANN001 - 
     """The cam outputs' writers for a pendulum plan (the registry's cam outputs read its plan and case only)."""
     from planning.reports.outputs import BY_NAME
 
-    chosen = _cam_outputs() + ((BY_NAME["cam_table.csv"],) if with_table else ())
+    tables = (BY_NAME["cam_table.csv"], BY_NAME["robot_cams.csv"]) if with_table else ()  # (robot_cams: with robots)
+    chosen = _cam_outputs() + tables
     return {name: w for output in chosen for name, w in output.writers(written).items()}
 
 
@@ -757,10 +758,16 @@ def _pendulum_bound(case, args) -> int:
     bound = pendulum_bound(case)
     data = {"case": case.name, "mode": "pendulum", "upper_bound_spm": bound.spm, "cycle_time_s": bound.cycle_time_s}
     data["arc_times_s"] = dict(zip(("forward", "backward"), bound.arc_times_s, strict=True))
+    data["set_by"] = bound.sets_it
+    windows = (
+        f"two robot's windows of {case.process.transfer_time_s:g} s and "
+        if case.robots is None
+        else f"set by {bound.sets_it}; "
+    )
     lines = [
         f"{case.name}: certified upper bound {bound.spm:.3f} strokes/min in pendulum strokes, two swings at least "
-        f"{bound.cycle_time_s:.4f} s: no swing within the limits makes more (two robot's windows of "
-        f"{case.process.transfer_time_s:g} s and theta1 .. theta4 at least {bound.arc_times_s[0]:.4f} s forward, "
+        f"{bound.cycle_time_s:.4f} s: no swing within the limits makes more ({windows}"
+        f"theta1 .. theta4 at least {bound.arc_times_s[0]:.4f} s forward, "
         f"{bound.arc_times_s[1]:.4f} s backward; the jerk limit, the least crank speed, the torques and the turns left "
         "out)"
     ]

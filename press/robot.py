@@ -162,6 +162,18 @@ class Robot:
             raise ValueError(f"{self.name}: {took}, longer than the cycle {period_s:g} s")
         return self.position_since_start(np.mod(np.asarray(t_s, dtype=float) - start_s, period_s))
 
+    def position_of_starts(self, t_s: np.ndarray, starts_s: tuple[float, ...], period_s: float) -> np.ndarray:
+        """The position [mm] at cycle times ``t_s`` [s] of a robot that leaves its waiting point at each of
+        ``starts_s`` [s] each cycle of ``period_s`` [s] (occupancies that do not overlap; at its waiting point
+        between them): a pendulum cycle's two strokes."""
+        t = np.asarray(t_s, dtype=float)
+        x = np.full(t.shape, self.path_mm)
+        for start in starts_s:
+            tau = np.mod(t - start, period_s)
+            inside = tau < self.occupancy_s
+            x[inside] = self.position_since_start(tau[inside])
+        return x
+
     def position_since_start(self, tau_s: np.ndarray) -> np.ndarray:
         """The position [mm] at times ``tau_s`` [s] from leaving its waiting point (at it again after its
         occupancy)."""

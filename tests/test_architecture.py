@@ -175,6 +175,7 @@ CASADI_MODULES = {  # the wrapper and the modules that build expressions for it
     "planning.solver.free_nlp",
     "planning.solver.pendulum_nlp",
     "planning.solver.pendulum_drive",
+    "planning.solver.pendulum_robots",  # its rows (the dense checks beside them load no CasADi)
     "planning.solver.bound",
     "planning.solver.upper_bound",
     "planning.solver.peak_shaving",  # the peak-shaving linear programme (HiGHS through casadi.conic)

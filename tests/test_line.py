@@ -385,3 +385,13 @@ def test_a_press_with_a_hold_keeps_it_at_the_lines_period(tmp_path: Path) -> Non
     still = np.abs(h) <= 1e-3
     runs = np.split(t[still], np.flatnonzero(np.diff(np.flatnonzero(still)) > 1) + 1)
     assert max(run[-1] - run[0] for run in runs if run.size) >= 0.2 - 1e-3  # the 1 ms grid's last step
+
+
+def test_a_pendulum_press_in_a_line_is_refused_in_one_line(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    """A station set to pendulum strokes: a line plans rotary strokes only (it planned the station as rotary
+    before, silently); one line naming the station's field, exit 2, nothing written."""
+    out = tmp_path / "out"
+    assert main(["line", str(SHIPPED), "--set", "pierce.planner.mode=pendulum", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "pierce" in err[0] and "planner.mode: pendulum" in err[0]
+    assert not out.exists()

@@ -145,3 +145,39 @@ def test_one_robot_removed_and_added_back(page) -> None:
     assert page.locator('[data-field="robots.loader.path_mm"]').count() == 1
     assert page.evaluate("state.last.result.verified")
     assert page.errors == []
+
+
+def test_robots_on_pendulum_strokes(site) -> None:
+    """The shallow bracket's pendulum strokes with two robots: the page's strokes are the CLI's plan's, the
+    interference chart marks each robot's least clearance in both windows; a longer loader dwell typed in after
+    a mouse click gives the CLI's plan of that case, with fewer strokes."""
+    from planning.model.case_file import case_from_data, load_yaml
+    from planning.solver.pendulum import solve_pendulum
+
+    path = CASES / "pendulum" / "shallow-pendulum-robots.yaml"
+    data = load_yaml(path.read_text(encoding="utf-8"))
+    _, browser = site  # (one Playwright a process: the module's browser, a server of this case)
+    with running_server(path) as url:
+        context = browser.new_context(viewport={"width": 1280, "height": 1400})
+        tab = context.new_page()
+        tab.goto(url)
+        wait_rendered(tab)
+        tab.wait_for_function("state.last && state.last.confirmed && state.last.result", timeout=60_000)
+        solution = solve_pendulum(case_from_data(data, str(path)), compare=False)
+        assert tab.locator("#spm").inner_text() == f"{solution.plan.spm:.3f}"
+        names = tab.evaluate("document.querySelector('#robots-chart').data.map((t) => t.name)")
+        for name in ("unloader at theta_e", "unloader at theta_s", "loader at theta_e", "loader at theta_s"):
+            assert any(n.startswith(f"{name}: least clearance") for n in names), names
+        assert sum(n.endswith("on its path [mm from the die centre]") for n in names) == 2
+        before = int(tab.evaluate("document.body.dataset.rendered"))
+        click(tab, '[data-field="robots.loader.dwell_s"]')
+        tab.keyboard.press("Control+A")
+        tab.keyboard.type("0.1")
+        tab.keyboard.press("Tab")
+        wait_rendered(tab, before)
+        tab.wait_for_function("state.last && state.last.confirmed && state.last.result", timeout=60_000)
+        data["robots"]["loader"]["dwell_s"] = 0.1
+        slower = solve_pendulum(case_from_data(data, str(path)), compare=False)
+        assert tab.locator("#spm").inner_text() == f"{slower.plan.spm:.3f}"
+        assert slower.plan.spm < solution.plan.spm
+        context.close()

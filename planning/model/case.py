@@ -966,24 +966,19 @@ PENDULUM_NOT_WITH = (  # what a pendulum stroke does not plan with yet: (field, 
     ),
     ("process.draw_slide_speed_mm_s", lambda c: c.process.draw_slide_speed_mm_s, "a swing draws at a crank speed"),
     ("drive", lambda c: "a drive" if c.electrical else None, "its electrical side (losses, storage, grid) not yet"),
-    (
-        "robots",
-        lambda c: "robots" if c.robots is not None else None,
-        "a swing turns above the safety height, no curves yet",
-    ),
 )
 
 
 def _pendulum_checks(case: Case) -> None:
     """A pendulum stroke (``planner.mode: pendulum``) plans with a law with halves, at the most strokes or at a
-    line's rate (the motor's heat or energy), against the safety height and the transfer time; what it does not
-    plan with yet is refused naming the field."""
+    line's rate (the motor's heat or energy), against the safety height and the transfer time or the robots on
+    their curves; what it does not plan with yet is refused naming the field."""
     if not case.pendulum:
         return
     for name, value_of, why in PENDULUM_NOT_WITH:
         value = value_of(case)
         if value is not None:
-            section = name in ("drive", "robots")
+            section = name == "drive"
             raise CaseError(name, f"not with planner.mode: pendulum ({why})", None if section else value, not section)
 
 

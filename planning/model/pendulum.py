@@ -26,7 +26,7 @@ swing's start (the crank at rest at theta_s, at the end of its standstill there)
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -168,7 +168,7 @@ class PendulumParameters:
     def segments(self) -> list[Segment]:
         """The cycle's segments in the crank's own angle (the backward swing's jerks and speed changes negated):
         forward swing, standstill at theta_e, backward swing, standstill at theta_s."""
-        back = [_reversed(s) for s in self.backward.segments()]
+        back = [reversed_segment(s) for s in self.backward.segments()]
         return [
             *[_named("forward", s) for s in self.forward.segments()],
             Segment(TURN_SEGMENT, self.turn_end_s, 0.0, 0.0),
@@ -177,7 +177,7 @@ class PendulumParameters:
         ]
 
 
-def _reversed(seg: Segment) -> Segment:
+def reversed_segment(seg: Segment) -> Segment:
     """A segment of the backward swing on u as the crank turns it: every jerk and speed change negated."""
     return seg._replace(j0=-seg.j0, j1=-seg.j1, dv=-seg.dv)
 
@@ -235,7 +235,8 @@ class PendulumPlan:
     key angles of each swing [rad, the crank's own] (``forward_keys``, ``backward_keys``), the ``solver``'s
     report (``planning.model.plan.SolverInfo``) and the NLP's variable values; ``time_scale``: the profile runs
     this many times as fast as the parameters say (a cam run at another master speed: its swings' times
-    divided by it)."""
+    divided by it); ``robot_starts_s``: with robots, each robot's start in each window (``at theta_e``, ``at
+    theta_s``) [s from the forward swing's start, as planned: divided by ``time_scale`` as run]."""
 
     parameters: PendulumParameters
     profile: Profile
@@ -244,6 +245,7 @@ class PendulumPlan:
     solver: Any
     nlp_values: dict[str, float]
     time_scale: float = 1.0
+    robot_starts_s: dict[str, dict[str, float]] = field(default_factory=dict)
 
     @property
     def slave_turn_deg(self) -> float:

@@ -47,8 +47,8 @@ def check_case(case: Case) -> dict[str, Any]:
     checks = [_check(c) for limit in limits_of(case) for c in limit.at_draw_speed(draw, w2)]
     if case.free_draw:  # no constant draw speed: the checks that assume one left out (the slide's speed in it)
         checks = [c for c in checks if c["id"] not in AT_CONSTANT_DRAW]
-    if case.pendulum:  # no window through TDC: the swings turn before it
-        checks = [c for c in checks if c["id"] != "safety_height"]
+    if case.pendulum:  # no window through TDC (the swings turn before it), no rotary cycle for the robots
+        checks = [c for c in checks if c["id"] not in ("safety_height", "robots")]
     bdc = math.degrees(m.bdc_angle)
     return {
         "case": case.name,
@@ -84,11 +84,18 @@ def _pendulum(case: Case) -> dict[str, Any]:
 
     (s_lo, s_hi), (e_lo, e_hi) = swing_bounds(case)
     forward, backward = swing_setups(case, {})  # the case's own limits
+    robots = {}
+    if case.robots is not None:  # the least cycle the robots allow (``planning.solver.pendulum_bound``)
+        from planning.solver.pendulum_bound import robot_demands
+
+        least, what = max(robot_demands(case, (forward, backward)))
+        robots = {"robots": {"least_cycle_s": least, "set_by": what}}
     return {
         "turn_start_deg": [math.degrees(s_lo), math.degrees(s_hi)],
         "turn_end_deg": [math.degrees(e_lo), math.degrees(e_hi)],
         "backward_key_angles_deg": [math.degrees(a) for a in backward_key_angles(case)],
         "max_draw_speed_rpm": {"forward": forward.draw_speed_bound / RPM, "backward": backward.draw_speed_bound / RPM},
+        **robots,
     }
 
 
@@ -213,6 +220,12 @@ def check_text(report: dict[str, Any]) -> str:
             f"  highest draw speed of each swing: forward {rounded_down(top['forward'])} rpm, backward "
             f"{rounded_down(top['backward'])} rpm",
         ]
+        if "robots" in swing:
+            r = swing["robots"]
+            lines.append(
+                f"  the robots need a cycle of at least {r['least_cycle_s']:.4f} s ({120 / r['least_cycle_s']:.3f} "
+                f"strokes/min at most): {r['set_by']}"
+            )
     lines += ["", "  checks"]
     for c in report["checks"]:
         mark = "PASS" if c["passed"] else "FAIL"

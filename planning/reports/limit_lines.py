@@ -145,7 +145,9 @@ def limit_lines(result: dict[str, Any], columns: dict[str, np.ndarray], axis: st
                 point=True,
             )
         )
-    for robot in (result.get("robots") or {}).get("robots", ()):  # each tool's need where it needs any
+    robots = (result.get("robots") or {}).get("robots", ())
+    for name in dict.fromkeys(r["name"] for r in robots):  # each tool's need where it needs any (once a robot)
+        robot = {"name": name}
         need = np.asarray(columns[f"{robot['name']}_needed_height_mm"], dtype=float)
         label = f"robots.{robot['name']}: the height its tool needs"
         upper = np.where(needing(need), need, np.nan)

@@ -1,6 +1,7 @@
 """The files of a pendulum plan (``planner.mode: pendulum``): ``result.json``, ``summary.txt``,
 ``trajectory.csv`` (the crank's own angle and its signed speed, time 0 at the forward swing's start) and the
-figure ``swing.png`` (or ``--format``'s) (the swings against time and against crank angle)."""
+figure ``swing.png`` (or ``--format``'s) (the swings against time and against crank angle); with robots the
+figure ``interference.png`` (the slide above each tool's need in both windows) and ``robot_cams.csv``."""
 
 from __future__ import annotations
 
@@ -14,11 +15,19 @@ from planning.model.case import RPM, Case
 from planning.model.pendulum import SWINGS
 from planning.reports.folder import write_json, write_table
 from planning.reports.report import MAX_ROWS, columns_at, drive_block, trajectory_columns
+from planning.reports.robots import robot_lines, robots_block
 from planning.solver.pendulum import PendulumSolution
 from planning.solver.solution import ENERGY
 
 KEY_NAMES = ("closing", "draw_start", "draw_end", "opening")
-PENDULUM_FILES = ("result.json", "summary.txt", "trajectory.csv", "swing.*")  # what a pendulum solve owns
+PENDULUM_FILES = (  # what a pendulum solve owns
+    "result.json",
+    "summary.txt",
+    "trajectory.csv",
+    "swing.*",
+    "interference.*",
+    "robot_cams.csv",
+)
 
 
 def pendulum_result(solution: PendulumSolution, case: Case) -> dict[str, Any]:
@@ -66,6 +75,7 @@ def pendulum_result(solution: PendulumSolution, case: Case) -> dict[str, Any]:
         "rotary": rotary,
         **({"drive": {**drive_block(solution, case), "per": "cycle of two strokes"}} if drive is not None else {}),
         **({"at_rate": _at_rate(solution)} if solution.at_rate is not None else {}),
+        **({"robots": robots_block(solution, case)} if case.robots is not None else {}),
         "verification": {
             "passed": verification.passed,
             "samples": verification.samples,
@@ -147,6 +157,7 @@ def pendulum_summary(r: dict[str, Any]) -> str:
             f"{d['peak_motor_power_kW']:.1f} kW; per stroke {d['energy_drawn_kJ'] / 2:.2f} kJ drawn, "
             f"{-d['energy_returned_kJ'] / 2:.2f} kJ returned"
         )
+    lines += robot_lines(r)
     v = r["verification"]
     lines.append(f"  binding: {', '.join(v['binding']) or 'none'}")
     failed = [c for c in v["checks"] if not c["passed"]]
@@ -177,7 +188,15 @@ def pendulum_writers(solution: PendulumSolution, case: Case, figure_format: str 
     }
     if figure_format is not None:
         writers[f"swing.{figure_format}"] = lambda p: _save_swing(result, columns, p)
+        if case.robots is not None:
+            writers[f"interference.{figure_format}"] = lambda p: _save_interference(result, columns, p)
     return writers
+
+
+def _save_interference(result: dict[str, Any], columns: dict[str, np.ndarray], path: Path) -> None:
+    from planning.reports.plots import interference_figure, save
+
+    save(interference_figure(result, columns), path)
 
 
 def _save_swing(result: dict[str, Any], columns: dict[str, np.ndarray], path: Path) -> None:

@@ -283,24 +283,28 @@ def interference_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> 
     heights, paths = fig.subplots(2, 1, sharex=True, height_ratios=(3, 2))
     t = traj["time_s"]
     heights.plot(t, traj["slider_height_mm"], color="#1f77b4", lw=1.8, label="slide height")
-    for r in result["robots"]["robots"]:
+    drawn = set()
+    for r in result["robots"]["robots"]:  # (a pendulum cycle's: each robot once in each window)
         name, colour = r["name"], ROBOT_COLOURS.get(r["name"], "k")
         need = np.asarray(traj[f"{name}_needed_height_mm"], dtype=float)
-        shown = np.where(needing(need), need, np.nan)
-        heights.plot(t, shown, color=colour, lw=1.4, label=f"height the {name}'s tool needs")
+        if name not in drawn:
+            drawn.add(name)
+            shown = np.where(needing(need), need, np.nan)
+            heights.plot(t, shown, color=colour, lw=1.4, label=f"height the {name}'s tool needs")
+            position = traj[f"{name}_position_mm"]
+            paths.plot(t, position, color=colour, lw=1.4, label=f"{name} on its path")
+            paths.fill_between(t, 0, position, where=need > 0, color=colour, alpha=0.15, lw=0)
         if r["least_clearance_mm"] is not None:
-            at = r["least_clearance_time_s"]
-            label = f"{name}: least clearance {round(r['least_clearance_mm'], 2) + 0.0:.2f} mm"  # no "-0.00"
+            at, which = r["least_clearance_time_s"], f"{name} {r['window']}" if "window" in r else name
+            label = f"{which}: least clearance {round(r['least_clearance_mm'], 2) + 0.0:.2f} mm"  # no "-0.00"
             heights.plot([at], [r["needed_there_mm"]], "v", color=colour, ms=7, label=label)
-        position = traj[f"{name}_position_mm"]
-        paths.plot(t, position, color=colour, lw=1.4, label=f"{name} on its path")
-        paths.fill_between(t, 0, position, where=need > 0, color=colour, alpha=0.15, lw=0)
     heights.set_ylabel("height above BDC [mm]")
     heights.set_ylim(bottom=0)
     heights.legend(loc="best", fontsize=8)
     heights.set_title(f"robots on their interference curves ({result['robots']['order']})", fontsize=9, loc="left")
     paths.set_ylabel("position from the die centre [mm]")
-    paths.set_xlabel("time from TDC [s]")
+    pendulum = result.get("mode") == "pendulum"
+    paths.set_xlabel("time from the forward swing's start [s]" if pendulum else "time from TDC [s]")
     paths.set_ylim(bottom=0)
     paths.legend(loc="center", fontsize=8, title="shaded: the tool over the die", title_fontsize=8)
     for ax in (heights, paths):
@@ -741,12 +745,14 @@ def swing_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
     ax[1, 0].set(xlabel="time [s]", ylabel="slide height above BDC [mm]", title="slide: two strokes a cycle")
     for a in (ax[0, 0], ax[0, 1], ax[1, 0]):
         for k, (lo, hi) in enumerate(windows):
-            a.axvspan(lo, hi, color="0.85", zorder=0, label="robot's window" if (k == 0 and a is ax[1, 0]) else None)
+            label = "theta4 .. theta1" if "robots" in result else "robot's window"
+            a.axvspan(lo, hi, color="0.85", zorder=0, label=label if (k == 0 and a is ax[1, 0]) else None)
     forward = t <= result["swings"]["forward"]["time_s"]
     ax[1, 1].plot(theta[forward], h[forward], color="C0", label="forward swing")
     ax[1, 1].plot(theta[~forward], h[~forward], color="C3", ls="--", label="backward swing")
     for a in (ax[1, 0], ax[1, 1]):
-        a.axhline(safety_mm, color="C4", lw=1, ls=":", label="safety height")
+        if safety_mm is not None:  # (with robots their curves, not one height)
+            a.axhline(safety_mm, color="C4", lw=1, ls=":", label="safety height")
         a.axhline(die_mm, color="C5", lw=1, ls=":", label="die height")
     for key in f + b:
         ax[1, 1].plot(key["angle_deg"], key["height_mm"], "k.", ms=5)

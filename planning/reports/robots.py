@@ -12,7 +12,8 @@ from typing import Any
 
 import numpy as np
 
-from planning.model.limits.robots import robot_schedule
+from planning.model.limits.robots import RobotSchedule, robot_schedule
+from planning.solver.pendulum_robots import WINDOWS, window_view
 from planning.solver.solution import Solution
 from press.robot import Robot
 
@@ -31,11 +32,25 @@ def robot_values(dense: Any, case: Any) -> list[np.ndarray]:
     height itself)."""
     plan, out = dense.plan, []
     for robot in case.robots_on_path:
-        start = plan.robot_starts_s[robot.name]
-        position = robot.position(dense.t, start, plan.period)
+        position = robot.position_of_starts(dense.t, starts_of(plan, robot.name), plan.period)
         need = robot.curve.need(position)
         out += [position, need, dense.h - need]
     return out
+
+
+def starts_of(plan: Any, name: str) -> tuple[float, ...]:
+    """The robot ``name``'s starts in a cycle of ``plan`` [s]: a rotary cycle's one, a pendulum cycle's one in
+    each window (``planning.solver.pendulum_robots``)."""
+    starts = plan.robot_starts_s[name]
+    return tuple(starts[w] for w in WINDOWS) if isinstance(starts, dict) else (starts,)
+
+
+def schedules(solution: Solution, case: Any) -> list[tuple[Robot, str, RobotSchedule]]:
+    """Each robot's schedule in the plan, with the window it runs in (``""`` in a rotary cycle's one)."""
+    dense = solution.evaluation.samples
+    if not case.pendulum:
+        return [(robot, "", robot_schedule(dense, robot)) for robot in case.robots_on_path]
+    return [(robot, w, robot_schedule(window_view(dense, w), robot)) for robot in case.robots_on_path for w in WINDOWS]
 
 
 def master_deg(time_s: float, period_s: float) -> float:
@@ -47,10 +62,9 @@ def robots_block(solution: Solution, case: Any) -> dict[str, Any]:
     """``result.json``'s ``robots`` block: the order, and per robot its moves' times and master angles (it
     leaves its waiting point, reaches the die centre, leaves it, is back), the time its tool spends over the
     die, its least clearance and where it occurs."""
-    dense, period = solution.evaluation.samples, solution.plan.period
+    period = solution.plan.period
     robots = []
-    for robot in case.robots_on_path:
-        s = robot_schedule(dense, robot)
+    for robot, window, s in schedules(solution, case):
         needs = bool(np.isfinite(s.least_clearance_mm))
         events = {
             name: {"time_s": t, "master_deg": master_deg(t, period)} for name, t in zip(EVENTS, s.events_s, strict=True)
@@ -58,6 +72,7 @@ def robots_block(solution: Solution, case: Any) -> dict[str, Any]:
         robots.append(
             {
                 "name": robot.name,
+                **({"window": window} if window else {}),
                 "move_s": robot.move.duration_s,
                 "dwell_s": robot.dwell_s,
                 "occupancy_s": robot.occupancy_s,
@@ -70,7 +85,11 @@ def robots_block(solution: Solution, case: Any) -> dict[str, Any]:
                 "needed_there_mm": s.tightest_need_mm if needs else None,
             }
         )
-    return {"order": case.robots.order, "robots": robots}
+    master = "master 0 at the forward swing's start, 360 a cycle of two swings" if case.pendulum else MASTER
+    return {"order": case.robots.order, "master": master, "robots": robots}
+
+
+MASTER = "master 0 at TDC, 360 a stroke"  # a rotary cycle's virtual master (``cam_table.csv``'s)
 
 
 def robot_lines(result: dict[str, Any]) -> list[str]:
@@ -78,9 +97,11 @@ def robot_lines(result: dict[str, Any]) -> list[str]:
     block = result.get("robots")
     if not block:
         return []
-    head = "  robot [master deg]  leaves    at die  leaves die      back  over die s  least clearance"
-    lines = ["", f"{head} ({block['order']}; master 0 at TDC, 360 a stroke)"]
-    for r in block["robots"]:
+    names = [f"{r['name']} {r['window']}" if "window" in r else r["name"] for r in block["robots"]]
+    width = max(18, *(len(n) + 1 for n in names))  # (a pendulum cycle's names carry their window)
+    head = f"  {'robot [master deg]':<{width}}  leaves    at die  leaves die      back  over die s  least clearance"
+    lines = ["", f"{head} ({block['order']}; {block.get('master', MASTER)})"]
+    for r, name in zip(block["robots"], names, strict=True):
         e = r["events"]
         degs = "".join(f"{e[k]['master_deg']:>{w}.1f}" for k, w in zip(EVENTS, (8, 10, 12, 10), strict=True))
         clearance = r["least_clearance_mm"]
@@ -89,7 +110,7 @@ def robot_lines(result: dict[str, Any]) -> list[str]:
             if clearance is None
             else f"{round(clearance, 3) + 0.0:.3f} mm at {r['least_clearance_master_deg']:.1f} deg"
         )
-        lines.append(f"  {r['name']:<18}{degs}  {r['over_die_s']:>10.4f}  {where}")
+        lines.append(f"  {name:<{width}}{degs}  {r['over_die_s']:>10.4f}  {where}")
     return lines
 
 
@@ -111,35 +132,36 @@ def robot_cam_table(solution: Solution, case: Any, points: int) -> np.ndarray:
     rate = 360.0 / period  # [deg/s] of the master
     columns = [master]
     for robot in case.robots_on_path:
-        x, v, a = _robot_state(robot, t, plan.robot_starts_s[robot.name], period)
+        x, v, a = _robot_state(robot, t, starts_of(plan, robot.name), period)
         columns += [x, v / rate, a / rate**2]
     return np.column_stack(columns)
 
 
-def _robot_state(robot: Robot, t: np.ndarray, start: float, period: float) -> tuple[np.ndarray, ...]:
-    """Position [mm], speed [mm/s] and acceleration [mm/s^2] along the path at cycle times ``t`` [s] (speed
-    negative on the way in, towards the die centre)."""
+def _robot_state(robot: Robot, t: np.ndarray, starts: tuple[float, ...], period: float) -> tuple[np.ndarray, ...]:
+    """Position [mm], speed [mm/s] and acceleration [mm/s^2] along the path at cycle times ``t`` [s] of a robot
+    leaving its waiting point at each of ``starts`` [s] (speed negative on the way in, towards the die centre)."""
     move = robot.move
-    tau = np.mod(t - start, period)
     out_start = move.duration_s + robot.dwell_s
-    _, v_in, a_in = move.state(tau)
-    _, v_out, a_out = move.state(tau - out_start)
-    inward = tau < out_start
-    x = robot.position(t, start, period)
-    v = np.where(inward, -v_in, v_out)
-    a = np.where(inward, -a_in, a_out)
-    waiting = tau >= robot.occupancy_s
-    return x, np.where(waiting, 0.0, v), np.where(waiting, 0.0, a)
+    v, a = np.zeros_like(t), np.zeros_like(t)
+    for start in starts:
+        tau = np.mod(t - start, period)
+        _, v_in, a_in = move.state(tau)
+        _, v_out, a_out = move.state(tau - out_start)
+        inward, moving = tau < out_start, tau < robot.occupancy_s
+        v = np.where(moving, np.where(inward, -v_in, v_out), v)
+        a = np.where(moving, np.where(inward, -a_in, a_out), a)
+    return robot.position_of_starts(t, starts, period), v, a
 
 
 def robot_cam_header(solution: Solution, case: Any, points: int) -> str:
     """The ``#`` lines that head ``robot_cams.csv``."""
     plan = solution.plan
+    zero = "the forward swing's start (a cycle of two swings)" if case.pendulum else "TDC"
     return "\n".join(
         [
             f"# pressplan robot cams for {case.name} ({case.robots.order})",
-            f"# period_s = {plan.period:.9f}; spm = {plan.spm:.6f}; master speed = {plan.spm * 6:.6f} deg/s",
-            f"# points = {points}; master 0 = TDC, the crank cam's master (cam_table.csv); master 0 ... <360 deg",
+            f"# period_s = {plan.period:.9f}; spm = {plan.spm:.6f}; master speed = {360 / plan.period:.6f} deg/s",
+            f"# points = {points}; master 0 = {zero}, the crank cam's master (cam_table.csv); master 0 ... <360 deg",
             "# units: position_mm [mm from the die centre, the path length at the waiting point]; "
             "dposition_dmaster [mm/deg]; d2position_dmaster2 [mm/deg^2]",
         ]

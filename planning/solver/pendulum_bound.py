@@ -20,6 +20,15 @@ each node. Within an interval the speed squared is at most the largest cap at it
 most either end's envelope plus the crank acceleration's reach, so the interval takes at least ``dtheta /
 sqrt(that)``. The bound is ``120 / (2 T + t_f + t_b)`` (two strokes a cycle). It leaves out the jerk limit, the
 turns (the crank at rest there) and the windows' own motion, so it is loose: an upper bound, not an estimate.
+
+With robots on their interference curves (``planning.solver.pendulum_robots``) there is no transfer time; the
+cycle is at least the largest of: ``t_f + t_b`` (each swing passes its key angles); each robot's occupancy twice
+(it goes in and out in both windows, in turns both robots'); both draws at their highest speed and twice the
+least time the robots need between the draws (``planning.model.limits.robots.between_draws_s``: the unloader
+grips after theta3 and the loader drops before theta2 in each window); and for each height ``H`` a curve names
+above the draw, the least time over each swing's arc below ``H`` (the procedure above on that arc) and twice
+each robot's time needing ``H`` (its two occupancies never overlap, and its tool needs ``H`` only where the
+slide is at or above it). Each is a necessary condition, so the bound stays a bound.
 """
 
 from __future__ import annotations
@@ -32,9 +41,11 @@ import numpy as np
 from planning.model.case import Case
 from planning.model.limits import limits_of
 from planning.model.limits.canonical import SpeedCap
+from planning.model.limits.robots import between_draws_s, robots_by_name
 from planning.model.pendulum import STROKES_PER_CYCLE, SwingSetup, swing_setups
 from planning.solver.upper_bound import inflections, slope_zeros
 from planning.tolerances import SAME_NODE_RAD, TINY
+from press.robot import time_needing
 
 ARC_INTERVALS = 20_000  # intervals over each swing's arc theta1 .. theta4
 MAX_PASSES = 50  # forward and backward passes at most (the envelope settles in a few)
@@ -48,23 +59,58 @@ class PendulumBound:
     spm: float
     cycle_time_s: float
     arc_times_s: tuple[float, float]
+    sets_it: str = "two robot's windows and theta1 .. theta4"  # what gives the least cycle
 
 
 def pendulum_bound(case: Case) -> PendulumBound:
     """The upper bound of a pendulum case (module docstring)."""
     setups = swing_setups(case, {})  # the case's own limits
     times = tuple(_least_arc_time(case, setup) for setup in setups)
-    cycle = 2 * case.process.transfer_time_s + sum(times)
-    return PendulumBound(STROKES_PER_CYCLE * 60.0 / cycle, cycle, times)  # type: ignore[arg-type]
+    if case.robots is None:
+        cycle = 2 * case.process.transfer_time_s + sum(times)
+        return PendulumBound(STROKES_PER_CYCLE * 60.0 / cycle, cycle, times)  # type: ignore[arg-type]
+    demands = [(sum(times), "theta1 .. theta4 of both swings"), *robot_demands(case, setups)]
+    cycle, sets_it = max(demands)
+    return PendulumBound(STROKES_PER_CYCLE * 60.0 / cycle, cycle, times, sets_it)  # type: ignore[arg-type]
 
 
-def _nodes(case: Case, setup: SwingSetup) -> np.ndarray:
-    """The arc's nodes on u: the key angles, die-height crossings, dead centres and inflections among them."""
-    u1, u2, u3, u4 = setup.keys
+def robot_demands(case: Case, setups: tuple[SwingSetup, ...]) -> list[tuple[float, str]]:
+    """With robots: the least cycles [s] their demands allow, each with what it is (module docstring): each
+    robot's two occupancies (in turns both robots'); the two draws and each window's share between the draws
+    (``planning.model.limits.robots.between_draws_s``); for each height ``H`` the curves name above the draw,
+    each swing's arc below ``H`` and each robot's time needing ``H`` in both windows."""
+    robots = robots_by_name(case)
+    occupancy = max(r.occupancy_s for r in robots.values())
+    if case.robots.order == "in-turns":
+        occupancy = sum(r.occupancy_s for r in robots.values())
+    draws = sum((s.keys[2] - s.keys[1]) / s.draw_speed_bound for s in setups)
+    out = [
+        (STROKES_PER_CYCLE * occupancy, "each robot in and out in both windows"),
+        (draws + STROKES_PER_CYCLE * between_draws_s(case), "the draws and the robots between them"),
+    ]
+    m = case.machine
+    _, th2, th3, _ = case.key_angles
+    above_draw = float(max(m.height(th2), m.height(th3)))
+    for level in sorted({float(h) for r in robots.values() for h in r.curve.needed_height_mm}):
+        if not above_draw < level < m.stroke:
+            continue
+        down, up = (float(a) for a in m.angles_at_height(level))
+        arcs = {"forward": (down, up), "backward": (2 * math.pi - up, 2 * math.pi - down)}
+        below = sum(_least_arc_time(case, s, arcs[s.name]) for s in setups)
+        need = max(time_needing(r, level) for r in robots.values())
+        out.append((below + STROKES_PER_CYCLE * need, f"the slide below {level:g} mm and the robots above it"))
+    return out
+
+
+def _nodes(case: Case, setup: SwingSetup, arc: tuple[float, float] | None = None) -> np.ndarray:
+    """The arc's nodes on u (``arc``: its ends, theta1 .. theta4 when None): its ends, the key angles, die-height
+    crossings, dead centres and inflections among them."""
+    u1, u4 = arc if arc is not None else (setup.keys[0], setup.keys[3])
     m = case.machine
     real = [m.bdc_angle, *slope_zeros(case), *inflections(case), *m.angles_at_height(case.limits.die_height_mm)]
     on_u = [float(a) if setup.name == "forward" else 2 * math.pi - float(a) for a in real]
-    breaks = sorted({u1, u2, u3, u4, *(a for a in on_u if u1 + SAME_NODE_RAD < a < u4 - SAME_NODE_RAD)})
+    inner = (a for a in [*setup.keys, *on_u] if u1 + SAME_NODE_RAD < a < u4 - SAME_NODE_RAD)
+    breaks = sorted({u1, u4, *inner})
     spans = np.diff(breaks)
     counts = np.maximum(4, np.round(ARC_INTERVALS * spans / spans.sum()).astype(int))
     parts = [np.linspace(a, b, n + 1)[:-1] for a, b, n in zip(breaks[:-1], breaks[1:], counts, strict=True)]
@@ -100,9 +146,10 @@ def _caps(
     return caps
 
 
-def _least_arc_time(case: Case, setup: SwingSetup) -> float:
-    """The least time [s] any motion meeting the limits takes over the swing's theta1 .. theta4."""
-    u = _nodes(case, setup)
+def _least_arc_time(case: Case, setup: SwingSetup, arc: tuple[float, float] | None = None) -> float:
+    """The least time [s] any motion meeting the limits takes over the swing's theta1 .. theta4 (or ``arc``: its
+    ends on u, around the draw)."""
+    u = _nodes(case, setup, arc)
     h, d1, _, _ = setup.jets(u)
     h, d1 = np.asarray(h), np.asarray(d1)
     caps = _caps(case, setup, u, h, d1)

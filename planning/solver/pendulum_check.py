@@ -6,9 +6,11 @@ mechanism at the crank's own angle (not from the NLP's path coordinate). The che
 closed (back at theta_s at rest), continuous at every knot; each swing turning one way only (forward, then
 backward), standing at its ends, never past TDC; each swing's draw between its theta2 and theta3 at one crank
 speed; the robot's two windows (the forward swing's theta4 through the turn to the backward swing's theta1, and
-back) each at least the transfer time with the slide at or above the safety height; the least crank speed in
-the draws; the die speed at and below the die height and where each swing crosses it; the slide's speed at each
-swing's theta2; and every other limit of the case by its own dense check (``Limit.check``, on |crank speed|).
+back) each at least the transfer time with the slide at or above the safety height, or with robots each robot
+on its interference curve in both windows between the draws (``planning.solver.pendulum_robots``); the least
+crank speed in the draws; the die speed at and below the die height and where each swing crosses it; the slide's
+speed at each swing's theta2; and every other limit of the case by its own dense check (``Limit.check``, on
+|crank speed|).
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from planning.model.limits import limits_of
 from planning.model.limits.base import Check, Dense
 from planning.model.pendulum import SWINGS, PendulumPlan, swing_forming_N, swing_of, time_at, windows_of
 from planning.model.profile import sample_times
+from planning.solver.pendulum_robots import WINDOWS, robot_checks
 from planning.solver.verify import CheckId, Evaluation, Verification, continuity_checks, energy_balance
 from planning.tolerances import (
     ACCEL_CLOSE_TOL_RAD_S2,
@@ -37,7 +40,7 @@ from planning.tolerances import (
 from press.dynamics import drive_state
 from press.mechanism import slider_motion
 
-OWN_CHECKS = ("transfer_time", "safety_height", "min_crank_speed", "die_speed", "draw_start_speed")  # here
+OWN_CHECKS = ("transfer_time", "safety_height", "min_crank_speed", "die_speed", "draw_start_speed", "robots")  # here
 
 
 def evaluate_pendulum(plan: PendulumPlan, case: Case, cam: bool = False) -> Evaluation:
@@ -140,7 +143,12 @@ def _swing_checks(d: Dense, cam: bool) -> list[Check]:
         tol = math.degrees(ANGLE_TOL_RAD)
         return [Check.of(CheckId.KEY_ANGLES, "each swing passes its key angles", math.nan, 0.0, "deg", "equal", tol)]
     out = [] if cam else _law_checks(d, spans, times)
-    out += _window_checks(d, times)
+    if case.robots is None:
+        out += _window_checks(d, times)
+    else:  # each window from a swing's theta3 to the next swing's theta2 (``planning.solver.pendulum_robots``)
+        f, b = times["forward"], times["backward"]
+        windows = {WINDOWS[0]: (f[2], b[1]), WINDOWS[1]: (b[2], f[1] + d.plan.period)}
+        out += robot_checks(d, windows)
     least = case.limits.min_crank_speed_rpm
     draws = [np.abs(d.omega[(d.t >= t[1]) & (d.t <= t[2])]) for t in times.values()]
     slowest = min(float(np.min(w, initial=np.inf)) for w in draws)

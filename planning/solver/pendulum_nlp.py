@@ -43,6 +43,7 @@ from planning.model.pendulum import (
     DIE_ZONE_POINTS,
     SWING_HALVES,
     SWINGS,
+    TURN_SEGMENT,
     TWO_PI,
     PendulumParameters,
     PendulumPlan,
@@ -50,15 +51,26 @@ from planning.model.pendulum import (
     SwingSetup,
     backward_key_angles,
     profile_of,
+    reversed_segment,
     swing_bounds,
     swing_setups,
 )
 from planning.model.plan import SolverInfo
-from planning.model.profile import Profile, advance_segment, knot_states
+from planning.model.profile import Profile, Segment, advance_segment, knot_states
 from planning.solver.halves_nlp import MIN_HALF_S, TOP_SPEED, VARIABLE_INDEX, angle_at, variable_scales
 from planning.solver.ipopt import NLPSolver
 from planning.solver.nlp import RATE_OPTIONS, Rows
+from planning.solver.parameters import time_limit
 from planning.solver.pendulum_drive import drive_rows, rate_terms, swing_drive
+from planning.solver.pendulum_robots import (
+    NEED_FACTOR,
+    WINDOWS,
+    CycleTimes,
+    first_starts,
+    plan_starts,
+    robot_rows,
+    start_variables,
+)
 from planning.tolerances import ACCEL_BACKOFF, DRIVE_BACKOFF, IPOPT_CONSTR_VIOL_TOL, REFINE_MARGIN
 
 SWING_VARIABLES = (  # per swing, prefixed ``forward_`` / ``backward_``: (name, scale kind of the halves NLP)
@@ -234,6 +246,9 @@ def _variables(case: Case) -> tuple[tuple[str, ...], np.ndarray]:
     for name, kind in SHARED_VARIABLES:
         names.append(name)
         scales.append(1.0 if kind is None else halves_scale[VARIABLE_INDEX[kind]])
+    for name in start_variables(case):  # the robots' starts (with robots: ``planning.solver.pendulum_robots``)
+        names.append(name)
+        scales.append(halves_scale[VARIABLE_INDEX["closing_time"]])
     return tuple(names), np.array(scales)
 
 
@@ -259,15 +274,21 @@ def build(case: Case) -> PendulumNLP:
         swings[setup.name] = _swing(setup, v, ends[setup.name], law, phys["law_parameter"])
         _swing_rows(rows, swings[setup.name], case, limits, units)
     f, b = swings["forward"], swings["backward"]
-    transfer = case.process.transfer_time_s
-    window_e = f.params.return_time - f.v["opening_time"] + phys["turn_end_s"] + b.v["closing_time"]
-    window_s = b.params.return_time - b.v["opening_time"] + phys["turn_start_s"] + f.v["closing_time"]
-    rows.add("robot windows", ca.vertcat(window_e, window_s) / transfer - 1.0, 0.0, math.inf, "process.transfer_time_s")
-    period = PendulumParameters(f.params, b.params, phys["turn_end_s"], phys["turn_start_s"]).period
+    transfer = case.transfer_time_s
+    turns = (phys["turn_end_s"], phys["turn_start_s"])
+    period = PendulumParameters(f.params, b.params, *turns).period
+    if case.robots is None:
+        window_e = f.params.return_time - f.v["opening_time"] + turns[0] + b.v["closing_time"]
+        window_s = b.params.return_time - b.v["opening_time"] + turns[1] + f.v["closing_time"]
+        windows = ca.vertcat(window_e, window_s) / transfer - 1.0
+        rows.add("robot windows", windows, 0.0, math.inf, "process.transfer_time_s")
+    else:  # the robots on their curves in both windows (``planning.solver.pendulum_robots``)
+        starts = {name: phys[name] for name in start_variables(case)}
+        cycle = _cycle_times(case, f, b, turns)
+        robot_rows(rows.add, case, cycle, starts, limits[NEED_FACTOR], units["half"])
     objective = period / transfer
     if case.drive is not None:  # the motor's torques at the swings' samples (``planning.solver.pendulum_drive``)
         drives = {name: swing_drive(case, swing) for name, swing in swings.items()}
-        turns = (phys["turn_end_s"], phys["turn_start_s"])
         drive_rows(case, rows.add, drives, turns, period, limits)
         if rate:
             rows.add("the cycle at the target rate", period / limits["target_period"] - 1.0, 0.0, 0.0, TARGET)
@@ -280,6 +301,43 @@ def build(case: Case) -> PendulumNLP:
     return PendulumNLP(case, solver, *rows.bounds(), names, scales, limit_names)
 
 
+def _cycle_times(case: Case, f: _Swing, b: _Swing, turns: tuple[Any, Any]) -> CycleTimes:
+    """The cycle as the robots' rows read it (``planning.solver.pendulum_robots.CycleTimes``): each window's
+    segments in the crank's own angle (the backward swing's negated) from the draw before it to the draw after
+    it, the slide's height at times from the window's theta3 (before the first draw's start and after the last
+    draw's end the heights there: lower than the slide's, which comes down to the one draw and rises from the
+    other)."""
+    draw_f = Segment("draw:constant", f.params.draw_time, 0.0, 0.0)
+    draw_b = Segment("draw:constant", b.params.draw_time, 0.0, 0.0)
+    forward_feed, forward_return = [*f.params.feed_segments(), draw_f], [*f.params.return_segments()]
+    backward_feed = [reversed_segment(seg) for seg in [*b.params.feed_segments(), draw_b]]
+    backward_return = [reversed_segment(seg) for seg in b.params.return_segments()]
+    at_e, at_s = (Segment(TURN_SEGMENT, turn, 0.0, 0.0) for turn in turns)
+    windows = {  # the draw before, the return, the turn, the feed and the draw after; the state at the first
+        WINDOWS[0]: ([draw_f, *forward_return, at_e, *backward_feed], f.setup.keys[1], f.params.draw_speed, f),
+        WINDOWS[1]: (
+            [backward_feed[-1], *backward_return, at_s, *forward_feed],
+            TWO_PI - b.setup.keys[1],
+            -b.params.draw_speed,
+            b,
+        ),
+    }
+    jets = case.machine.jets
+    heights = {}
+    for w, (segs, theta2, omega2, before) in windows.items():
+        (starts, states, segs_w), _ = _segments_from(segs, theta2, omega2)
+        heights[w] = (starts, states, segs_w, before.params.draw_time)
+
+    def height_at(window: str, times: list) -> Any:
+        starts, states, segs, lead = heights[window]
+        return jets(ca.vertcat(*[angle_at(t + lead, starts, states, segs)[0] for t in times]))[0]
+
+    to_backward = f.params.return_time + turns[0] + b.params.feed_time
+    offsets = {WINDOWS[0]: 0.0, WINDOWS[1]: to_backward + b.params.draw_time}
+    free = {WINDOWS[0]: to_backward, WINDOWS[1]: b.params.return_time + turns[1] + f.params.feed_time}
+    return CycleTimes(height_at, offsets, free, PendulumParameters(f.params, b.params, *turns).period)
+
+
 def _bounds(case: Case, names: tuple[str, ...], setups: tuple[SwingSetup, ...]) -> tuple[np.ndarray, np.ndarray]:
     """Variable bounds: speeds from the least crank speed (the draw) or 0 up to the top crank speed, the draw
     speed at most its swing's bound (the case's own when it gives one), durations above ``MIN_HALF_S``."""
@@ -288,6 +346,7 @@ def _bounds(case: Case, names: tuple[str, ...], setups: tuple[SwingSetup, ...]) 
     top = min(tops, default=TOP_SPEED)  # the crank's and the motor's top speed
     given = case.process.draw_speed_rpm
     (s_lo, s_hi), (e_lo, e_hi) = swing_bounds(case)
+    robots = start_variables(case)
     for i, name in enumerate(names):
         if name.endswith("peak_speed"):
             hi[i] = top
@@ -305,6 +364,8 @@ def _bounds(case: Case, names: tuple[str, ...], setups: tuple[SwingSetup, ...]) 
             lo[i], hi[i] = e_lo, e_hi
         elif name == "law_parameter":
             lo[i], hi[i] = _law_parameter_bounds(case)
+        elif name in robots:  # a robot's start: within a period either side of its window's theta3
+            lo[i], hi[i] = -time_limit(case), time_limit(case)
     return lo, hi
 
 
@@ -337,13 +398,25 @@ def starts(case: Case, nlp: PendulumNLP) -> list[dict[str, float]]:
             i = nlp.names.index(f"{setup.name}_draw_speed")
             w2 = max(nlp.lbx[i], min(nlp.ubx[i], draw_share * nlp.ubx[i]))
             values.update(_swing_start(setup, ends[setup.name], w2, peak * w2, law.name, shape))
-        transfer = case.process.transfer_time_s
+        transfer = case.transfer_time_s  # (with robots their span: a start's window)
         turns = (("turn_end_s", ("forward", "backward")), ("turn_start_s", ("backward", "forward")))
         for turn, (first, second) in turns:
             window = _tail(values, first) + values[f"{second}_closing_time"]
             values[turn] = max(transfer - window, 0.0)
-        out.append(values)
+        out.append(values | _robot_starts(case, values))
     return out
+
+
+def _robot_starts(case: Case, values: dict[str, float]) -> dict[str, float]:
+    """The robots' starts of a start's ``values`` (``planning.solver.pendulum_robots.first_starts``): each
+    window's theta4 and next theta1 [s from its theta3]."""
+    if case.robots is None:
+        return {}
+    times = {}
+    for w, (first, second), turn in zip(WINDOWS, (SWINGS, SWINGS[::-1]), ("turn_end_s", "turn_start_s"), strict=True):
+        opening = values[f"{first}_opening_time"]
+        times[w] = (opening, opening + _tail(values, first) + values[turn] + values[f"{second}_closing_time"])
+    return first_starts(case, times)
 
 
 def _tail(values: dict[str, float], swing: str) -> float:
@@ -403,7 +476,14 @@ def plan_of_values(case: Case, values: dict[str, float], info: SolverInfo) -> Pe
         )
     params = PendulumParameters(swings["forward"], swings["backward"], values["turn_end_s"], values["turn_start_s"])
     fwd = tuple(float(a) for a in case.key_angles)
-    return PendulumPlan(params, profile_of(params), fwd, backward_key_angles(case), info, dict(values))
+    plan = PendulumPlan(params, profile_of(params), fwd, backward_key_angles(case), info, dict(values))
+    if case.robots is None:
+        return plan
+    f, b = params.forward, params.backward
+    t3 = float(f.feed_time + f.draw_time)  # the forward swing's theta3 [s from its start]
+    to_back3 = float(f.return_time + params.turn_end_s + b.feed_time + b.draw_time)
+    offsets = {WINDOWS[0]: t3, WINDOWS[1]: t3 + to_back3}
+    return replace(plan, robot_starts_s=plan_starts(case, values, offsets, plan.period))
 
 
 def solve_once(case: Case, nlp: PendulumNLP, start: dict[str, float]) -> tuple[dict[str, float] | None, Any]:
@@ -428,6 +508,8 @@ def sampled_limit_values(case: Case) -> dict[str, float]:
         cap = torque_capacity_kNm(case)
         if cap is not None:
             out["crank_torque"] = cap * (1 - DRIVE_BACKOFF)
+    if case.robots is not None:
+        out[NEED_FACTOR] = 1.0  # the robots' needs at the samples as the curves say (raised on a dense failure)
     return out
 
 
@@ -436,9 +518,13 @@ def refined(limits: dict[str, float], failures: list) -> dict[str, float] | None
     failure is no sampled limit's: refining cannot help)."""
     out = dict(limits)
     for check in failures:
-        if check.id not in SAMPLED_LIMITS:
+        if check.refine_by is not None and check.refine_by[0] in limits:  # the robots' needs: raised
+            name, factor, _ = check.refine_by
+            out[name] = limits[name] * factor
+        elif check.id in SAMPLED_LIMITS:
+            out[check.id] = limits[check.id] * min(check.limit / check.value, 1.0) * (1 - REFINE_MARGIN)
+        else:
             return None
-        out[check.id] = limits[check.id] * min(check.limit / check.value, 1.0) * (1 - REFINE_MARGIN)
     return out
 
 

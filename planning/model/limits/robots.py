@@ -286,15 +286,10 @@ class RobotsLimit(Limit):
         out, clearances = [], []
         for robot in case.robots_on_path:
             schedule = robot_schedule(dense, robot)
-            clearances.append((_clearance_check(self, dense, schedule), schedule.least_ratio))
+            clearances.append((clearance_check(dense, schedule), schedule.least_ratio))
             out.append(clearances[-1][0])
-            out += _path_checks(robot, k)
-        failed = [(c, ratio) for c, ratio in clearances if not c.passed]
-        if failed:  # the search raises the needs at the NLP's samples once, by the worst shortfall
-            worst, ratio = min(failed, key=lambda pair: pair[1])
-            factor = (1 / max(ratio, 0.5)) * (1 + REFINE_MARGIN) / (1 - REFINE_MARGIN)
-            out[out.index(worst)] = replace(worst, refine_by=("robots_need_factor", factor, np.inf))
-        return out + within + _order_checks(case, plan, dense)
+            out += path_checks(robot, k)
+        return worst_refined(out, clearances) + within + _order_checks(case, plan, dense)
 
     def bound_rows(self, mesh: BoundMesh) -> list[tuple[Any, Any, Any]]:
         """For each height a tool needs: the intervals that reach it take at least the robots' time there;
@@ -330,24 +325,39 @@ def _within_check(robot: Robot, occupancy_s: float, period_s: float) -> Check:
     return Check.of("robots_order", name, occupancy_s, period_s, "s", "max", TIME_TOL_S)
 
 
-def _clearance_check(limit: RobotsLimit, dense: Dense, schedule: RobotSchedule) -> Check:
+def clearance_check(dense: Dense, schedule: RobotSchedule) -> Check:
     """The slide's height where the robot's tool is closest against what it needs there, located; a tool
     that never needs height has nothing to keep (passes)."""
+    check_id = RobotsLimit.id
     if not np.isfinite(schedule.least_clearance_mm):
-        return Check.of(limit.id, f"{schedule.name}: its tool never needs the slide up", 0.0, 0.0, "mm", "min", 0.0)
+        return Check.of(check_id, f"{schedule.name}: its tool never needs the slide up", 0.0, 0.0, "mm", "min", 0.0)
     need = schedule.tightest_need_mm
     c = Check.of(
-        limit.id,
+        check_id,
         f"{schedule.name}: slide height where its tool is closest",
         need + schedule.least_clearance_mm,
         need,
-        limit.unit,
+        RobotsLimit.unit,
         "min",
         LIMIT_REL_TOL * max(need, 1.0),
     )
     at = schedule.least_at_s
     angle = float(np.degrees(dense.plan.profile.at_time(np.array([at]))[0][0])) % 360.0
     return replace(c, peak=Peak(at, angle, ((at, at),)))
+
+
+def worst_refined(checks: list[Check], clearances: list[tuple[Check, float]]) -> list[Check]:
+    """``checks`` with the worst failed clearance (of ``clearances``: each check with the schedule's least
+    height over need) carrying the refinement: the search raises the needs at the NLP's samples once, by that
+    shortfall."""
+    failed = [(c, ratio) for c, ratio in clearances if not c.passed]
+    if not failed:
+        return checks
+    worst, ratio = min(failed, key=lambda pair: pair[1])
+    factor = (1 / max(ratio, 0.5)) * (1 + REFINE_MARGIN) / (1 - REFINE_MARGIN)
+    out = list(checks)
+    out[out.index(worst)] = replace(worst, refine_by=("robots_need_factor", factor, np.inf))
+    return out
 
 
 def _levels(robots: dict[str, Robot]) -> list[float]:
@@ -417,7 +427,7 @@ def robot_schedule(dense: Dense, robot: Robot) -> RobotSchedule:
 PATH_GRID = 4001  # times over an occupancy at which a robot's speed and acceleration are differenced
 
 
-def _path_checks(robot: Robot, scale: float) -> list[Check]:
+def path_checks(robot: Robot, scale: float) -> list[Check]:
     """The robot's speed and acceleration along its path run ``scale`` times as fast as planned, by central
     differences of its position on :data:`PATH_GRID` times (exact for its pieces up to cubic; between pieces a
     mean of the two)."""

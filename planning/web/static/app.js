@@ -851,19 +851,24 @@ function drawRobots(r, c, x, axis) {
   if (!r.robots) { Plotly.purge(el); el.style.display = "none"; return; }
   el.style.display = "block";
   const traces = [{ x, y: c.slider_height_mm, name: "slide height [mm]", line: { color: "#1f77b4" } }];
-  for (const robot of r.robots.robots) {
+  const paths = [];
+  for (const robot of r.robots.robots) {  // (a pendulum cycle's: each robot once in each window)
     const colour = ROBOT_COLOURS[robot.name] || "#000";
-    const need = c[`${robot.name}_needed_height_mm`];
-    // drawn where it needs height and one sample either side (the line reaches 0 where the tool leaves)
-    const shown = need.map((v, i) => (v > 0 || need[i - 1] > 0 || need[i + 1] > 0 ? v : null));
-    traces.push({ x, y: shown, name: `height the ${robot.name}'s tool needs [mm]`, line: { color: colour }, connectgaps: false });
+    if (!paths.some((p) => p.name.startsWith(`${robot.name} on`))) {
+      const need = c[`${robot.name}_needed_height_mm`];
+      // drawn where it needs height and one sample either side (the line reaches 0 where the tool leaves)
+      const shown = need.map((v, i) => (v > 0 || need[i - 1] > 0 || need[i + 1] > 0 ? v : null));
+      traces.push({ x, y: shown, name: `height the ${robot.name}'s tool needs [mm]`, line: { color: colour }, connectgaps: false });
+      paths.push({ x, y: c[`${robot.name}_position_mm`], yaxis: "y2", name: `${robot.name} on its path [mm from the die centre]`, line: { color: colour, dash: "dot" } });
+    }
     if (robot.least_clearance_mm != null) {
       const at = axis === "time" ? robot.least_clearance_time_s : c.crank_angle_deg[nearest(c.time_s, robot.least_clearance_time_s)];
       const clearance = (Math.round(robot.least_clearance_mm * 100) / 100 + 0).toFixed(2);
-      traces.push({ x: [at], y: [robot.needed_there_mm], mode: "markers", marker: { symbol: "triangle-down", size: 10, color: colour }, name: `${robot.name}: least clearance ${clearance} mm` });
+      const which = robot.window ? `${robot.name} ${robot.window}` : robot.name;
+      traces.push({ x: [at], y: [robot.needed_there_mm], mode: "markers", marker: { symbol: "triangle-down", size: 10, color: colour }, name: `${which}: least clearance ${clearance} mm` });
     }
-    traces.push({ x, y: c[`${robot.name}_position_mm`], yaxis: "y2", name: `${robot.name} on its path [mm from the die centre]`, line: { color: colour, dash: "dot" } });
   }
+  traces.push(...paths);
   const layout = {
     ...cycleChartLayout(r, x, axis, -0.18),
     title: { text: `robots on their interference curves (${r.robots.order})`, font: { size: 12 }, x: 0.01, xanchor: "left" },
