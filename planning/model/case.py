@@ -956,7 +956,7 @@ PENDULUM_NOT_WITH = (  # what a pendulum stroke does not plan with yet: (field, 
     (
         "planner.objective",
         lambda c: c.planner.objective if c.planner.objective == "min-grid-peak" else None,
-        "the grid's peak needs the drive's electrical side, not planned for swings yet",
+        "the swings' NLP holds no grid rows yet",
     ),
     ("process.hold_time_s", lambda c: c.process.hold_time_s, "no hold in a swing yet"),
     (
@@ -965,7 +965,11 @@ PENDULUM_NOT_WITH = (  # what a pendulum stroke does not plan with yet: (field, 
         f"at most {MAX_HOLD_S:g} s: the swings stand at the turns, a cycle's times within the plan's precision",
     ),
     ("process.draw_slide_speed_mm_s", lambda c: c.process.draw_slide_speed_mm_s, "a swing draws at a crank speed"),
-    ("drive", lambda c: "a drive" if c.electrical else None, "its electrical side (losses, storage, grid) not yet"),
+    (
+        "drive.grid.peak_power_kW",
+        lambda c: g.peak_power_kW if c.drive is not None and (g := c.drive.grid) is not None else None,
+        "the swings' NLP holds no grid rows yet (the power chain to the grid is computed and written)",
+    ),
 )
 
 
@@ -978,8 +982,7 @@ def _pendulum_checks(case: Case) -> None:
     for name, value_of, why in PENDULUM_NOT_WITH:
         value = value_of(case)
         if value is not None:
-            section = name == "drive"
-            raise CaseError(name, f"not with planner.mode: pendulum ({why})", None if section else value, not section)
+            raise CaseError(name, f"not with planner.mode: pendulum ({why})", value)
 
 
 def _slide_draw_checks(case: Case) -> None:

@@ -74,6 +74,7 @@ def pendulum_result(solution: PendulumSolution, case: Case) -> dict[str, Any]:
         "swings": swings,
         "rotary": rotary,
         **({"drive": {**drive_block(solution, case), "per": "cycle of two strokes"}} if drive is not None else {}),
+        **({"power": {**drive.power.as_dict(), "per": "cycle of two strokes"}} if drive and drive.power else {}),
         **({"at_rate": _at_rate(solution)} if solution.at_rate is not None else {}),
         **({"robots": robots_block(solution, case)} if case.robots is not None else {}),
         "verification": {
@@ -157,7 +158,7 @@ def pendulum_summary(r: dict[str, Any]) -> str:
             f"{d['peak_motor_power_kW']:.1f} kW; per stroke {d['energy_drawn_kJ'] / 2:.2f} kJ drawn, "
             f"{-d['energy_returned_kJ'] / 2:.2f} kJ returned"
         )
-    lines += robot_lines(r)
+    lines += _power_lines(r) + robot_lines(r)
     v = r["verification"]
     lines.append(f"  binding: {', '.join(v['binding']) or 'none'}")
     failed = [c for c in v["checks"] if not c["passed"]]
@@ -168,6 +169,28 @@ def pendulum_summary(r: dict[str, Any]) -> str:
     sv = r["solver"]
     lines.append(f"  solver: {sv['iterations']} iterations, {sv['starts']} starts, {sv['wall_time_s']:.3f} s")
     return "\n".join(lines)
+
+
+def _power_lines(r: dict[str, Any]) -> list[str]:
+    """With the drive's electrical side: the grid's energy and peak and the losses, a stroke's (a cycle's over
+    its two strokes)."""
+    p = r.get("power")
+    if not p:
+        return []
+    storage = (
+        f", with the storage {p['grid_peak_kW']:.1f} kW (it swings {p['storage_swing_kJ']:.2f} of "
+        f"{p['storage_usable_kJ']:.2f} kJ)"
+        if p["storage_usable_kJ"] > 0
+        else ""
+    )
+    return [
+        f"  grid: {p['grid_energy_kJ'] / 2:.2f} kJ a stroke ({p['grid_energy_kWh_per_1000_strokes']:.2f} kWh per "
+        f"1000 strokes), mean {p['mean_grid_power_kW']:.1f} kW; peak without storage {p['bus_peak_kW']:.1f} kW"
+        + storage,
+        f"  losses a stroke: copper {p['copper_loss_kJ'] / 2:.2f}, converter {p['converter_loss_kJ'] / 2:.2f}, gear "
+        f"{p['gear_loss_kJ'] / 2:.2f}, storage {p['storage_loss_kJ'] / 2:.2f}, braking resistor "
+        f"{p['resistor_loss_kJ'] / 2:.2f} kJ",
+    ]
 
 
 def pendulum_columns(solution: PendulumSolution, case: Case) -> dict[str, np.ndarray]:

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -321,9 +322,13 @@ def chain(state: dict, case: Case) -> dict[str, np.ndarray]:
     )
 
 
-def _state(profile: Profile, case: Case, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict]:
+def _state(
+    profile: Profile, case: Case, t: np.ndarray, forming: Any = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict]:
+    """The crank's state and the drive's with its power chain at times ``t`` [s from the cycle's start]
+    (``forming(theta, omega)`` [N]: a pendulum stroke's forming force on either swing; None: a rotary cycle's)."""
     th, om, al, _ = profile.at_time(profile.t0 + t)
-    s = drive_state(th, om, al, case.machine, case.drive_model)
+    s = drive_state(th, om, al, case.machine, case.drive_model, None if forming is None else forming(th, om))
     return th, om, al, {**s, **chain(s, case)}
 
 
@@ -356,24 +361,46 @@ def power_columns(schedule: Schedule, state: dict, t: np.ndarray, case: Case) ->
     }
 
 
+def _sizing(
+    edges: np.ndarray, top: np.ndarray, storage: Storage | None, limit_kW: float | None, grid_peak_W: float
+) -> tuple[float | None, float | None]:
+    """``(bus cap [kW], storage [kJ])`` for the grid's limit: where the grid's peak is above it, the bus's cap
+    at which the storage could hold it; the least storage that holds it on this plan (None where there is no
+    limit or no storage, or no size would do: JSON has no infinity)."""
+    if limit_kW is None or storage is None:
+        return None, None
+    needed = storage_needed(edges, top, limit_kW * 1e3, storage.efficiency, storage.max_power)
+    cap = bus_cap_for_limit(edges, top, storage, limit_kW * 1e3) / 1e3 if grid_peak_W > limit_kW * 1e3 else None
+    return cap, (needed / 1e3 if math.isfinite(needed) else None)
+
+
 def power_figures(
-    profile: Profile, case: Case, dense_t: np.ndarray, dense_state: dict, least_energy: bool = True
+    profile: Profile,
+    case: Case,
+    dense_t: np.ndarray,
+    dense_state: dict,
+    least_energy: bool = True,
+    swings: Any = None,
 ) -> PowerFigures:
     """The power chain of a plan's cycle (``profile`` from TDC) per stroke, with the storage's schedule;
     peaks on the dense grid ``dense_t`` [s from the start] (drive states ``dense_state`` there) and on the
     schedule's edges, which the schedule holds (:func:`interval_peaks`). ``least_energy`` False: the lazy
-    schedule at the same peak (:func:`shave`; a search's verification), whose energies differ."""
+    schedule at the same peak (:func:`shave`; a search's verification), whose energies differ. ``swings``: a
+    pendulum stroke's ``(breakpoints [s], forming(theta, omega) [N])`` (``planning.model.drive.cycle_integrals``'
+    own): the energies a cycle's, two strokes (the per-1000-strokes figure halved)."""
     d = case.drive
+    breakpoints, forming = (None, None) if swings is None else swings
+    strokes = 1 if swings is None else 2
     edges = shaving_edges(profile.duration)
-    edge_state = _state(profile, case, edges)[3]
+    edge_state = _state(profile, case, edges, forming)[3]
     edge_bus = edge_state["bus_power_W"]
     dense_chain = {**dense_state, **chain(dense_state, case)}
     top = interval_peaks(edges, edge_bus, dense_t, dense_chain["bus_power_W"])
     schedule = _schedule(edges, edge_bus, top, case, least_energy)
     storage = Storage.of(case)
-    nodes, weights = quadrature(profile, case, extra_edges=profile.t0 + schedule.edges)
+    nodes, weights = quadrature(profile, case, extra_edges=profile.t0 + schedule.edges, edges=breakpoints)
     t = nodes - profile.t0
-    _, om, al, s = _state(profile, case, t)
+    _, om, al, s = _state(profile, case, t, forming)
     cols = power_columns(schedule, s, t, case)
     i = case.drive_model.i
 
@@ -395,14 +422,8 @@ def power_figures(
     th_peak = profile.at_time(profile.t0 + np.array([times[k]]))[0][0]
     grid_energy = integral(cols["grid_power_W"])
     limit = d.grid.peak_power_kW if d.grid is not None else None
-    cap = None
+    cap, for_limit = _sizing(edges, top, storage, limit, float(grid[k]))
     flatten = storage_to_flatten(edges, edge_bus, top, storage) if storage is not None else None
-    for_limit = None  # also where no size would do (its power limit): JSON has no infinity
-    if limit is not None and storage is not None:
-        needed = storage_needed(edges, top, limit * 1e3, storage.efficiency, storage.max_power)
-        for_limit = needed / 1e3 if math.isfinite(needed) else None
-    if limit is not None and storage is not None and float(grid[k]) > limit * 1e3:
-        cap = bus_cap_for_limit(edges, top, storage, limit * 1e3) / 1e3
     return PowerFigures(
         copper_loss_kJ=integral(cols["copper_loss_W"]),
         converter_loss_kJ=integral(cols["bus_power_W"] - (shaft + cols["copper_loss_W"])),
@@ -413,7 +434,7 @@ def power_figures(
         bus_energy_kJ=integral(cols["bus_power_W"]),
         bus_supply_energy_kJ=integral(grid_power(cols["bus_power_W"], d.regen_efficiency)),
         grid_energy_kJ=grid_energy,
-        grid_energy_kWh_per_1000_strokes=grid_energy / 3.6,
+        grid_energy_kWh_per_1000_strokes=grid_energy / strokes / 3.6,
         mean_bus_power_kW=integral(cols["bus_power_W"]) / profile.duration,
         mean_grid_power_kW=grid_energy / profile.duration,
         bus_peak_kW=bus_peak / 1e3,

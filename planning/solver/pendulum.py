@@ -56,9 +56,11 @@ class PendulumSolution(Solution):
 
     @property
     def energy_kJ(self) -> float:
-        """The supply energy a stroke [kJ]: a cycle's over its two strokes (at the motors' shaft: the drive's
-        electrical side is not planned for swings)."""
-        return self.drive.supply_energy_kJ / STROKES_PER_CYCLE
+        """The supply energy a stroke [kJ]: a cycle's over its two strokes, at the bus with the drive's electrical
+        side (its copper and converter losses counted), else at the motors' shaft (as a rotary solution's)."""
+        power = self.drive.power
+        cycle = power.bus_supply_energy_kJ if power is not None else self.drive.supply_energy_kJ
+        return cycle / STROKES_PER_CYCLE
 
     @property
     def gain(self) -> float | None:

@@ -27,8 +27,16 @@ from planning.model.limits import limits_of
 from planning.model.limits.base import Check, Dense
 from planning.model.pendulum import SWINGS, PendulumPlan, swing_forming_N, swing_of, time_at, windows_of
 from planning.model.profile import sample_times
+from planning.solver.peak_shaving import power_columns, power_figures
 from planning.solver.pendulum_robots import WINDOWS, robot_checks
-from planning.solver.verify import CheckId, Evaluation, Verification, continuity_checks, energy_balance
+from planning.solver.verify import (
+    CheckId,
+    Evaluation,
+    Verification,
+    continuity_checks,
+    energy_balance,
+    power_checks,
+)
 from planning.tolerances import (
     ACCEL_CLOSE_TOL_RAD_S2,
     ANGLE_TOL_RAD,
@@ -60,18 +68,24 @@ def evaluate_pendulum(plan: PendulumPlan, case: Case, cam: bool = False) -> Eval
         keys = np.full(4, np.nan)
     dense = Dense(case, plan, t, th, om, al, je, h, v, a, keys, slide_jerk=slide_jerk, slope=d1, curvature=d2)
     checks = _cycle_checks(dense, cam) + _swing_checks(dense, cam)
-    figures = None
+    figures, columns = None, None
     if case.drive is not None:  # the drive on either swing (``press.dynamics``: signed speeds)
         dense.drive_state = drive_state(th, om, al, case.machine, case.drive_model, swing_forming_N(case, th, om, h))
-        dense.integrals = cycle_integrals(prof, case, (_breakpoints(plan, case), _forming(case)))
+        swings = (_breakpoints(plan, case), _forming(case))
+        dense.integrals = cycle_integrals(prof, case, swings)
         checks.append(energy_balance(dense.integrals))
         figures = drive_figures(prof, case, dense.integrals, (th, dense.drive_state))
+        if case.electrical:  # the power chain to the grid, a cycle's (``planning.solver.peak_shaving``)
+            dense.power = power_figures(prof, case, t, dense.drive_state, True, swings)
+            checks += power_checks(dense.power, dense.integrals, case.drive.storage is not None)
+            columns = power_columns(dense.power.schedule, dense.drive_state, t, case)
+            figures = replace(figures, power=dense.power)
     magnitude = replace(dense, omega=np.abs(om))  # the limits of the crank's speed read its magnitude
     for limit in limits_of(case):
         if limit.id not in OWN_CHECKS:
             checks += limit.check(magnitude)
     verification = Verification(tuple(checks), float(np.max(np.diff(t))), int(t.size))
-    return Evaluation(dense, uniform, verification, figures)
+    return Evaluation(dense, uniform, verification, figures, columns)
 
 
 def _forming(case: Case) -> Any:

@@ -113,14 +113,17 @@ def trapezoid_heat(samples: DriveSamples) -> Any:
 def rate_terms(case: Case, drives: dict[str, DriveSamples], turns: tuple[Any, Any]) -> tuple[Any, Any]:
     """``(heat [N^2 m^2 s], supply energy [J])`` of a cycle of two swings, as the rotary rate NLP takes them
     (``planning.solver.nlp.objective_terms``: the gear's loss rounded where T_c changes sign, the supply
-    ``r P + (1 - r) smoothmax(P, 0)`` of the shaft power ``P = T_m omega_m``, the same on u as on theta), each
+    ``r P + (1 - r) smoothmax(P, 0)`` of the shaft power ``P = T_m omega_m``, or with the drive's copper or
+    converter losses of the bus power through them, the same on u as on theta), each
     standstill's holding torque squared times its time added to the heat (at rest no power flows)."""
     q = objective_values(case)
-    q["motor_base_speed"] = case.drive.motor.base_speed_rpm * RPM
+    d = case.drive
+    q["motor_base_speed"] = d.motor.base_speed_rpm * RPM
+    losses = d.motor.copper_loss_at_rated_kW > 0 or d.converter_efficiency < 1  # the energy at the bus then
     heat, energy = 0.0, 0.0
     for samples in drives.values():
         torque = NLPDriveSamples(case.drive_model, samples.tc, samples.tm, samples.speed)
-        h, e = objective_terms(q, torque, samples.alpha, samples.times)
+        h, e = objective_terms(q, torque, samples.alpha, samples.times, losses)
         heat, energy = heat + h, energy + e
     f, b = drives["forward"], drives["backward"]
     return heat + f.holding**2 * turns[0] + b.holding**2 * turns[1], energy

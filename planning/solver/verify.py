@@ -179,7 +179,7 @@ def _judged(dense: Dense, uniform: np.ndarray, cam: bool = False) -> Evaluation:
         checks.append(energy_balance(dense.integrals))
     columns = None
     if dense.power is not None:
-        checks += _power_checks(dense.power, dense.integrals, case.drive.storage is not None)
+        checks += power_checks(dense.power, dense.integrals, case.drive.storage is not None)
         columns = power_columns(dense.power.schedule, dense.drive_state, dense.t, case)
     verification = Verification(tuple(checks), float(np.max(np.diff(dense.t))), int(dense.t.size))
     figures = None
@@ -194,7 +194,7 @@ def schedule_matters(case: Case) -> bool:
     return case.drive is not None and case.drive.storage is not None
 
 
-def _power_checks(power: PowerFigures, integrals: dict, storage: bool) -> list[Check]:
+def power_checks(power: PowerFigures, integrals: dict, storage: bool) -> list[Check]:
     """The power chain over the cycle: the grid's energy is the forming work and every loss (the kinetic
     energies return to their start), and (``storage``) the storage stays within its usable energy and ends
     where it started."""
