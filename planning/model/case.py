@@ -958,7 +958,6 @@ PENDULUM_NOT_WITH = (  # what a pendulum stroke does not plan with yet: (field, 
         lambda c: c.planner.objective if c.planner.objective == "min-grid-peak" else None,
         "the swings' NLP holds no grid rows yet",
     ),
-    ("process.hold_time_s", lambda c: c.process.hold_time_s, "no hold in a swing yet"),
     (
         "process.transfer_time_s",
         lambda c: t if (t := c.process.transfer_time_s) is not None and t > MAX_HOLD_S else None,

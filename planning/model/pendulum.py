@@ -31,9 +31,11 @@ from typing import Any
 
 import numpy as np
 
+from planning.model.cycle import BRAKE, BRAKE_PREFIX, HOLD_SEGMENT
 from planning.model.laws import get_law
 from planning.model.limits import limits_of
 from planning.model.limits.base import DRAW_GRID, Draw
+from planning.model.limits.hold import least_rate
 from planning.model.profile import Profile, Segment
 from planning.tolerances import ANGLE_ROUND_OFF_RAD, ANGLE_TOL_RAD, SAME_TIME_S, TINY
 from press.dynamics import table_force
@@ -69,11 +71,36 @@ class SwingParameters:
     end: Any
     motion_law: str
     law_parameter: Any = 0.0
+    hold_angle: Any = None
+    hold_time: Any = 0.0
+
+    @property
+    def has_hold(self) -> bool:
+        """The crank brakes after the draw and stands at the hold (``hold_angle`` on u) for ``hold_time``."""
+        return self.hold_angle is not None
+
+    @property
+    def brake_duration(self) -> Any:
+        """The brake half's duration [s] from w2 to standstill over theta3 -> the hold (0 without a hold): every
+        half sweeps ``D (v0 + v1) / 2`` (``planning.model.cycle``)."""
+        return 2 * (self.hold_angle - self.draw_end) / self.draw_speed if self.has_hold else 0.0
+
+    @property
+    def return_start_speed(self) -> Any:
+        """The speed the return rises from [rad/s]: w2, or 0 after a hold."""
+        return 0.0 if self.has_hold else self.draw_speed
+
+    def halves(self) -> tuple[str, ...]:
+        """The swing's halves: :data:`SWING_HALVES` and, with a hold, the brake."""
+        return SWING_HALVES + ((BRAKE,) if self.has_hold else ())
 
     def half(self, name: str) -> tuple[Any, Any]:
-        """``(duration [s], speed change [rad/s])`` of the half ``name`` (:data:`SWING_HALVES`)."""
+        """``(duration [s], speed change [rad/s])`` of the half ``name`` (:meth:`halves`)."""
         w2, wm1, wm2 = self.draw_speed, self.feed_peak_speed, self.return_peak_speed
-        dv = {"feed_accel": wm1, "feed_decel": w2 - wm1, "return_accel": wm2 - w2, "return_decel": -wm2}
+        if name == BRAKE:
+            return self.brake_duration, -w2
+        wr = self.return_start_speed
+        dv = {"feed_accel": wm1, "feed_decel": w2 - wm1, "return_accel": wm2 - wr, "return_decel": -wm2}
         return getattr(self, f"{name}_duration"), dv[name]
 
     @property
@@ -88,8 +115,9 @@ class SwingParameters:
 
     @property
     def return_time(self) -> Any:
-        """Duration [s] from theta3 to the swing's end."""
-        return self.return_accel_duration + self.return_decel_duration
+        """Duration [s] from theta3 to the swing's end (the brake and the hold included)."""
+        halves = self.return_accel_duration + self.return_decel_duration
+        return halves + self.brake_duration + self.hold_time if self.has_hold else halves
 
     @property
     def duration(self) -> Any:
@@ -105,9 +133,13 @@ class SwingParameters:
         return out
 
     def return_segments(self) -> list[Segment]:
-        """The return's segments on u, from w2 at theta3 to rest at the end."""
+        """The return's segments on u, from w2 at theta3 to rest at the end (with a hold: the brake to rest at
+        the hold, the standstill there, then the rise from rest)."""
         law = get_law(self.motion_law)
         out: list[Segment] = []
+        if self.has_hold:
+            out += law.half(BRAKE_PREFIX, *self.half(BRAKE), self.law_parameter)
+            out.append(Segment(HOLD_SEGMENT, self.hold_time, 0.0, 0.0))
         for name in SWING_HALVES[2:]:
             out += law.half(name.replace("_", ":"), *self.half(name), self.law_parameter)
         return out
@@ -118,21 +150,22 @@ class SwingParameters:
         return self.feed_segments() + [draw] + self.return_segments()
 
     def speed_changes(self) -> list[Any]:
-        """|speed change| [rad/s] of each half as the halves are monotone (the peaks at or above the speeds they
-        join, which the NLP holds): wm1, wm1 - w2, wm2 - w2, wm2."""
+        """|speed change| [rad/s] of each half (:meth:`halves`) as the halves are monotone (the peaks at or above
+        the speeds they join, which the NLP holds): wm1, wm1 - w2, wm2 - wr, wm2 (wr the return's start speed),
+        and w2 for the brake."""
         w2, wm1, wm2 = self.draw_speed, self.feed_peak_speed, self.return_peak_speed
-        return [wm1, wm1 - w2, wm2 - w2, wm2]
+        return [wm1, wm1 - w2, wm2 - self.return_start_speed, wm2] + ([w2] if self.has_hold else [])
 
     def peak_accelerations(self) -> list[Any]:
         """Peak |crank acceleration| [rad/s^2] of each half (the law's closed form)."""
         rate = get_law(self.motion_law).peak_rate(self.law_parameter)
-        durations = [self.half(n)[0] for n in SWING_HALVES]
+        durations = [self.half(n)[0] for n in self.halves()]
         return [rate * dv / D for D, dv in zip(durations, self.speed_changes(), strict=True)]
 
     def peak_jerks(self) -> list[Any]:
         """Peak |crank jerk| [rad/s^3] of each half (the law's closed form)."""
         jerk = get_law(self.motion_law).peak_jerk(self.law_parameter)
-        durations = [self.half(n)[0] for n in SWING_HALVES]
+        durations = [self.half(n)[0] for n in self.halves()]
         return [jerk * dv / D**2 for D, dv in zip(durations, self.speed_changes(), strict=True)]
 
 
@@ -339,6 +372,7 @@ class SwingSetup:
     jets: Any
     die_zone: tuple[float, ...]
     draw_speed_bound: float
+    hold: float | None = None  # u [rad] of the hold (``process.hold_time_s``): where the slide stands on this swing
 
 
 def swing_setups(case: Any, limits: dict[str, float]) -> tuple[SwingSetup, SwingSetup]:
@@ -346,11 +380,19 @@ def swing_setups(case: Any, limits: dict[str, float]) -> tuple[SwingSetup, Swing
     m = case.machine
     fwd = tuple(float(a) for a in case.key_angles)
     back = tuple(TWO_PI - a for a in backward_key_angles(case))
+    holds = (None, None) if case.hold_angle is None else hold_angles(case)
     out = []
-    for name, keys in zip(SWINGS, (fwd, back), strict=True):
+    for name, keys, hold in zip(SWINGS, (fwd, back), holds, strict=True):
         jets = m.jets if name == "forward" else (lambda u: mirrored_jets(m, u))  # noqa: E731 - one line each
-        out.append(SwingSetup(name, keys, jets, die_zone(case, name, keys), draw_speed_bound(case, keys, jets, limits)))
+        bound = draw_speed_bound(case, keys, jets, limits, hold)
+        out.append(SwingSetup(name, keys, jets, die_zone(case, name, keys), bound, hold))
     return out[0], out[1]
+
+
+def hold_angles(case: Any) -> tuple[float, float]:
+    """The hold's angle on each swing's u [rad]: where the slide passes the hold height on its way down (BDC for
+    a hold at BDC)."""
+    return float(case.hold_angle), TWO_PI - other_side(case.machine, float(case.hold_angle))
 
 
 def die_zone(case: Any, swing: str, keys: tuple[float, ...]) -> tuple[float, ...]:
@@ -368,10 +410,13 @@ def die_zone(case: Any, swing: str, keys: tuple[float, ...]) -> tuple[float, ...
     return tuple(float(a) for a in np.linspace(u3, leave, DIE_ZONE_POINTS + 1)[1:])
 
 
-def draw_speed_bound(case: Any, keys: tuple[float, ...], jets: Any, limits: dict[str, float]) -> float:
+def draw_speed_bound(
+    case: Any, keys: tuple[float, ...], jets: Any, limits: dict[str, float], hold: float | None = None
+) -> float:
     """The highest constant draw speed [rad/s] in a swing's draw (``keys`` on u, ``jets`` the mechanism on u):
-    each limit's own bound on the draw (``Limit.draw_speed_bound``) and the die speed's over the draw's part at
-    or below the die height and where the draw crosses it."""
+    each limit's own bound on the draw (``Limit.draw_speed_bound``), the die speed's over the draw's part at
+    or below the die height and where the draw crosses it, and with a hold at ``hold`` (u) the speed the crank can
+    brake from to the hold (``planning.model.limits.hold``: ``sqrt(2 A (u_h - u3) / rate)``)."""
     theta = np.linspace(keys[1], keys[2], DRAW_GRID)
     h, d1, d2, _ = jets(theta)
     draw = Draw(case, theta, np.asarray(h), np.asarray(d1), np.asarray(d2))
@@ -397,6 +442,9 @@ def draw_speed_bound(case: Any, keys: tuple[float, ...], jets: Any, limits: dict
     accel = limits.get("slider_accel")
     if accel is not None:  # the refined acceleration limit in the draw too
         bounds.append(math.sqrt(accel / max(float(np.max(np.abs(d2))), TINY)))
+    top = case.limits.crank_accel_rad_s2
+    if hold is not None and top is not None:
+        bounds.append(math.sqrt(2 * top * (hold - keys[2]) / least_rate(case)))
     return min(bounds)
 
 

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from planning.model.case import RPM, Case
-from planning.model.pendulum import SWINGS
+from planning.model.pendulum import SWINGS, TWO_PI, hold_angles
 from planning.reports.folder import write_json, write_table
 from planning.reports.report import MAX_ROWS, columns_at, drive_block, trajectory_columns
 from planning.reports.robots import robot_lines, robots_block
@@ -70,6 +70,7 @@ def pendulum_result(solution: PendulumSolution, case: Case) -> dict[str, Any]:
             "turn_start_s": float(p.turn_start_s),
             "safety_height_mm": case.process.safety_height_mm,
             "die_height_mm": case.limits.die_height_mm,
+            **({"hold": _hold(case)} if case.hold_angle is not None else {}),
         },
         "swings": swings,
         "rotary": rotary,
@@ -89,6 +90,17 @@ def pendulum_result(solution: PendulumSolution, case: Case) -> dict[str, Any]:
             "starts": plan.solver.starts,
             "wall_time_s": plan.solver.wall_time_s,
         },
+    }
+
+
+def _hold(case: Case) -> dict[str, Any]:
+    """A hold on each swing: its time [s], height [mm above BDC] and crank angle on each swing [deg]."""
+    forward, backward = (TWO_PI - u if k else u for k, u in enumerate(hold_angles(case)))
+    return {
+        "time_s": case.process.hold_time_s,
+        "height_mm": case.hold_height_mm,
+        "forward_deg": math.degrees(forward),
+        "backward_deg": math.degrees(backward),
     }
 
 
@@ -134,6 +146,12 @@ def pendulum_summary(r: dict[str, Any]) -> str:
         f"({s['end_deg'] - s['start_deg']:.2f} deg), standing {s['turn_end_s']:.4f} s and {s['turn_start_s']:.4f} s "
         "at the ends",
     ]
+    if "hold" in s:
+        hold = s["hold"]
+        lines.append(
+            f"  each swing holds {hold['time_s']:g} s at {hold['height_mm']:g} mm above BDC, the crank standing at "
+            f"{hold['forward_deg']:.2f} deg forward and {hold['backward_deg']:.2f} deg backward"
+        )
     for name, sw in (("forward", f), ("backward", b)):
         keys = ", ".join(f"{k['name']} {k['angle_deg']:.2f} deg" for k in sw["key_points"])
         lines.append(

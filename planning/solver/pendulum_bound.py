@@ -18,7 +18,8 @@ interval) by the crank speed squared ``s`` any such motion can have at the nodes
 propagated forward and backward over the arc until nothing changes: the largest ``s`` any motion can have at
 each node. Within an interval the speed squared is at most the largest cap at its ends (|h'| monotone) and at
 most either end's envelope plus the crank acceleration's reach, so the interval takes at least ``dtheta /
-sqrt(that)``. The bound is ``120 / (2 T + t_f + t_b)`` (two strokes a cycle). It leaves out the jerk limit, the
+sqrt(that)``; with a hold each swing stands its hold time on the arc, added to ``t_k``. The bound is
+``120 / (2 T + t_f + t_b)`` (two strokes a cycle). It leaves out the jerk limit, the
 turns (the crank at rest there) and the windows' own motion, so it is loose: an upper bound, not an estimate.
 
 With robots on their interference curves (``planning.solver.pendulum_robots``) there is no transfer time; the
@@ -65,7 +66,7 @@ class PendulumBound:
 def pendulum_bound(case: Case) -> PendulumBound:
     """The upper bound of a pendulum case (module docstring)."""
     setups = swing_setups(case, {})  # the case's own limits
-    times = tuple(_least_arc_time(case, setup) for setup in setups)
+    times = tuple(_least_arc_time(case, setup) + case.standstill_s for setup in setups)  # (a hold: on the arc)
     if case.robots is None:
         cycle = 2 * case.process.transfer_time_s + sum(times)
         return PendulumBound(STROKES_PER_CYCLE * 60.0 / cycle, cycle, times)  # type: ignore[arg-type]
@@ -96,10 +97,15 @@ def robot_demands(case: Case, setups: tuple[SwingSetup, ...]) -> list[tuple[floa
             continue
         down, up = (float(a) for a in m.angles_at_height(level))
         arcs = {"forward": (down, up), "backward": (2 * math.pi - up, 2 * math.pi - down)}
-        below = sum(_least_arc_time(case, s, arcs[s.name]) for s in setups)
+        below = sum(_least_arc_time(case, s, arcs[s.name]) + _hold_below(case, level) for s in setups)
         need = max(time_needing(r, level) for r in robots.values())
         out.append((below + STROKES_PER_CYCLE * need, f"the slide below {level:g} mm and the robots above it"))
     return out
+
+
+def _hold_below(case: Case, level: float) -> float:
+    """[s] the hold's standstill where it lies below ``level`` [mm] (on the arc below it), else 0."""
+    return case.standstill_s if case.hold_height_mm < level else 0.0
 
 
 def _nodes(case: Case, setup: SwingSetup, arc: tuple[float, float] | None = None) -> np.ndarray:

@@ -25,6 +25,7 @@ from planning.model.case import RPM, Case
 from planning.model.drive import cycle_integrals, drive_figures
 from planning.model.limits import limits_of
 from planning.model.limits.base import Check, Dense
+from planning.model.limits.hold import longest_run_s
 from planning.model.pendulum import SWINGS, PendulumPlan, swing_forming_N, swing_of, time_at, windows_of
 from planning.model.profile import sample_times
 from planning.solver.peak_shaving import power_columns, power_figures
@@ -40,6 +41,7 @@ from planning.solver.verify import (
 from planning.tolerances import (
     ACCEL_CLOSE_TOL_RAD_S2,
     ANGLE_TOL_RAD,
+    HOLD_STILL_MM,
     HOLD_STILL_RAD_S,
     LIMIT_REL_TOL,
     SPEED_TOL_RAD_S,
@@ -48,7 +50,15 @@ from planning.tolerances import (
 from press.dynamics import drive_state
 from press.mechanism import slider_motion
 
-OWN_CHECKS = ("transfer_time", "safety_height", "min_crank_speed", "die_speed", "draw_start_speed", "robots")  # here
+OWN_CHECKS = (  # held here
+    "transfer_time",
+    "safety_height",
+    "min_crank_speed",
+    "die_speed",
+    "draw_start_speed",
+    "robots",
+    "hold",
+)
 
 
 def evaluate_pendulum(plan: PendulumPlan, case: Case, cam: bool = False) -> Evaluation:
@@ -170,6 +180,25 @@ def _swing_checks(d: Dense, cam: bool) -> list[Check]:
     out.append(Check.of("min_crank_speed", name, slowest / RPM, least, "rpm", "min", LIMIT_REL_TOL * least))
     out.append(_draw_start_check(d, times))
     out.append(_die_check(d, spans))
+    if case.process.hold_time_s is not None:
+        out += _hold_checks(d, spans)
+    return out
+
+
+def _hold_checks(d: Dense, spans: dict[str, tuple[float, float]]) -> list[Check]:
+    """The hold on each swing: the longest run of samples within the swing with the crank standing and the slide
+    within ``HOLD_STILL_MM`` of its hold height lasts at least the hold time (``planning.model.limits.hold``)."""
+    case = d.case
+    still = (np.abs(d.h - case.hold_height_mm) <= HOLD_STILL_MM) & (np.abs(d.omega) <= HOLD_STILL_RAD_S)
+    limit = case.process.hold_time_s
+    out = []
+    for swing, (lo, hi) in spans.items():
+        inside = (d.t >= lo) & (d.t <= hi)
+        stood, start = longest_run_s(d.t[inside], still[inside]) if still[inside].any() else (0.0, lo)
+        name = f"{swing} swing: crank standing, the slide at its hold height"
+        check = Check.of("hold", name, stood, limit, "s", "min", TIME_TOL_S)
+        theta = float(np.interp(start, d.t, d.theta))
+        out.append(check.located(np.array([start]), np.array([theta]), np.array([stood]), limit))
     return out
 
 

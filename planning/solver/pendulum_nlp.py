@@ -123,7 +123,12 @@ def _segments_from(segs: list, theta0: Any, omega0: Any) -> tuple[tuple[list, li
     return (starts, states[:-1], segs), states[-1]
 
 
-def _swing(setup: SwingSetup, v: dict[str, Any], ends: tuple[Any, Any], law_name: str, law_parameter: Any) -> _Swing:
+def _swing(
+    setup: SwingSetup, v: dict[str, Any], ends: tuple[Any, Any], law: tuple[str, Any], hold_time: float
+) -> _Swing:
+    """One swing's symbols (``law``: the law's name and its shape parameter; ``hold_time`` [s] at the setup's
+    hold, where it has one)."""
+    law_name, law_parameter = law
     p = SwingParameters(
         v["draw_speed"],
         v["feed_peak_speed"],
@@ -138,6 +143,8 @@ def _swing(setup: SwingSetup, v: dict[str, Any], ends: tuple[Any, Any], law_name
         ends[1],
         law_name,
         law_parameter,
+        setup.hold,
+        hold_time if setup.hold is not None else 0.0,
     )
     feed, feed_end = _segments_from(p.feed_segments(), ends[0], 0.0)
     ret, return_end = _segments_from(p.return_segments(), setup.keys[2], p.draw_speed)
@@ -158,13 +165,13 @@ def _swing_rows(rows: Rows, s: _Swing, case: Case, limits: dict[str, float], uni
         "key_points",
     )
     # (the speeds at theta2 and at the end are w2 and 0 by construction: the halves' changes add up)
-    w2, wm1, wm2 = p.draw_speed, p.feed_peak_speed, p.return_peak_speed
+    w2, wm1, wm2, wr = p.draw_speed, p.feed_peak_speed, p.return_peak_speed, p.return_start_speed
     rows.add(
-        "peak speeds above the draw speed", ca.vertcat(wm1 - w2, wm2 - w2) / w_unit, 0.0, math.inf, "planner.motion_law"
+        "peak speeds above the draw speed", ca.vertcat(wm1 - w2, wm2 - wr) / w_unit, 0.0, math.inf, "planner.motion_law"
     )
     if law.one_jerk_per_curve:  # Eq. 14: one jerk for both halves of each S-curve
         d_fa, d_fd, d_ra, d_rd = (p.half(n)[0] for n in SWING_HALVES)
-        one = ca.vertcat(wm1 * d_fd**2 - (wm1 - w2) * d_fa**2, (wm2 - w2) * d_rd**2 - wm2 * d_ra**2)
+        one = ca.vertcat(wm1 * d_fd**2 - (wm1 - w2) * d_fa**2, (wm2 - wr) * d_rd**2 - wm2 * d_ra**2)
         rows.add("one jerk per S-curve (Eq. 14)", one / (t_unit**2 * w_unit), 0.0, 0.0, "planner.motion_law")
     th1, _ = angle_at(v["closing_time"], *s.feed)
     th4, _ = angle_at(v["opening_time"], *s.ret)
@@ -271,7 +278,8 @@ def build(case: Case) -> PendulumNLP:
     swings = {}
     for setup in setups:
         v = {name: phys[f"{setup.name}_{name}"] for name, _ in SWING_VARIABLES}
-        swings[setup.name] = _swing(setup, v, ends[setup.name], law, phys["law_parameter"])
+        hold = case.process.hold_time_s or 0.0
+        swings[setup.name] = _swing(setup, v, ends[setup.name], (law, phys["law_parameter"]), hold)
         _swing_rows(rows, swings[setup.name], case, limits, units)
     f, b = swings["forward"], swings["backward"]
     transfer = case.transfer_time_s
@@ -397,7 +405,8 @@ def starts(case: Case, nlp: PendulumNLP) -> list[dict[str, float]]:
         for setup in nlp.setups:
             i = nlp.names.index(f"{setup.name}_draw_speed")
             w2 = max(nlp.lbx[i], min(nlp.ubx[i], draw_share * nlp.ubx[i]))
-            values.update(_swing_start(setup, ends[setup.name], w2, peak * w2, law.name, shape))
+            hold = case.process.hold_time_s or 0.0
+            values.update(_swing_start(setup, ends[setup.name], w2, peak * w2, (law.name, shape), hold))
         transfer = case.transfer_time_s  # (with robots their span: a start's window)
         turns = (("turn_end_s", ("forward", "backward")), ("turn_start_s", ("backward", "forward")))
         for turn, (first, second) in turns:
@@ -425,17 +434,23 @@ def _tail(values: dict[str, float], swing: str) -> float:
     return ret - values[f"{swing}_opening_time"]
 
 
-def _swing_start(setup: SwingSetup, ends: tuple[float, float], w2: float, wm: float, law: str, shape: float) -> dict:
+def _swing_start(
+    setup: SwingSetup, ends: tuple[float, float], w2: float, wm: float, law: tuple[str, float], hold_time: float
+) -> dict:
     """One swing's start values: S-curves of one jerk each (Eq. 14: ``dv = k J T^2`` per half of ``4 T``, the
-    half sweeping ``D (v0 + v1) / 2``) through the draw speed ``w2`` with peaks ``wm``."""
+    half sweeping ``D (v0 + v1) / 2``) through the draw speed ``w2`` with peaks ``wm`` (``law``: its name and
+    shape parameter); with a hold the return rises from rest at the hold after ``hold_time`` [s]."""
     a, e = ends
-    feed, ret = setup.keys[1] - a, e - setup.keys[2]
+    wr = 0.0 if setup.hold is not None else w2  # the return's start speed
+    feed, ret = setup.keys[1] - a, e - (setup.keys[2] if setup.hold is None else setup.hold)
     # feed: 0 -> wm -> w2 sweeps 2 T_a wm + 2 T_d (wm + w2), T = sqrt(dv / (k J)): solve for sqrt(k J)
     root = 2 * (wm**1.5 + math.sqrt(wm - w2) * (wm + w2)) / feed
     fa, fd = 4 * math.sqrt(wm) / root, max(4 * math.sqrt(wm - w2) / root, MIN_HALF_S)
-    root = 2 * (math.sqrt(wm - w2) * (w2 + wm) + wm**1.5) / ret
-    ra, rd = max(4 * math.sqrt(wm - w2) / root, MIN_HALF_S), 4 * math.sqrt(wm) / root
-    p = SwingParameters(w2, wm, wm, fa, fd, ra, rd, a, setup.keys[1], setup.keys[2], e, law, shape)
+    root = 2 * (math.sqrt(wm - wr) * (wr + wm) + wm**1.5) / ret
+    ra, rd = max(4 * math.sqrt(wm - wr) / root, MIN_HALF_S), 4 * math.sqrt(wm) / root
+    keys = setup.keys
+    hold = (setup.hold, hold_time) if setup.hold is not None else (None, 0.0)
+    p = SwingParameters(w2, wm, wm, fa, fd, ra, rd, a, keys[1], keys[2], e, law[0], law[1], *hold)
     feed_profile = Profile(tuple(p.feed_segments()), a, 0.0)
     ret_profile = Profile(tuple(p.return_segments()), setup.keys[2], w2)
     n = setup.name
@@ -473,6 +488,8 @@ def plan_of_values(case: Case, values: dict[str, float], info: SolverInfo) -> Pe
             e,
             law,
             float(values["law_parameter"]),
+            setup.hold,
+            (case.process.hold_time_s or 0.0) if setup.hold is not None else 0.0,
         )
     params = PendulumParameters(swings["forward"], swings["backward"], values["turn_end_s"], values["turn_start_s"])
     fwd = tuple(float(a) for a in case.key_angles)
