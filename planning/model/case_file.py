@@ -168,6 +168,11 @@ def case_from_data(data: Any, label: str = "<case>") -> Case:
         raise CaseFileError(f"{label}: expected a mapping of case fields at the top level (got {type(data).__name__})")
     if "process" in data and data["process"] is None:  # every process field optional: a section of comments
         data = {**data, "process": {}}
+    robots = data.get("robots")
+    for role in ("unloader", "loader"):  # an empty robot is not a robot left out (a typo's half-written section)
+        if isinstance(robots, dict) and role in robots and robots[role] is None:
+            reason = "is empty: give its path, limits, dwell and interference curve, or leave it out"
+            raise CaseFileError(f"{label}: robots.{role}: {reason}", f"robots.{role}")
     try:
         case = Case.model_validate(data)
     except ValidationError as exc:
@@ -234,6 +239,8 @@ def _pydantic_line(exc: ValidationError, data: Any, label: str, model: type[Base
         return f"{label}: {field}: unknown key{did}"
     if kind == "missing":
         return f"{label}: {field}: missing required field"
+    if kind in ("model_type", "dict_type"):  # (pydantic names its class: a section to the reader)
+        return f"{label}: {field}: must be a section of keys (got {show_value(value)})"
     msg = err["msg"]
     msg = msg[0].lower() + msg[1:] if msg else kind
     return f"{label}: {field}: {msg} (got {show_value(value)})"

@@ -19,7 +19,7 @@ import numpy as np
 from planning.model.cam import Cam, Interpolation
 from planning.model.case import Case
 from planning.reports.outputs._cam import CRANK, FORMATS, MOTOR, CamOptionError
-from planning.solver.cam_proof import OVERRIDE_STEP, CamProof, CamSpec, cam_for, motor_cam, slide_at
+from planning.solver.cam_proof import OVERRIDE_STEP, SPEED_RESOLUTION, CamProof, CamSpec, cam_for, motor_cam, slide_at
 from planning.solver.outcomes import Unverified
 
 if TYPE_CHECKING:
@@ -207,4 +207,6 @@ def refusal(export: CamExport) -> str:
         else "it holds at no master speed searched"
     )
     remedy = "more points" if p.cam.interpolation is Interpolation.POLY5 else "more points, or poly5"
+    if p.highest_speed >= 1.0 - SPEED_RESOLUTION:  # it holds at the plan's own speed: the master asked is too fast
+        remedy = f"run it at most {100 * p.highest_speed:.2f} % (--cam-speed)"
     return f"{cam} breaks {broken} at {100 * p.speed:.2f} % of the plan's master speed; {where}; {remedy}"

@@ -100,7 +100,8 @@ def robot_lines(result: dict[str, Any]) -> list[str]:
     names = [f"{r['name']} {r['window']}" if "window" in r else r["name"] for r in block["robots"]]
     width = max(18, *(len(n) + 1 for n in names))  # (a pendulum cycle's names carry their window)
     head = f"  {'robot [master deg]':<{width}}  leaves    at die  leaves die      back  over die s  least clearance"
-    lines = ["", f"{head} ({block['order']}; {block.get('master', MASTER)})"]
+    order = f"{block['order']}; " if len({r["name"] for r in block["robots"]}) == 2 else ""  # (one robot: no order)
+    lines = ["", f"{head} ({order}{block.get('master', MASTER)})"]
     for r, name in zip(block["robots"], names, strict=True):
         e = r["events"]
         degs = "".join(f"{e[k]['master_deg']:>{w}.1f}" for k, w in zip(EVENTS, (8, 10, 12, 10), strict=True))

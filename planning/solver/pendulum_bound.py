@@ -45,9 +45,10 @@ from planning.model.limits.canonical import SpeedCap
 from planning.model.limits.robots import between_draws_s, robots_by_name
 from planning.model.pendulum import STROKES_PER_CYCLE, SwingSetup, swing_setups
 from planning.solver.upper_bound import inflections, slope_zeros
-from planning.tolerances import SAME_NODE_RAD, TINY
+from planning.tolerances import LIMIT_REL_TOL, SAME_NODE_RAD, TIME_TOL_S, TINY
 from press.robot import time_needing
 
+CHAINED_CHECKS = 3  # the order checks a window's robots pass in turn, each within TIME_TOL_S (at the die, clear, at it)
 ARC_INTERVALS = 20_000  # intervals over each swing's arc theta1 .. theta4
 MAX_PASSES = 50  # forward and backward passes at most (the envelope settles in a few)
 
@@ -85,9 +86,11 @@ def robot_demands(case: Case, setups: tuple[SwingSetup, ...]) -> list[tuple[floa
     if case.robots.order == "in-turns":
         occupancy = sum(r.occupancy_s for r in robots.values())
     draws = sum((s.keys[2] - s.keys[1]) / s.draw_speed_bound for s in setups)
+    # (each less what the verification's tolerances let a plan pass by: no verified plan above the bound)
+    between = between_draws_s(case) - CHAINED_CHECKS * TIME_TOL_S
     out = [
-        (STROKES_PER_CYCLE * occupancy, "each robot in and out in both windows"),
-        (draws + STROKES_PER_CYCLE * between_draws_s(case), "the draws and the robots between them"),
+        (STROKES_PER_CYCLE * (occupancy - TIME_TOL_S), "each robot in and out in both windows"),
+        (draws + STROKES_PER_CYCLE * between, "the draws and the robots between them"),
     ]
     m = case.machine
     _, th2, th3, _ = case.key_angles
@@ -95,7 +98,8 @@ def robot_demands(case: Case, setups: tuple[SwingSetup, ...]) -> list[tuple[floa
     for level in sorted({float(h) for r in robots.values() for h in r.curve.needed_height_mm}):
         if not above_draw < level < m.stroke:
             continue
-        down, up = (float(a) for a in m.angles_at_height(level))
+        lowest = level - LIMIT_REL_TOL * max(level, 1.0)  # the slide a clearance check passes where H is needed
+        down, up = (float(a) for a in m.angles_at_height(max(lowest, above_draw)))
         arcs = {"forward": (down, up), "backward": (2 * math.pi - up, 2 * math.pi - down)}
         below = sum(_least_arc_time(case, s, arcs[s.name]) + _hold_below(case, level) for s in setups)
         need = max(time_needing(r, level) for r in robots.values())

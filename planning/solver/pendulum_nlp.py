@@ -64,6 +64,7 @@ from planning.solver.parameters import time_limit
 from planning.solver.pendulum_drive import drive_rows, rate_terms, swing_drive
 from planning.solver.pendulum_robots import (
     NEED_FACTOR,
+    ROBOTS_CHECK,
     WINDOWS,
     CycleTimes,
     first_starts,
@@ -534,10 +535,13 @@ def refined(limits: dict[str, float], failures: list) -> dict[str, float] | None
     """``limits`` with each sampled limit the dense check found exceeded lowered by its overshoot (None when a
     failure is no sampled limit's: refining cannot help)."""
     out = dict(limits)
+    raised = any(c.refine_by is not None and c.refine_by[0] in limits for c in failures)
     for check in failures:
-        if check.refine_by is not None and check.refine_by[0] in limits:  # the robots' needs: raised
+        if check.refine_by is not None and check.refine_by[0] in limits:  # the robots' needs: raised by the worst
             name, factor, _ = check.refine_by
             out[name] = limits[name] * factor
+        elif check.id == ROBOTS_CHECK and raised:  # another clearance: the worst one's factor raises them all
+            continue
         elif check.id in SAMPLED_LIMITS:
             out[check.id] = limits[check.id] * min(check.limit / check.value, 1.0) * (1 - REFINE_MARGIN)
         else:

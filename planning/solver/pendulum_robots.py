@@ -5,9 +5,10 @@ cycle's two windows between the draws: the window **at theta_e**, from the forwa
 turn at theta_e to the backward swing's theta2, and the window **at theta_s**, from the backward swing's theta3
 through the turn at theta_s to the next forward swing's theta2. In each window the rotary cycle's rules hold
 (``planning.model.limits.robots``): the slide at least as high as each tool needs where the tool is
-(``c(t) = h(t) - n(x(t)) >= 0``), the unloader grips after theta3 and the loader has dropped before theta2, the
-loader after the unloader in the case's order (``overlapping``: it reaches the die centre once the unloader's
-tool is clear of the die; ``in-turns``: it leaves its waiting point once the unloader is back at its own).
+(``c(t) = h(t) - n(x(t)) >= 0``), each robot's dwell at the die centre (the unloader gripping, the loader
+dropping the blank) after theta3 and before theta2, the loader after the unloader in the case's order
+(``overlapping``: it reaches the die centre once the unloader's tool is clear of the die; ``in-turns``: it leaves
+its waiting point once the unloader is back at its own).
 Across the windows each robot's two occupancies do not overlap, and in turns the loader is back before the
 next window's unloader leaves. The planner decides each robot's start in each window: on an asymmetric press
 the swings, and so the windows, differ.
@@ -39,6 +40,7 @@ import numpy as np
 from planning.model.limits.base import Check, Dense
 from planning.model.limits.robots import (
     ROBOT_SAMPLES,
+    RobotsLimit,
     clearance_check,
     order_terms,
     path_checks,
@@ -52,6 +54,7 @@ from press.robot import Robot, sample_points, time_to_clear_s
 
 WINDOWS = ("at theta_e", "at theta_s")  # the cycle's two windows (``planning.model.pendulum.windows_of``'s names)
 NEED_FACTOR = "robots_need_factor"  # the NLP's parameter that scales the needs at the samples
+ROBOTS_CHECK = RobotsLimit.id  # the clearance checks' id (the worst failed one carries the refinement)
 
 
 def start_variable(robot: str, window: str) -> str:
@@ -96,8 +99,8 @@ def robot_rows(add: Callable, case: Any, cycle: CycleTimes, starts: dict[str, An
             height = cycle.height_at(w, [s + float(tau) for tau in offsets])
             clearance = (height - ca.DM(needs) * factor) / stroke
             add(f"{name} {w}: slide above its tool", clearance, 0.0, math.inf, "robots")
-            at_die = s + robot.move.duration_s + (robot.dwell_s if name == "loader" else 0.0)
-            between = ca.vertcat(at_die, cycle.free_s[w] - at_die) / unit
+            arrives = s + robot.move.duration_s  # its dwell at the die centre within theta3 .. theta2
+            between = ca.vertcat(arrives, cycle.free_s[w] - arrives - robot.dwell_s) / unit
             add(f"{name} {w}: at the die between the draws", between, 0.0, math.inf, "robots")
         e, s_ = (at[name, w] for w in WINDOWS)
         apart = ca.vertcat(s_ - e, e + cycle.period - s_) - robot.occupancy_s
@@ -201,11 +204,12 @@ def _order_checks(case: Any, plan: PendulumPlan, windows: dict[str, tuple[float,
 
         at_die = {}
         for name, robot in robots.items():
-            event = starts[name][w] + (robot.move.duration_s + (robot.dwell_s if name == "loader" else 0.0)) / k
-            at_die[name] = since(event)
-            what = "grips after theta3" if name == "unloader" else "has dropped the blank"
-            margin = min(at_die[name], free - at_die[name])
-            name_w = f"{name} {w}: {what}, before theta2"
+            arrives = since(starts[name][w] + robot.move.duration_s / k)
+            leaves = arrives + robot.dwell_s / k
+            at_die[name] = arrives if name == "unloader" else leaves  # it grips; it has dropped the blank
+            what = "grips" if name == "unloader" else "drops the blank"
+            margin = min(arrives, free - leaves)
+            name_w = f"{name} {w}: {what} at the die centre after theta3 and leaves it before theta2"
             out.append(Check.of("robots_order", name_w, margin, 0.0, "s", "min", TIME_TOL_S))
         if len(robots) < 2:
             continue

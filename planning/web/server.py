@@ -416,6 +416,8 @@ def _solve_routes(app: Flask, shared: _Shared) -> None:
 
 def _cam_response(session: Session, shown: Any, body: dict[str, Any], label: str, name: str | None) -> Any:
     """The cam of the confirmed plan on screen: its proof (``name`` None) or its file ``name``."""
+    if _pendulum(body.get("case")):
+        return jsonify({"status": Outcome.BAD_INPUT, "message": PENDULUM_FILES.format(label=label)}), 409
     if shown is None or shown[0] != case_key(body.get("case")):
         message = f"{label}: no confirmed plan of this case on the page yet; wait for the plan, then prove its cam"
         return jsonify({"status": Outcome.BAD_INPUT, "message": message}), 409
@@ -783,6 +785,18 @@ def bound_of(data: Any, label: str) -> dict[str, Any]:
     return {"spm": grid.spm, "upper_spm": upper.spm, "left_out": list(upper.left_out)}
 
 
+PENDULUM_FILES = (  # the page's downloads and cams are off for a pendulum case
+    "{label}: a pendulum plan's files and cams come from the CLI (pressplan solve, pressplan cam); "
+    "the page's downloads are off for swings"
+)
+
+
+def _pendulum(data: Any) -> bool:
+    """The case data the page sent plans pendulum strokes."""
+    planner = data.get("planner") if isinstance(data, dict) else None
+    return isinstance(planner, dict) and planner.get("mode") == "pendulum"
+
+
 def case_key(data: Any) -> str:
     """A key of a case's data as the page sends it (the same edits give the same key)."""
     return hashlib.sha256(json.dumps(data, sort_keys=True, default=str).encode()).hexdigest()
@@ -793,6 +807,8 @@ def files_of(shown: tuple[str, Any, Any] | None, data: Any, label: str, name: st
     alone; no solve here); 409 when the case sent is not the one whose confirmed plan is shown."""
     from planning.reports.outputs import writer_of
 
+    if _pendulum(data):
+        return jsonify({"status": Outcome.BAD_INPUT, "message": PENDULUM_FILES.format(label=label)}), 409
     if shown is None or shown[0] != case_key(data):
         message = f"{label}: no confirmed plan of this case on the page yet; wait for the plan, then download"
         return jsonify({"status": Outcome.BAD_INPUT, "message": message}), 409

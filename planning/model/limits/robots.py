@@ -4,11 +4,11 @@ each robot's tool needs it where the tool is (``press.robot``: its fastest moves
 The model (docs/robots.md): each robot leaves its waiting point at its start ``s`` [s], moves in to the die
 centre (its fastest move, ``T_in``), dwells ``T_d`` and moves out (``T_in`` again), once per cycle of period
 ``P``; the planner decides ``s``. With ``n(t)`` the height its tool needs at time ``t`` (its curve at its
-position) and ``h(t)`` the slide's height, the clearance ``c(t) = h(t) - n(t) >= 0`` at every ``t``. The unloader
-grips after the draw ends (theta3) and the loader has dropped the blank before the next draw starts (theta2);
-the loader reaches the die centre once the unloader's tool, moving out, is clear of the die (``overlapping``),
-or leaves its waiting point once the unloader is back at its own (``in-turns``). Each occupancy (in, dwell,
-out) fits in one period.
+position) and ``h(t)`` the slide's height, the clearance ``c(t) = h(t) - n(t) >= 0`` at every ``t``. Each
+robot's dwell at the die centre (the unloader gripping, the loader dropping the blank) lies between the draw's
+end (theta3) and the next draw's start (theta2); the loader reaches the die centre once the unloader's tool,
+moving out, is clear of the die (``overlapping``), or leaves its waiting point once the unloader is back at its
+own (``in-turns``). Each occupancy (in, dwell, out) fits in one period.
 
 In an NLP (a transcription that offers ``height_at`` and the robots' start variables) the clearance is held
 at :data:`ROBOT_SAMPLES` times of each occupancy, the curve's crossings among them (where its kinks and its
@@ -147,16 +147,15 @@ def _slowest_field(case: Any) -> str:
 
 
 def between_draws_s(case: Any) -> float:
-    """The least time [s] the robots need between theta3 and theta2 of one cycle: the unloader grips after
-    theta3 and the loader has dropped before theta2, the order between them (in turns: the unloader's dwell
-    and way out, the loader's way in and dwell; overlapping: the unloader's dwell and clearing, the loader's
-    dwell); and each tool's time over a slide higher than it is anywhere in the draw (it cannot be there in
-    the draw)."""
+    """The least time [s] the robots need between theta3 and theta2 of one cycle: each robot's dwell at the
+    die centre lies there, and the order between them (in turns: the unloader's dwell and way out, the
+    loader's way in and dwell; overlapping: the unloader's dwell and clearing, the loader's dwell); and each
+    tool's time over a slide higher than it is anywhere in the draw (it cannot be there in the draw)."""
     robots = robots_by_name(case)
     m = case.machine
     _, th2, th3, _ = case.key_angles
     above_draw = float(max(m.height(th2), m.height(th3))) + SAME_POSITION_MM  # the draw's highest slide
-    need = max(time_needing(r, above_draw) for r in robots.values())
+    need = max(max(time_needing(r, above_draw), r.dwell_s) for r in robots.values())
     if len(robots) == 2:
         u, ld = robots["unloader"], robots["loader"]
         if case.robots.order == "in-turns":
@@ -258,9 +257,11 @@ class RobotsLimit(Limit):
             height = nlp.height_at([start + tau for tau in offsets])
             clearance = (height - sample_vector(needs) * p("robots_need_factor")) / nlp.length_unit
             out.append(Row(f"{r}: slide above its tool", clearance, 0.0, np.inf, sampled=True))
-            # the unloader grips, the loader has dropped, after theta3 and before theta2 (time 0 is theta3)
-            at_die = start + p(f"robot_{r}_in") + (p(f"robot_{r}_dwell") if r == "loader" else 0.0)
-            frame = sample_vector([present * at_die, present * (nlp.draw_start_time - at_die)])
+            # at the die centre (its dwell: the unloader gripping, the loader dropping) after theta3 and before
+            # theta2 (time 0 is theta3)
+            arrives = start + p(f"robot_{r}_in")
+            leaves = arrives + p(f"robot_{r}_dwell")
+            frame = sample_vector([present * arrives, present * (nlp.draw_start_time - leaves)])
             out.append(Row(f"{r}: at the die between the draws", frame, 0.0, np.inf))
             within = present * (nlp.period - p(f"robot_{r}_occupancy"))
             out.append(Row(f"{r}: in and out within the cycle", within, 0.0, np.inf))
@@ -474,12 +475,13 @@ def _order_checks(case: Any, plan: Any, dense: Dense) -> list[Check]:
     k = plan.robot_time_scale
     out, at_die = [], {}
     for name, robot in robots.items():
-        start = plan.robot_starts_s[name] / k
-        event = start + (robot.move.duration_s + (robot.dwell_s if name == "loader" else 0.0)) / k
-        at_die[name] = since_draw(event)
-        what = "grips after theta3" if name == "unloader" else "has dropped the blank"
-        margin = min(at_die[name], free - at_die[name])
-        out.append(Check.of("robots_order", f"{name}: {what}, before theta2", margin, 0.0, "s", "min", TIME_TOL_S))
+        arrives = since_draw(plan.robot_starts_s[name] / k + robot.move.duration_s / k)
+        leaves = arrives + robot.dwell_s / k
+        at_die[name] = arrives if name == "unloader" else leaves  # it grips; it has dropped the blank
+        what = "grips" if name == "unloader" else "drops the blank"
+        margin = min(arrives, free - leaves)
+        name_at = f"{name}: {what} at the die centre after theta3 and leaves it before theta2"
+        out.append(Check.of("robots_order", name_at, margin, 0.0, "s", "min", TIME_TOL_S))
     if len(robots) == 2:
         u, ld = robots["unloader"], robots["loader"]
         grip, dropped = at_die["unloader"], at_die["loader"]
