@@ -363,6 +363,39 @@ def test_a_swing_with_its_electrical_side_balances_from_the_trajectory(tmp_path)
     assert p["grid_energy_kWh_per_1000_strokes"] == pytest.approx(p["grid_energy_kJ"] / 2 / 3.6, rel=1e-12)
 
 
+def test_a_grid_limit_caps_the_swings_bus_power(tmp_path, capsys):
+    """The cup's drive case in pendulum strokes with copper and converter losses and a 600 kW grid limit (no
+    storage): verified with the limit binding, the written grid power at most the limit; the same plan against a
+    limit 1 % below its peak fails that check only; a limit the draw cannot keep at the least crank speed is
+    refused before solving (exit 3) and a storage with the limit in one line (exit 2)."""
+    import yaml
+
+    data = yaml.safe_load((ROOT / "cases" / "cup-2000kN-drive.yaml").read_text(encoding="utf-8"))
+    data["planner"]["mode"] = "pendulum"
+    data["drive"].update(converter_efficiency=0.96, regen_efficiency=0.3, grid={"peak_power_kW": 600.0})
+    data["drive"]["motor"]["copper_loss_at_rated_kW"] = 72.0
+    path = tmp_path / "cup-pendulum-grid.yaml"
+    path.write_text(yaml.safe_dump(data), encoding="utf-8")
+    assert main(["solve", str(path), "--out", str(tmp_path / "out"), "--no-plots"]) == 0
+    result = json.loads((tmp_path / "out" / "result.json").read_text())
+    assert result["status"] == "verified" and "grid peak power" in result["verification"]["binding"]
+    grid = _columns(tmp_path / "out" / "trajectory.csv")["grid_power_kW"]
+    assert 600.0 * (1 - 1e-3) <= float(np.max(grid)) <= 600.0 * (1 + 1e-6)
+    case = read_case(path)
+    plan = solve_pendulum(case, compare=False).plan
+    peak = result["power"]["grid_peak_kW"]
+    lower = read_case(path, {"drive.grid.peak_power_kW": peak * 0.99})
+    assert {c.id for c in evaluate_pendulum(plan, lower).verification.failures()} == {"grid_peak_power"}
+    capsys.readouterr()
+    out = ["--no-plots", "--out", str(tmp_path / "x")]
+    assert main(["solve", str(path), "--set", "drive.grid.peak_power_kW=350", *out]) == 3
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "drive.grid.peak_power_kW = 350 cannot make the forward swing's draw" in err[0]
+    assert main(["solve", str(path), "--set", "drive.storage.usable_energy_kJ=40", *out]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].count("drive.storage") >= 1 and "pendulum" in err[0]
+
+
 def test_what_a_swing_cannot_draw_is_refused_before_solving(capsys):
     """On the link drive the backward swing draws on the fast side of BDC: the forming force's lever is longer
     there, beyond the motors' peak torque at any speed; on the offset crank the case's draw speed is above what
@@ -410,7 +443,12 @@ def test_one_folder_for_either_stroke(tmp_path, capsys):
     ("path", "args", "field", "code"),
     [
         ("cup-2000kN-drive", ["--objective", "min-grid-peak", "--spm", "20"], "--objective", 2),
-        ("cup-2000kN-drive", ["--set", "drive.grid.peak_power_kW=300"], "drive.grid.peak_power_kW", 2),
+        (
+            "cup-2000kN-drive",
+            ["--set", "drive.grid.peak_power_kW=900", "--set", "drive.storage.usable_energy_kJ=9"],
+            "drive.storage",
+            2,
+        ),
         ("cup-2000kN-drive", ["--objective", "min-energy", "--spm", "45"], "process.transfer_time_s", 3),
         ("cup-2000kN-drive", ["--set", "process.transfer_time_s=20000"], "process.transfer_time_s", 2),
         ("wang2023-side-panel-drive", ["--set", "press.capacity.crank_torque_kNm=500"], "crank_torque_kNm", 3),
@@ -574,9 +612,7 @@ def test_a_swing_holds_at_the_bottom_on_each_swing(tmp_path):
     solution = solve_pendulum(case, compare=False)
     assert pendulum_bound(case).spm > solution.plan.spm
     p = solution.plan.parameters
-    shorter = replace(
-        p, forward=replace(p.forward, hold_time=0.297), backward=replace(p.backward, hold_time=0.297)
-    )
+    shorter = replace(p, forward=replace(p.forward, hold_time=0.297), backward=replace(p.backward, hold_time=0.297))
     plan = replace(solution.plan, parameters=shorter, profile=profile_of(shorter))
     failed = {c.name for c in evaluate_pendulum(plan, case).verification.failures()}
     assert failed == {f"{s} swing: crank standing, the slide at its hold height" for s in ("forward", "backward")}

@@ -956,7 +956,7 @@ PENDULUM_NOT_WITH = (  # what a pendulum stroke does not plan with yet: (field, 
     (
         "planner.objective",
         lambda c: c.planner.objective if c.planner.objective == "min-grid-peak" else None,
-        "the swings' NLP holds no grid rows yet",
+        "the least grid peak is not planned for swings yet; a grid peak limit without a storage is",
     ),
     (
         "process.transfer_time_s",
@@ -965,11 +965,17 @@ PENDULUM_NOT_WITH = (  # what a pendulum stroke does not plan with yet: (field, 
     ),
     ("process.draw_slide_speed_mm_s", lambda c: c.process.draw_slide_speed_mm_s, "a swing draws at a crank speed"),
     (
-        "drive.grid.peak_power_kW",
-        lambda c: g.peak_power_kW if c.drive is not None and (g := c.drive.grid) is not None else None,
-        "the swings' NLP holds no grid rows yet (the power chain to the grid is computed and written)",
+        "drive.storage",
+        lambda c: "a storage" if c.drive is not None and c.drive.storage is not None and _grid_limited(c) else None,
+        "with a grid peak limit: the storage's schedule over two swings is not planned yet; without a storage the "
+        "limit caps the bus at every sample",
     ),
 )
+
+
+def _grid_limited(case: Case) -> bool:
+    """The drive has a grid peak limit (``drive.grid.peak_power_kW``)."""
+    return case.drive.grid is not None and case.drive.grid.peak_power_kW is not None
 
 
 def _pendulum_checks(case: Case) -> None:

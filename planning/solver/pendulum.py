@@ -156,9 +156,10 @@ def _precheck_draw_speed(case: Case) -> None:
 
 
 def _precheck_draw_torque(case: Case) -> None:
-    """A draw the motors, or the crank, cannot make on one swing even at the least draw speed (the forming
-    force's torque on the crank does not fall with the speed; on a link drive the backward swing draws where the
-    slide moves fast for the crank, its lever longer): refused before solving."""
+    """A draw the motors, the crank or the grid cannot make on one swing even at the least draw speed (the
+    forming force's torque on the crank does not fall with the speed; on a link drive the backward swing draws
+    where the slide moves fast for the crank, its lever longer; the bus's power at the least speed): refused
+    before solving."""
     motor = case.drive.motor
     lowest = max(case.limits.min_crank_speed_rpm, case.process.draw_speed_rpm or 0.0) * RPM
     capacity = torque_capacity_kNm(case)
@@ -170,6 +171,11 @@ def _precheck_draw_torque(case: Case) -> None:
             uses.append(
                 ("press.capacity.crank_torque_kNm", np.abs(crank) / (1e3 * capacity), crank / 1e3, capacity, "kN m")
             )
+        grid = case.drive.grid.peak_power_kW if case.drive.grid is not None else None
+        if grid is not None:  # no storage with swings: the bus's power is the grid's
+            copper = motor.copper_loss_at_rated_kW * 1e3 / motor.rated_torque_Nm**2
+            bus = (torque * speed + copper * torque**2) / case.drive.converter_efficiency / 1e3
+            uses.append(("drive.grid.peak_power_kW", bus / grid, bus, grid, "kW"))
         for field, use, needed, value, unit in uses:
             k = int(np.argmax(use))
             if use[k] > 1.0:

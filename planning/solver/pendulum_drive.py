@@ -36,6 +36,7 @@ from planning.solver.parameters import DRAW_SAMPLES_DRIVE, objective_values
 from press.dynamics import crank_torque, link_terms, motor_torque
 
 PEAK, RMS = "drive.motor.peak_torque_Nm", "drive.motor.rated_torque_Nm"  # the case fields of the motor's rows
+GRID = "drive.grid.peak_power_kW"
 DRAW_TORQUE_POINTS = 2001  # angles of a swing's draw on which the precheck takes the drive's torques
 
 
@@ -151,6 +152,19 @@ def drive_rows(
     f, b = drives["forward"], drives["backward"]
     heat = trapezoid_heat(f) + trapezoid_heat(b) + f.holding**2 * turns[0] + b.holding**2 * turns[1]
     add("motor RMS torque", heat / period / limits["motor_rms_torque"] ** 2, -math.inf, 1.0, RMS)
+    if "grid_cap" in limits:
+        _grid_rows(case, add, drives, limits)
+
+
+def _grid_rows(case: Case, add: Any, drives: dict[str, DriveSamples], limits: dict[str, float]) -> None:
+    """The grid's limit without storage (``planning.model.limits.grid``): the bus power
+    ``(T_m omega_m + k T_m^2) / eta_c`` under the cap at every sample of both swings (the grid's power where the
+    bus draws; at the standstills the holding torque's copper loss, far below any limit)."""
+    d = case.drive
+    copper = d.motor.copper_loss_at_rated_kW * 1e3 / d.motor.rated_torque_Nm**2
+    for samples in drives.values():
+        power = (samples.tm * samples.speed + copper * samples.tm**2) / d.converter_efficiency
+        add("grid peak power", power / limits["grid_cap"], -math.inf, 1.0, GRID)
 
 
 def draw_torque(case: Case, setup: Any, speed: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

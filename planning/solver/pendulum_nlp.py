@@ -39,6 +39,7 @@ from planning.model.case import RPM, Case
 from planning.model.laws import get_law
 from planning.model.limits import limits_of
 from planning.model.limits.capacity import torque_capacity_kNm
+from planning.model.limits.grid import GridPeakLimit
 from planning.model.pendulum import (
     DIE_ZONE_POINTS,
     SWING_HALVES,
@@ -94,7 +95,16 @@ SHARED_VARIABLES = (
     ("law_parameter", "law_parameter"),
 )
 # held at samples (or, the RMS, by the trapezoidal rule): refined on a dense failure
-SAMPLED_LIMITS = ("slider_accel", "slider_speed", "die_speed", "motor_peak_torque", "motor_rms_torque", "crank_torque")
+SAMPLED_LIMITS = (
+    "slider_accel",
+    "slider_speed",
+    "die_speed",
+    "motor_peak_torque",
+    "motor_rms_torque",
+    "crank_torque",
+    "grid_peak_power",
+)
+SAMPLED_PARAMETER = {"grid_peak_power": "grid_cap"}  # a sampled limit's parameter where it is not the limit's id
 ACCEL, JERK, SLIDE_ACCEL = "limits.crank_accel_rad_s2", "limits.crank_jerk_rad_s3", "limits.slider_accel_mm_s2"
 OPTIONS = {"ipopt.constr_viol_tol": IPOPT_CONSTR_VIOL_TOL, "ipopt.max_iter": 600}
 # at a target rate: the cycle's time [s] and the weights of the heat [1/(N^2 m^2 s)] and the energy [1/J]
@@ -526,6 +536,9 @@ def sampled_limit_values(case: Case) -> dict[str, float]:
         cap = torque_capacity_kNm(case)
         if cap is not None:
             out["crank_torque"] = cap * (1 - DRIVE_BACKOFF)
+        grid = GridPeakLimit()
+        if grid.applies(case):  # the bus's cap, no storage (``planning.model.limits.grid``)
+            out["grid_cap"] = grid.parameter_values(case)["grid_cap"]
     if case.robots is not None:
         out[NEED_FACTOR] = 1.0  # the robots' needs at the samples as the curves say (raised on a dense failure)
     return out
@@ -537,13 +550,14 @@ def refined(limits: dict[str, float], failures: list) -> dict[str, float] | None
     out = dict(limits)
     raised = any(c.refine_by is not None and c.refine_by[0] in limits for c in failures)
     for check in failures:
-        if check.refine_by is not None and check.refine_by[0] in limits:  # the robots' needs: raised by the worst
-            name, factor, _ = check.refine_by
-            out[name] = limits[name] * factor
+        if check.refine_by is not None and check.refine_by[0] in limits:  # (the robots' needs, the grid's terms)
+            name, factor, ceiling = check.refine_by
+            out[name] = min(limits[name], ceiling) * factor
         elif check.id == ROBOTS_CHECK and raised:  # another clearance: the worst one's factor raises them all
             continue
         elif check.id in SAMPLED_LIMITS:
-            out[check.id] = limits[check.id] * min(check.limit / check.value, 1.0) * (1 - REFINE_MARGIN)
+            name = SAMPLED_PARAMETER.get(check.id, check.id)
+            out[name] = limits[name] * min(check.limit / check.value, 1.0) * (1 - REFINE_MARGIN)
         else:
             return None
     return out
