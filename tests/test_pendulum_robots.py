@@ -184,6 +184,7 @@ def test_a_lone_robot_dwells_between_the_draws(mode, tmp_path):
         assert arrives >= -1e-9 and leaves <= (t2 - t3) % period + 1e-9, (r.get("window"), arrives, leaves)
 
 
+@pytest.mark.slow  # in the slow tier (CI runs it): three solves with the rotary stroke beside each
 def test_several_failed_clearances_refine_together(capsys, tmp_path):
     """An outside trial's cases: a curve that ramps from the die centre (its tightest point between the NLP's
     samples in both windows) and a faster crank: each failed its clearance in both windows and stopped
