@@ -616,3 +616,21 @@ def test_a_swing_holds_at_the_bottom_on_each_swing(tmp_path):
     plan = replace(solution.plan, parameters=shorter, profile=profile_of(shorter))
     failed = {c.name for c in evaluate_pendulum(plan, case).verification.failures()}
     assert failed == {f"{s} swing: crank standing, the slide at its hold height" for s in ("forward", "backward")}
+
+
+def test_a_hold_above_bdc_holds_the_forming_force_on_both_swings(tmp_path):
+    """The cup's drive case in pendulum strokes held 0.3 s at 10 mm (its draw ending at 150 deg): the crank's
+    holding torque at the backward swing's hold is the forward one's mirror image (a review found the check
+    dropping the forming force at a standstill on the backward swing: 300 N m against 10.4 kN m)."""
+    sets = ["planner.mode=pendulum", "key_points.draw_end_deg=150", "process.hold_time_s=0.3"]
+    args = ["solve", str(ROOT / "cases" / "cup-2000kN-drive.yaml"), "--no-plots", "--out", str(tmp_path)]
+    for field in [*sets, "process.hold_height_mm=10"]:
+        args += ["--set", field]
+    assert main(args) == 0
+    c = _columns(tmp_path / "trajectory.csv")
+    result = json.loads((tmp_path / "result.json").read_text())
+    still = (np.abs(c["slider_height_mm"] - 10.0) <= 1e-3) & (np.abs(c["crank_speed_rpm"]) <= 1e-9)
+    forward = c["time_s"] <= result["swings"]["forward"]["time_s"]
+    held = [c["crank_torque_Nm"][still & side] for side in (forward, ~forward)]
+    assert min(h.size for h in held) >= 299  # 0.3 s at 1 ms on each swing
+    assert abs(held[0][0]) > 1e4 and held[1][0] == pytest.approx(-held[0][0], rel=1e-6)

@@ -214,3 +214,16 @@ def test_a_robot_that_is_no_section_is_one_line(robot, words, tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and words in err[0] and str(path) in err[0]
     assert not (tmp_path / "out").exists()
+
+
+def test_in_turns_the_next_windows_unloader_waits_for_the_loader():
+    """In turns: the unloader at theta_s moved to leave 10 ms before the loader of the window at theta_e is back
+    fails that order check (a review found it measured across the period's wrap, passing with a period's margin)."""
+    case = read_case(CASE, {"robots.order": "in-turns"})
+    plan = solve_pendulum(case, compare=False).plan
+    loader = next(r for r in case.robots_on_path if r.name == "loader")
+    starts = {name: dict(by_window) for name, by_window in plan.robot_starts_s.items()}
+    starts["unloader"][WINDOWS[1]] = starts["loader"][WINDOWS[0]] + loader.occupancy_s - 0.01
+    failed = evaluate_pendulum(replace(plan, robot_starts_s=starts), case).verification.failures()
+    check = next(c for c in failed if c.name == "the loader at theta_e back before the next unloader leaves")
+    assert check.value == pytest.approx(-0.01, abs=1e-6)

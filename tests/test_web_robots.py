@@ -48,6 +48,17 @@ def click_and_confirm(tab, selector: str) -> None:  # noqa: ANN001 - a Playwrigh
     tab.wait_for_function("state.last && state.last.confirmed && state.last.result", timeout=60_000)
 
 
+def type_and_confirm(tab, selector: str, text: str) -> None:  # noqa: ANN001 - a Playwright page
+    """A real mouse click into ``selector``, its text replaced by ``text`` typed, Tab; then the confirmed answer."""
+    before = int(tab.evaluate("document.body.dataset.rendered"))
+    click(tab, selector)
+    tab.keyboard.press("Control+A")
+    tab.keyboard.type(text)
+    tab.keyboard.press("Tab")
+    wait_rendered(tab, before)
+    tab.wait_for_function("state.last && state.last.confirmed && state.last.result", timeout=60_000)
+
+
 def spm(tab) -> float:  # noqa: ANN001
     return float(tab.evaluate("state.last.result.spm"))
 
@@ -69,13 +80,7 @@ def test_the_robots_fields_edit_the_plan(page) -> None:
         assert f"{name}: least clearance 0.00 mm" in robots
         assert f"{name} on its path [mm from the die centre]" in robots
     fast = spm(page)
-    before = int(page.evaluate("document.body.dataset.rendered"))
-    click(page, '[data-field="robots.unloader.speed_mm_s"]')
-    page.keyboard.press("Control+A")
-    page.keyboard.type("2000")
-    page.keyboard.press("Tab")
-    wait_rendered(page, before)
-    page.wait_for_function("state.last && state.last.confirmed", timeout=60_000)
+    type_and_confirm(page, '[data-field="robots.unloader.speed_mm_s"]', "2000")
     assert page.evaluate("state.last.result.verified")
     assert spm(page) < fast
     assert page.errors == []
@@ -169,13 +174,7 @@ def test_robots_on_pendulum_strokes(site) -> None:
         for name in ("unloader at theta_e", "unloader at theta_s", "loader at theta_e", "loader at theta_s"):
             assert any(n.startswith(f"{name}: least clearance") for n in names), names
         assert sum(n.endswith("on its path [mm from the die centre]") for n in names) == 2
-        before = int(tab.evaluate("document.body.dataset.rendered"))
-        click(tab, '[data-field="robots.loader.dwell_s"]')
-        tab.keyboard.press("Control+A")
-        tab.keyboard.type("0.1")
-        tab.keyboard.press("Tab")
-        wait_rendered(tab, before)
-        tab.wait_for_function("state.last && state.last.confirmed && state.last.result", timeout=60_000)
+        type_and_confirm(tab, '[data-field="robots.loader.dwell_s"]', "0.1")
         data["robots"]["loader"]["dwell_s"] = 0.1
         slower = solve_pendulum(case_from_data(data, str(path)), compare=False)
         assert tab.locator("#spm").inner_text() == f"{slower.plan.spm:.3f}"

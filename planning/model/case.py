@@ -408,6 +408,12 @@ class DriveSection(_Model):
         the power chain from the motors to the grid."""
         return states_electrical(self.model_dump())
 
+    @property
+    def has_losses(self) -> bool:
+        """The motors' copper or the converter loses power between the bus and the shafts: the energy at the bus
+        then differs from the shafts' (an objective of energy weighs the bus's)."""
+        return self.motor.copper_loss_at_rated_kW > 0 or self.converter_efficiency < 1
+
 
 ELECTRICAL_KEYS = ("motor.copper_loss_at_rated_kW", "converter_efficiency", "storage", "grid")  # within drive:
 

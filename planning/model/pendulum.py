@@ -37,7 +37,7 @@ from planning.model.limits import limits_of
 from planning.model.limits.base import DRAW_GRID, Draw
 from planning.model.limits.hold import least_rate
 from planning.model.profile import Profile, Segment
-from planning.tolerances import ANGLE_ROUND_OFF_RAD, ANGLE_TOL_RAD, SAME_TIME_S, TINY
+from planning.tolerances import ANGLE_ROUND_OFF_RAD, ANGLE_TOL_RAD, HOLD_STILL_RAD_S, SAME_TIME_S, TINY
 from press.dynamics import table_force
 
 TWO_PI = 2 * math.pi
@@ -56,7 +56,8 @@ class SwingParameters:
     """One swing on its path coordinate u [rad] (module docstring): ``draw_speed`` w2, ``feed_peak_speed`` wm1,
     ``return_peak_speed`` wm2 [rad/s, >= 0]; the four halves' durations [s]; ``start``, ``draw_start``,
     ``draw_end``, ``end``: u at the swing's start, theta2, theta3 and its end [rad]; the ``motion_law`` and its
-    ``law_parameter`` (0 when it has none)."""
+    ``law_parameter`` (0 when it has none); ``hold_angle``: u [rad] of a hold at the bottom (None: none), where
+    the crank stands ``hold_time`` [s] (``planning.model.cycle``'s brake, standstill and rise from rest)."""
 
     draw_speed: Any
     feed_peak_speed: Any
@@ -452,12 +453,14 @@ def swing_forming_N(case: Any, theta: np.ndarray, omega: np.ndarray, h: np.ndarr
     """The forming force [N, upward on the slide] on a pendulum stroke at crank angles ``theta`` [rad], speeds
     ``omega`` [rad/s] and slide heights ``h`` [mm]: the case's table (``press.dynamics.table_force``) from theta2
     to BDC turning forward, and on the backward swing over the same arc of the slide's way down, from its theta2
-    back to BDC; zero elsewhere (``press.dynamics``: a rotary stroke's window, on either swing). Needs a drive."""
+    back to BDC, a hold's standstill within either included; zero elsewhere (``press.dynamics``: a rotary
+    stroke's window, on either swing). Needs a drive."""
     theta, omega = np.asarray(theta, dtype=float), np.asarray(omega, dtype=float)
     bdc = float(case.machine.bdc_angle)
     th2, back2 = float(case.key_angles[1]), backward_key_angles(case)[1]
-    forward = (omega > 0) & (theta >= th2) & (theta <= bdc)
-    backward = (omega < 0) & (theta >= bdc) & (theta <= back2)
+    standing = np.abs(omega) <= HOLD_STILL_RAD_S  # (a hold at rest within either: the force acts there)
+    forward = ((omega > 0) | standing) & (theta >= th2) & (theta <= bdc)
+    backward = ((omega < 0) | standing) & (theta >= bdc) & (theta <= back2)
     return table_force(h, forward | backward, case.drive_model)
 
 

@@ -553,7 +553,7 @@ def halves_nlp_for(case: Case, drive: bool | None = None, rate: bool = False, pe
     limit_ids = nlp_limits(case, drive or rate)
     links = drive_links(case) if drive or rate else ()
     d = case.drive
-    losses = rate and d is not None and (d.motor.copper_loss_at_rated_kW > 0 or d.converter_efficiency < 1)
+    losses = rate and d is not None and d.has_losses
     law, formula, hold = case.planner.motion_law, case.machine.formula, case.hold_angle is not None
     return halves_nlp(law, formula, limit_ids, drive, rate, False, links, peak, losses, hold)
 

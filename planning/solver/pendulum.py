@@ -5,7 +5,8 @@ swing at the least draw speed, are refused (``Infeasible``). Each start of
 :func:`~planning.solver.pendulum_nlp.starts` is solved; every converged plan is verified densely
 (``planning.solver.pendulum_check``); the answer is the verified plan with the most strokes. When none verifies
 and the failures are of limits the NLP holds at samples only (the slide's acceleration and speed, the die
-zone, the motor's torques), those limits are lowered by their overshoot and the NLP (built once, the limits
+zone, the motor's torques, the grid's peak, the robots' clearances), those limits are lowered by their overshoot
+(the robots' needs raised by their shortfall) and the NLP (built once, the limits
 its parameters) solved again, at most :data:`REFINE_ROUNDS` times, each round also starting from the last
 round's best plan. For comparison the same case is solved as a rotary stroke: the gain of the swing is stated
 beside its plan.
@@ -21,6 +22,7 @@ import numpy as np
 
 from planning.model.case import Case
 from planning.model.limits.capacity import torque_capacity_kNm
+from planning.model.limits.grid import drive_chain
 from planning.model.pendulum import STROKES_PER_CYCLE, TWO_PI, PendulumPlan, swing_setups
 from planning.model.units import RPM, rounded_down
 from planning.solver.outcomes import Infeasible, NoPlanFound, PlanningError, Unverified
@@ -173,8 +175,7 @@ def _precheck_draw_torque(case: Case) -> None:
             )
         grid = case.drive.grid.peak_power_kW if case.drive.grid is not None else None
         if grid is not None:  # no storage with swings: the bus's power is the grid's
-            copper = motor.copper_loss_at_rated_kW * 1e3 / motor.rated_torque_Nm**2
-            bus = (torque * speed + copper * torque**2) / case.drive.converter_efficiency / 1e3
+            bus = drive_chain(torque, torque * speed, case.drive)["bus_power_W"] / 1e3
             uses.append(("drive.grid.peak_power_kW", bus / grid, bus, grid, "kW"))
         for field, use, needed, value, unit in uses:
             k = int(np.argmax(use))

@@ -23,8 +23,9 @@ sqrt(that)``; with a hold each swing stands its hold time on the arc, added to `
 turns (the crank at rest there) and the windows' own motion, so it is loose: an upper bound, not an estimate.
 
 With robots on their interference curves (``planning.solver.pendulum_robots``) there is no transfer time; the
-cycle is at least the largest of: ``t_f + t_b`` (each swing passes its key angles); each robot's occupancy twice
-(it goes in and out in both windows, in turns both robots'); both draws at their highest speed and twice the
+cycle is at least the largest of: ``t_f + t_b`` (each swing passes its key angles); the robots' shortest cycle
+twice (each robot goes in and out in both windows, in turns both robots', overlapping also the unloader's dwell
+and clearing and the loader's dwell); both draws at their highest speed and twice the
 least time the robots need between the draws (``planning.model.limits.robots.between_draws_s``: the unloader
 grips after theta3 and the loader drops before theta2 in each window); and for each height ``H`` a curve names
 above the draw, the least time over each swing's arc below ``H`` (the procedure above on that arc) and twice
@@ -42,13 +43,13 @@ import numpy as np
 from planning.model.case import Case
 from planning.model.limits import limits_of
 from planning.model.limits.canonical import SpeedCap
-from planning.model.limits.robots import between_draws_s, robots_by_name
+from planning.model.limits.robots import between_draws_s, least_period_s, levels, robots_by_name
 from planning.model.pendulum import STROKES_PER_CYCLE, SwingSetup, swing_setups
 from planning.solver.upper_bound import inflections, slope_zeros
 from planning.tolerances import LIMIT_REL_TOL, SAME_NODE_RAD, TIME_TOL_S, TINY
 from press.robot import time_needing
 
-CHAINED_CHECKS = 3  # the order checks a window's robots pass in turn, each within TIME_TOL_S (at the die, clear, at it)
+CHAINED_CHECKS = 4  # the most order checks a window's robots pass in turn, each within TIME_TOL_S
 ARC_INTERVALS = 20_000  # intervals over each swing's arc theta1 .. theta4
 MAX_PASSES = 50  # forward and backward passes at most (the envelope settles in a few)
 
@@ -61,7 +62,7 @@ class PendulumBound:
     spm: float
     cycle_time_s: float
     arc_times_s: tuple[float, float]
-    sets_it: str = "two robot's windows and theta1 .. theta4"  # what gives the least cycle
+    sets_it: str = "the robot's two windows and theta1 .. theta4"  # what gives the least cycle
 
 
 def pendulum_bound(case: Case) -> PendulumBound:
@@ -77,29 +78,28 @@ def pendulum_bound(case: Case) -> PendulumBound:
 
 
 def robot_demands(case: Case, setups: tuple[SwingSetup, ...]) -> list[tuple[float, str]]:
-    """With robots: the least cycles [s] their demands allow, each with what it is (module docstring): each
-    robot's two occupancies (in turns both robots'); the two draws and each window's share between the draws
-    (``planning.model.limits.robots.between_draws_s``); for each height ``H`` the curves name above the draw,
-    each swing's arc below ``H`` and each robot's time needing ``H`` in both windows."""
+    """With robots: the least cycles [s] their demands allow, each with what it is (module docstring): the
+    robots' shortest cycle in both windows (``planning.model.limits.robots.least_period_s``); the two draws and
+    each window's share between the draws (``planning.model.limits.robots.between_draws_s``); for each height
+    ``H`` the curves name above the draw, each swing's arc below ``H`` and each robot's time needing ``H`` in
+    both windows. Each less what the verification's tolerances let a plan pass by."""
     robots = robots_by_name(case)
-    occupancy = max(r.occupancy_s for r in robots.values())
-    if case.robots.order == "in-turns":
-        occupancy = sum(r.occupancy_s for r in robots.values())
-    draws = sum((s.keys[2] - s.keys[1]) / s.draw_speed_bound for s in setups)
     # (each less what the verification's tolerances let a plan pass by: no verified plan above the bound)
+    occupancy = least_period_s(case) - CHAINED_CHECKS * TIME_TOL_S
+    draws = sum((s.keys[2] - s.keys[1]) / s.draw_speed_bound for s in setups) * (1 - LIMIT_REL_TOL)
     between = between_draws_s(case) - CHAINED_CHECKS * TIME_TOL_S
     out = [
-        (STROKES_PER_CYCLE * (occupancy - TIME_TOL_S), "each robot in and out in both windows"),
+        (STROKES_PER_CYCLE * occupancy, "each robot in and out in both windows"),
         (draws + STROKES_PER_CYCLE * between, "the draws and the robots between them"),
     ]
     m = case.machine
     _, th2, th3, _ = case.key_angles
     above_draw = float(max(m.height(th2), m.height(th3)))
-    for level in sorted({float(h) for r in robots.values() for h in r.curve.needed_height_mm}):
-        if not above_draw < level < m.stroke:
-            continue
+    for level in levels(robots):
         lowest = level - LIMIT_REL_TOL * max(level, 1.0)  # the slide a clearance check passes where H is needed
-        down, up = (float(a) for a in m.angles_at_height(max(lowest, above_draw)))
+        if not above_draw < lowest < m.stroke:
+            continue
+        down, up = (float(a) for a in m.angles_at_height(lowest))
         arcs = {"forward": (down, up), "backward": (2 * math.pi - up, 2 * math.pi - down)}
         below = sum(_least_arc_time(case, s, arcs[s.name]) + _hold_below(case, level) for s in setups)
         need = max(time_needing(r, level) for r in robots.values())

@@ -1,5 +1,5 @@
-"""The drive's rows of a pendulum NLP (``planning.solver.pendulum_nlp``): the motor's peak and RMS torque and the
-crank's torque capacity at the swings' samples.
+"""The drive's rows of a pendulum NLP (``planning.solver.pendulum_nlp``): the motor's peak and RMS torque, the
+crank's torque capacity and (a grid peak limit without a storage) the bus's power at the swings' samples.
 
 Each swing runs on its path coordinate u with speeds >= 0 (``planning.model.pendulum``); on the backward swing
 ``theta = 2 pi - u``, so ``theta' = -u'``, ``theta'' = -u''``, ``h' = -h_b'`` and a linkage's ``J_links' `` and
@@ -27,6 +27,7 @@ import casadi as ca
 import numpy as np
 
 from planning.model.case import RPM, Case
+from planning.model.cycle import HOLD_SEGMENT
 from planning.model.laws import get_law
 from planning.model.pendulum import TWO_PI, forming_on_path
 from planning.model.profile import advance_segment
@@ -80,10 +81,21 @@ def swing_drive(case: Case, swing: Any) -> DriveSamples:
     forming = forming_on_path(case, swing.setup.name, u, h)  # the draw's and, past theta3 before BDC, the return's
     tc = crank_torque(om, al, d1, d2, forming, model, _links(case, swing.setup.name, u))
     tm = motor_torque(tc, al, model)
+    if swing.setup.name == "backward" and p.has_hold:  # standing at the hold: through the gear as the check
+        # takes a standing crank's (forward), the crank's own torque -T_u; on u its sign flipped again
+        standing = _hold_samples(swing, fractions.shape[0])
+        tm = ca.vertcat(*[-motor_torque(-tc[i], 0.0, model) if i in standing else tm[i] for i in range(tm.shape[0])])
     # at rest at the swing's end the crank's torque is -T_u on the backward swing, through the gear as the
     # verification takes a standing crank's (``press.dynamics.motor_torque``: standing counts as forward)
     resting = tc[tc.shape[0] - 1] * (1.0 if swing.setup.name == "forward" else -1.0)
     return DriveSamples(tc, tm, model.i * om, al, times, motor_torque(resting, 0.0, model))
+
+
+def _hold_samples(swing: Any, per_segment: int) -> set[int]:
+    """The indices of a swing's samples (:func:`swing_drive`'s order) at its hold's standstill."""
+    first = per_segment * len(swing.feed[2]) + DRAW_SAMPLES_DRIVE + 1  # the return's first sample
+    k = next(i for i, seg in enumerate(swing.ret[2]) if seg.name == HOLD_SEGMENT)
+    return set(range(first + k * per_segment, first + (k + 1) * per_segment))
 
 
 def _half_samples(starts: list, states: list, segs: list, fractions: ca.DM, offset: Any) -> list[tuple]:
@@ -116,17 +128,21 @@ def rate_terms(case: Case, drives: dict[str, DriveSamples], turns: tuple[Any, An
     (``planning.solver.nlp.objective_terms``: the gear's loss rounded where T_c changes sign, the supply
     ``r P + (1 - r) smoothmax(P, 0)`` of the shaft power ``P = T_m omega_m``, or with the drive's copper or
     converter losses of the bus power through them, the same on u as on theta), each
-    standstill's holding torque squared times its time added to the heat (at rest no power flows)."""
+    standstill's holding torque squared times its time added to the heat (and, with the losses, its copper loss
+    to the energy: at rest no power flows to the shaft)."""
     q = objective_values(case)
     d = case.drive
     q["motor_base_speed"] = d.motor.base_speed_rpm * RPM
-    losses = d.motor.copper_loss_at_rated_kW > 0 or d.converter_efficiency < 1  # the energy at the bus then
+    losses = d.has_losses  # the energy at the bus then
     heat, energy = 0.0, 0.0
     for samples in drives.values():
         torque = NLPDriveSamples(case.drive_model, samples.tc, samples.tm, samples.speed)
         h, e = objective_terms(q, torque, samples.alpha, samples.times, losses)
         heat, energy = heat + h, energy + e
     f, b = drives["forward"], drives["backward"]
+    if losses:  # standing at the turns the bus still feeds the holding torque's copper loss
+        copper = q["copper_coefficient"] / q["converter_efficiency"]
+        energy += copper * (f.holding**2 * turns[0] + b.holding**2 * turns[1])
     return heat + f.holding**2 * turns[0] + b.holding**2 * turns[1], energy
 
 

@@ -6,23 +6,26 @@ speeds >= 0. Variables (scaled to O(1) like the halves NLP's, ``planning.solver.
 per swing w2, wm1, wm2, the four halves' durations, the times ``t1`` (from the swing's start to theta1) and
 ``t4`` (from theta3 to theta4), the times from theta3 to the return's die-zone angles
 (``planning.model.pendulum.die_zone``); the swing's ends theta_s and theta_e (bounded by
-:func:`~planning.model.pendulum.swing_bounds`), the standstills there, the law's shape parameter. Parameters:
-the sampled limits' values (:func:`sampled_limit_values`; the search lowers one the dense check finds exceeded
-between samples and solves again, :meth:`PendulumNLP.at`).
+:func:`~planning.model.pendulum.swing_bounds`), the standstills there, the law's shape parameter; with robots
+each robot's start in each window (``planning.solver.pendulum_robots``). Parameters: the sampled limits' values
+(:func:`sampled_limit_values`; the search lowers one the dense check finds exceeded between samples, or raises
+the robots' needs where a clearance is lost between them, and solves again, :meth:`PendulumNLP.at`).
 
 Rows per swing: the feed reaches theta2 and the return the swing's end (the halves' closed forms from rest and
 from theta3; the speeds there hold by construction), the peaks at or above the speeds they join (each half
 monotone), one jerk per S-curve where the law says so (Eq. 14), t1 and t4 at their angles, the peak
 acceleration and jerk of each half (closed form), the slide's acceleration and speed at ``law.samples`` points
 of every segment of the halves (the acceleration held ``ACCEL_BACKOFF`` inside), the slide's speed at the
-return's die-zone angles. In the draw the crank turns at the constant w2, so each limit there is a bound on w2
+return's die-zone angles (with a hold, the brake and the standstill are the return's first segments). In the
+draw the crank turns at the constant w2, so each limit there is a bound on w2
 (``planning.model.pendulum.draw_speed_bound``), a variable bound. With a drive, the motor's and the crank's
-torque rows (``planning.solver.pendulum_drive``). Across the swings: the robot's two windows (theta4 through the
-turn at theta_e to the backward swing's theta1, and the backward swing's theta4 through theta_s to theta1) each
-at least the transfer time. The objective: the cycle time (both swings and both standstills); at a target rate
-(``planner.objective`` with ``planner.target_spm``, a drive) the cycle held at that rate's time and the weighed
-heat and supply energy of the motor (``planning.solver.pendulum_drive.rate_terms``) instead, their weights
-parameters (:data:`RATE_PARAMETERS`).
+torque rows and the grid's cap (``planning.solver.pendulum_drive``). Across the swings: the robot's two windows
+(theta4 through the turn at theta_e to the backward swing's theta1, and the backward swing's theta4 through
+theta_s to theta1) each at least the transfer time, or with robots their rows in both windows. The objective:
+the cycle time (both swings and both standstills); at a target rate (``planner.objective`` with
+``planner.target_spm``, a drive) the cycle held at that rate's time and the weighed heat and supply energy of
+the motor (``planning.solver.pendulum_drive.rate_terms``) instead, their weights parameters
+(:data:`RATE_PARAMETERS`).
 """
 
 from __future__ import annotations
@@ -323,9 +326,8 @@ def build(case: Case) -> PendulumNLP:
 def _cycle_times(case: Case, f: _Swing, b: _Swing, turns: tuple[Any, Any]) -> CycleTimes:
     """The cycle as the robots' rows read it (``planning.solver.pendulum_robots.CycleTimes``): each window's
     segments in the crank's own angle (the backward swing's negated) from the draw before it to the draw after
-    it, the slide's height at times from the window's theta3 (before the first draw's start and after the last
-    draw's end the heights there: lower than the slide's, which comes down to the one draw and rises from the
-    other)."""
+    it, the slide's height at times from the window's theta3; before the first draw's start and after the last
+    draw's end BDC's, 0: never higher than the slide (a tool needing height there finds none)."""
     draw_f = Segment("draw:constant", f.params.draw_time, 0.0, 0.0)
     draw_b = Segment("draw:constant", b.params.draw_time, 0.0, 0.0)
     forward_feed, forward_return = [*f.params.feed_segments(), draw_f], [*f.params.return_segments()]
@@ -345,11 +347,14 @@ def _cycle_times(case: Case, f: _Swing, b: _Swing, turns: tuple[Any, Any]) -> Cy
     heights = {}
     for w, (segs, theta2, omega2, before) in windows.items():
         (starts, states, segs_w), _ = _segments_from(segs, theta2, omega2)
-        heights[w] = (starts, states, segs_w, before.params.draw_time)
+        span = sum(seg.duration for seg in segs_w)
+        heights[w] = (starts, states, segs_w, before.params.draw_time, span)
 
     def height_at(window: str, times: list) -> Any:
-        starts, states, segs, lead = heights[window]
-        return jets(ca.vertcat(*[angle_at(t + lead, starts, states, segs)[0] for t in times]))[0]
+        starts, states, segs, lead, span = heights[window]
+        inside = ca.vertcat(*[ca.logic_and(t + lead >= 0, t + lead <= span) for t in times])
+        h = jets(ca.vertcat(*[angle_at(t + lead, starts, states, segs)[0] for t in times]))[0]
+        return ca.if_else(inside, h, 0.0)  # (BDC, the lowest the slide goes, outside the window's segments)
 
     to_backward = f.params.return_time + turns[0] + b.params.feed_time
     offsets = {WINDOWS[0]: 0.0, WINDOWS[1]: to_backward + b.params.draw_time}
@@ -440,9 +445,13 @@ def _robot_starts(case: Case, values: dict[str, float]) -> dict[str, float]:
 
 
 def _tail(values: dict[str, float], swing: str) -> float:
-    """[s] from the swing's theta4 to its end."""
+    """[s] from the swing's theta4 to its end (a start's ``values``: with a hold, its brake and standstill
+    :data:`STOPPED` after theta3 too)."""
     ret = values[f"{swing}_return_accel_duration"] + values[f"{swing}_return_decel_duration"]
-    return ret - values[f"{swing}_opening_time"]
+    return ret + values.get(f"{swing}_{STOPPED}", 0.0) - values[f"{swing}_opening_time"]
+
+
+STOPPED = "brake_and_hold_s"  # a start's time [s] braking to the hold and standing there (not a variable)
 
 
 def _swing_start(
@@ -474,6 +483,7 @@ def _swing_start(
         f"{n}_feed_decel_duration": fd,
         f"{n}_return_accel_duration": ra,
         f"{n}_return_decel_duration": rd,
+        f"{n}_{STOPPED}": float(p.brake_duration + p.hold_time),
         f"{n}_closing_time": feed_profile.time_at_angle(setup.keys[0]),
         f"{n}_opening_time": ret_profile.time_at_angle(setup.keys[3]),
         **{f"{n}_die_time_{k}": 0.0 for k in range(DIE_ZONE_POINTS)},
@@ -548,16 +558,16 @@ def refined(limits: dict[str, float], failures: list) -> dict[str, float] | None
     """``limits`` with each sampled limit the dense check found exceeded lowered by its overshoot (None when a
     failure is no sampled limit's: refining cannot help)."""
     out = dict(limits)
-    raised = any(c.refine_by is not None and c.refine_by[0] in limits for c in failures)
+    raised = any(c.refine_by is not None and c.refine_by[0] == NEED_FACTOR for c in failures)
     for check in failures:
-        if check.refine_by is not None and check.refine_by[0] in limits:  # (the robots' needs, the grid's terms)
+        if check.refine_by is not None and check.refine_by[0] in limits:  # (the robots' needs: raised)
             name, factor, ceiling = check.refine_by
             out[name] = min(limits[name], ceiling) * factor
         elif check.id == ROBOTS_CHECK and raised:  # another clearance: the worst one's factor raises them all
             continue
-        elif check.id in SAMPLED_LIMITS:
+        elif check.id in SAMPLED_LIMITS:  # lowered by its overshoot, the most of two checks of one limit
             name = SAMPLED_PARAMETER.get(check.id, check.id)
-            out[name] = limits[name] * min(check.limit / check.value, 1.0) * (1 - REFINE_MARGIN)
+            out[name] = min(out[name], limits[name] * min(check.limit / check.value, 1.0) * (1 - REFINE_MARGIN))
         else:
             return None
     return out

@@ -14,10 +14,10 @@ next window's unloader leaves. The planner decides each robot's start in each wi
 the swings, and so the windows, differ.
 
 In the NLP (``planning.solver.pendulum_nlp``) each start is a variable, its time [s] from its window's theta3.
-The slide's height at any time is the NLP's closed form: the crank angle over the whole cycle's segments in the
-crank's own angle from the forward swing's theta3 (the forward return, the turn at theta_e, the backward
-swing's segments with their jerks and speed changes negated, the turn at theta_s, the forward feed and draw),
-``h(theta(t))`` at ``t`` within the period. The clearance is held at ``ROBOT_SAMPLES`` times of each
+The slide's height in a window is the NLP's closed form: the crank angle over the window's segments in the
+crank's own angle, from the draw before it through the return, the turn and the feed to the draw after it (the
+backward swing's jerks and speed changes negated), ``h(theta(t))``; outside those, BDC's height (0, never above
+the slide's). The clearance is held at ``ROBOT_SAMPLES`` times of each
 occupancy (the curve's crossings among them), each need scaled by ``robots_need_factor`` (1 at first; raised
 by the search by the worst shortfall when the dense check finds the clearance lost between the samples).
 
@@ -46,11 +46,14 @@ from planning.model.limits.robots import (
     path_checks,
     robot_schedule,
     robots_by_name,
+    since,
+    window_order_checks,
+    within_check,
     worst_refined,
 )
 from planning.model.pendulum import PendulumPlan
 from planning.tolerances import TIME_TOL_S
-from press.robot import Robot, sample_points, time_to_clear_s
+from press.robot import Robot, sample_points
 
 WINDOWS = ("at theta_e", "at theta_s")  # the cycle's two windows (``planning.model.pendulum.windows_of``'s names)
 NEED_FACTOR = "robots_need_factor"  # the NLP's parameter that scales the needs at the samples
@@ -71,7 +74,7 @@ def start_variables(case: Any) -> tuple[str, ...]:
 class CycleTimes:
     """What the robots' rows read of a pendulum cycle (symbols or numbers): ``height_at(window, times)`` the
     slide's height [mm] at times [s] from the window's theta3 (from the draw before it to the draw after it;
-    outside those, at most the slide's height); ``offset_s``: each window's theta3 [s from the forward swing's
+    outside those BDC's, never above the slide); ``offset_s``: each window's theta3 [s from the forward swing's
     theta3]; ``free_s``: each window's time from its theta3 to the next theta2 [s]; the ``period`` [s]."""
 
     height_at: Callable[[str, list], Any]
@@ -163,8 +166,11 @@ def robot_checks(dense: Dense, windows: dict[str, tuple[float, float]]) -> list[
     if missing:
         name = f"{', '.join(missing)}: scheduled in the plan"
         return [Check.of("robots_order", name, math.nan, 0.0, "s", "min", TIME_TOL_S)]
-    out, clearances = [], []
     k = plan.time_scale
+    within = [within_check(r, 2 * r.occupancy_s / k, plan.period, "in and out twice") for r in case.robots_on_path]
+    if not all(c.passed for c in within):  # two occupancies longer than the cycle: no schedule to check
+        return within
+    out, clearances = [], []
     for robot in case.robots_on_path:
         for w in WINDOWS:
             schedule = replace(robot_schedule(window_view(dense, w), robot), name=f"{robot.name} {w}")
@@ -172,12 +178,12 @@ def robot_checks(dense: Dense, windows: dict[str, tuple[float, float]]) -> list[
             clearances.append((check, schedule.least_ratio))
             out.append(check)
         out += path_checks(robot, k)
-        out.append(_apart_check(robot, plan))
+        out.append(_occupancies_apart(robot, plan))
     out = worst_refined(out, clearances)
     return out + _order_checks(case, plan, windows)
 
 
-def _apart_check(robot: Robot, plan: PendulumPlan) -> Check:
+def _occupancies_apart(robot: Robot, plan: PendulumPlan) -> Check:
     """The robot's two occupancies apart: the shorter time from one start to the next, at least its occupancy
     [s as run]."""
     k, period = plan.time_scale, plan.period
@@ -188,43 +194,19 @@ def _apart_check(robot: Robot, plan: PendulumPlan) -> Check:
 
 
 def _order_checks(case: Any, plan: PendulumPlan, windows: dict[str, tuple[float, float]]) -> list[Check]:
-    """In each window: each robot at the die between its theta3 and the next theta2, the loader after the
-    unloader (in the case's order); in turns the loader back before the next window's unloader leaves."""
+    """Each window's order (``planning.model.limits.robots.window_order_checks``): its arrivals from its theta3,
+    the next window's unloader from this theta3 (across the turn)."""
     k, period = plan.time_scale, plan.period
-    robots = robots_by_name(case)
-    starts = {name: {w: plan.robot_starts_s[name][w] / k for w in WINDOWS} for name in robots}
+    arrivals = {}
+    for w, (t3, _) in windows.items():
+        arrivals[w] = {
+            r.name: since((plan.robot_starts_s[r.name][w] + r.move.duration_s) / k, t3, period)
+            for r in case.robots_on_path
+        }
     out = []
     for w, other in zip(WINDOWS, WINDOWS[::-1], strict=True):
         t3, t2 = windows[w]
-        free = t2 - t3
-
-        def since(time_s: float, t3: float = t3) -> float:
-            rel = float(np.mod(time_s - t3, period))
-            return rel - period if rel > period - TIME_TOL_S else rel
-
-        at_die = {}
-        for name, robot in robots.items():
-            arrives = since(starts[name][w] + robot.move.duration_s / k)
-            leaves = arrives + robot.dwell_s / k
-            at_die[name] = arrives if name == "unloader" else leaves  # it grips; it has dropped the blank
-            what = "grips" if name == "unloader" else "drops the blank"
-            margin = min(arrives, free - leaves)
-            name_w = f"{name} {w}: {what} at the die centre after theta3 and leaves it before theta2"
-            out.append(Check.of("robots_order", name_w, margin, 0.0, "s", "min", TIME_TOL_S))
-        if len(robots) < 2:
-            continue
-        u, ld = robots["unloader"], robots["loader"]
-        grip, dropped = at_die["unloader"], at_die["loader"]
-        if case.robots.order == "in-turns":
-            back = grip + (u.dwell_s + u.move.duration_s) / k
-            leaves = dropped - (ld.dwell_s + ld.move.duration_s) / k
-            gap, name = leaves - back, f"the loader leaves after the unloader is back {w}"
-            next_leaves = float(np.mod(starts["unloader"][other] - starts["loader"][w], period))
-            wrap = next_leaves - ld.occupancy_s / k
-            back_name = f"the loader back before the unloader {other}"
-            out.append(Check.of("robots_order", back_name, wrap, 0.0, "s", "min", TIME_TOL_S))
-        else:
-            gap = (dropped - ld.dwell_s / k) - (grip + (u.dwell_s + time_to_clear_s(u)) / k)
-            name = f"the loader reaches the die {w} once the unloader is clear of it"
-        out.append(Check.of("robots_order", name, gap, 0.0, "s", "min", TIME_TOL_S))
+        to_other = float(np.mod(windows[other][0] - t3, period))  # this theta3 to the other's
+        next_unloader = to_other + arrivals[other].get("unloader", 0.0)
+        out += window_order_checks(case, arrivals[w], t2 - t3, k, (f" {w}", next_unloader))
     return out

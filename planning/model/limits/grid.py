@@ -102,7 +102,7 @@ class GridPeakLimit(Limit):
         limit = d.grid.peak_power_kW * 1e3
         w2 = given if given is not None else lowest
         theta, state = draw_drive_state(case, w2)
-        bus = _chain(state["motor_torque_Nm"], state["motor_power_W"], d)["bus_power_W"]
+        bus = drive_chain(state["motor_torque_Nm"], state["motor_power_W"], d)["bus_power_W"]
         k = int(np.argmax(bus))
         if bus[k] <= limit * (1 + LIMIT_REL_TOL):
             return None
@@ -170,10 +170,10 @@ def _most_bus_power(case: Any) -> float:
     """The most the motors can draw from the bus [W]: the peak torque at the base speed (the envelope's
     constant power), with its copper loss, through the converter."""
     m = case.drive.motor
-    return float(_chain(m.peak_torque_Nm, m.peak_torque_Nm * m.base_speed_rpm * RPM, case.drive)["bus_power_W"])
+    return float(drive_chain(m.peak_torque_Nm, m.peak_torque_Nm * m.base_speed_rpm * RPM, case.drive)["bus_power_W"])
 
 
-def _chain(motor_torque_Nm: Any, shaft_power_W: Any, drive: Any) -> dict[str, Any]:
+def drive_chain(motor_torque_Nm: Any, shaft_power_W: Any, drive: Any) -> dict[str, Any]:
     """``press.power.chain`` with the case's ``drive`` section's figures."""
     m = drive.motor
     return chain(

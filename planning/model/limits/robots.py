@@ -130,7 +130,7 @@ def _highest_demand(case: Any) -> tuple[float, float, float]:
     top = np.maximum(h[:-1], h[1:])
     step = theta[1] - theta[0]
     best = (0.0, 0.0, 2 * np.pi)
-    for level in _levels(robots):
+    for level in levels(robots):
         arc = float(np.count_nonzero(top >= level) * step)
         need = _time_needing(case, robots, level)
         if arc <= 0 or need / arc > best[0] / best[2]:
@@ -281,7 +281,7 @@ class RobotsLimit(Limit):
             name = f"{', '.join(missing)}: scheduled in the plan"
             return [Check.of("robots_order", name, float("nan"), 0.0, "s", "min", TIME_TOL_S)]
         k, period = plan.robot_time_scale, plan.period
-        within = [_within_check(robot, robot.occupancy_s / k, period) for robot in case.robots_on_path]
+        within = [within_check(robot, robot.occupancy_s / k, period) for robot in case.robots_on_path]
         if not all(c.passed for c in within):  # a robot longer than the cycle has no periodic schedule
             return within
         out, clearances = [], []
@@ -308,7 +308,7 @@ class RobotsLimit(Limit):
             # robots' rows could otherwise stretch a cycle past the longest the limits allow)
             w_min = case.limits.min_crank_speed_rpm * RPM
             rows.append((mesh.tau - mesh.dtheta / w_min, -np.inf, 0.0))
-        for level in _levels(robots):
+        for level in levels(robots):
             above = np.flatnonzero(top >= level).tolist()
             need = _time_needing(case, robots, level) - (stood if case.hold_height_mm >= level else 0.0)
             if need > 0 and above:  # (a level no node reaches: refused by the case's checks, above the stroke)
@@ -320,9 +320,10 @@ class RobotsLimit(Limit):
         return self.bound_rows(mesh)
 
 
-def _within_check(robot: Robot, occupancy_s: float, period_s: float) -> Check:
-    """The robot in and out within the cycle (its occupancy as it runs, at most the period)."""
-    name = f"{robot.name}: in and out within the cycle"
+def within_check(robot: Robot, occupancy_s: float, period_s: float, what: str = "in and out") -> Check:
+    """The robot in and out within the cycle (its occupancy as it runs, at most the period; ``what`` it does
+    in a cycle)."""
+    name = f"{robot.name}: {what} within the cycle"
     return Check.of("robots_order", name, occupancy_s, period_s, "s", "max", TIME_TOL_S)
 
 
@@ -361,7 +362,7 @@ def worst_refined(checks: list[Check], clearances: list[tuple[Check, float]]) ->
     return out
 
 
-def _levels(robots: dict[str, Robot]) -> list[float]:
+def levels(robots: dict[str, Robot]) -> list[float]:
     """The heights the robots' curves name (each a level the bounds hold)."""
     return sorted({float(h) for robot in robots.values() for h in robot.curve.needed_height_mm if h > 0})
 
@@ -466,34 +467,52 @@ def _order_checks(case: Any, plan: Any, dense: Dense) -> list[Check]:
     period = plan.period
     t3 = float(dense.key_times[2])
     free = float(np.mod(dense.key_times[1] - t3, period))  # theta3 -> theta2: the time outside the draw
-
-    def since_draw(time_s: float) -> float:
-        rel = float(np.mod(time_s - t3, period))
-        return rel - period if rel > period - TIME_TOL_S else rel
-
-    robots = robots_by_name(case)
     k = plan.robot_time_scale
-    out, at_die = [], {}
+    arrivals = {
+        r.name: since(plan.robot_starts_s[r.name] / k + r.move.duration_s / k, t3, period) for r in case.robots_on_path
+    }
+    next_unloader = arrivals.get("unloader", 0.0) + period  # the next cycle's
+    return window_order_checks(case, arrivals, free, k, ("", next_unloader))
+
+
+def since(time_s: float, t3_s: float, period_s: float) -> float:
+    """[s] from ``t3_s`` to ``time_s`` within the period (a time just before ``t3_s``, to round-off, negative)."""
+    rel = float(np.mod(time_s - t3_s, period_s))
+    return rel - period_s if rel > period_s - TIME_TOL_S else rel
+
+
+def window_order_checks(
+    case: Any, arrivals: dict[str, float], free_s: float, scale: float, where: tuple[str, float]
+) -> list[Check]:
+    """The order of the robots between one draw's end (theta3) and the next draw's start (theta2), ``free_s``
+    [s] apart: ``arrivals`` each robot's arrival at the die centre [s from theta3, as run], its moves run
+    ``scale`` times as fast as planned. Each robot's dwell there (gripping, dropping the blank) between theta3
+    and theta2; the loader after the unloader (overlapping: it reaches the die centre once the unloader's tool
+    is clear of the die; in turns: it leaves once the unloader is back, and is back before the next unloader
+    leaves, which reaches the die centre at ``where[1]`` [s from this theta3]); ``where[0]`` names the window
+    in the checks' names (a pendulum cycle's two)."""
+    robots = robots_by_name(case)
+    k, label = scale, where[0]
+    out = []
     for name, robot in robots.items():
-        arrives = since_draw(plan.robot_starts_s[name] / k + robot.move.duration_s / k)
-        leaves = arrives + robot.dwell_s / k
-        at_die[name] = arrives if name == "unloader" else leaves  # it grips; it has dropped the blank
+        arrives = arrivals[name]
         what = "grips" if name == "unloader" else "drops the blank"
-        margin = min(arrives, free - leaves)
-        name_at = f"{name}: {what} at the die centre after theta3 and leaves it before theta2"
+        margin = min(arrives, free_s - (arrives + robot.dwell_s / k))
+        name_at = f"{name}{label}: {what} at the die centre after theta3 and leaves it before theta2"
         out.append(Check.of("robots_order", name_at, margin, 0.0, "s", "min", TIME_TOL_S))
-    if len(robots) == 2:
-        u, ld = robots["unloader"], robots["loader"]
-        grip, dropped = at_die["unloader"], at_die["loader"]
-        if case.robots.order == "in-turns":
-            back = grip + (u.dwell_s + u.move.duration_s) / k  # the unloader at its waiting point again
-            leaves = dropped - (ld.dwell_s + ld.move.duration_s) / k  # the loader leaves its own
-            wrap = (grip - u.move.duration_s / k + period) - (dropped + ld.move.duration_s / k)
-            name = "the loader back before the next unloader leaves"
-            out.append(Check.of("robots_order", name, wrap, 0.0, "s", "min", TIME_TOL_S))
-            gap, name = leaves - back, "the loader leaves after the unloader is back"
-        else:
-            gap = (dropped - ld.dwell_s / k) - (grip + (u.dwell_s + time_to_clear_s(u)) / k)
-            name = "the loader reaches the die once the unloader is clear of it"
-        out.append(Check.of("robots_order", name, gap, 0.0, "s", "min", TIME_TOL_S))
+    if len(robots) < 2:
+        return out
+    u, ld = robots["unloader"], robots["loader"]
+    grip, reaches = arrivals["unloader"], arrivals["loader"]
+    if case.robots.order == "in-turns":
+        back = grip + (u.dwell_s + u.move.duration_s) / k  # the unloader at its waiting point again
+        leaves = reaches - ld.move.duration_s / k  # the loader leaves its own
+        wrap = (where[1] - u.move.duration_s / k) - (reaches + (ld.dwell_s + ld.move.duration_s) / k)
+        name = f"the loader{label} back before the next unloader leaves"
+        out.append(Check.of("robots_order", name, wrap, 0.0, "s", "min", TIME_TOL_S))
+        gap, name = leaves - back, f"the loader{label} leaves after the unloader is back"
+    else:
+        gap = reaches - (grip + (u.dwell_s + time_to_clear_s(u)) / k)
+        name = f"the loader reaches the die{label} once the unloader is clear of it"
+    out.append(Check.of("robots_order", name, gap, 0.0, "s", "min", TIME_TOL_S))
     return out
