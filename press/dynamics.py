@@ -202,13 +202,19 @@ def motor_torque(crank_torque_Nm: Any, alpha: Any, drive: DriveModel, omega: Any
     """Motor torque [N m] (all motors): the crank torque through the gear (losses against the power
     flow) plus the motor-side inertia: ``T_c/(i eta)`` where power flows to the crank, ``T_c eta/i`` where
     the crank drives the motor back, plus ``J_m i alpha``. The power flows to the crank where ``T_c >= 0``
-    and the crank turns forward or stands (``omega`` None: it does), or ``T_c < 0`` and it turns backward."""
+    and the crank turns forward (``omega`` None: it does), or ``T_c < 0`` and it turns backward; a standing
+    crank (``|omega| <= HOLD_STILL_RAD_S``) is held through the gear as if driven, ``T_c/(i eta)`` either way
+    (no power flows: the motor holds the crank's torque against the gear's friction, the same on either
+    side)."""
     m = math_module(crank_torque_Nm, alpha)
     t = crank_torque_Nm
     driving, braking = t / (drive.i * drive.eta), t * drive.eta / drive.i
     if m is np:
-        forward = True if omega is None else np.asarray(omega) >= -HOLD_STILL_RAD_S  # standing: as forward
-        to_crank = (t >= 0) == forward
+        if omega is None:
+            to_crank = t >= 0
+        else:
+            w = np.asarray(omega)
+            to_crank = (np.abs(w) <= HOLD_STILL_RAD_S) | ((t >= 0) == (w > 0))
         through = np.where(to_crank, driving, braking)
     else:
         through = m.if_else(t >= 0, driving, braking)  # the NLPs turn forward

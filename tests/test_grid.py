@@ -293,7 +293,8 @@ def test_without_the_new_keys_the_outputs_are_todays():
 
 
 # written by the commit before the grid's work (ded1870); rewritten in the same form (the summary without the
-# words said since) when the slide acceleration's sampled limit came to be refined by segment (better plans)
+# words said since) when the slide acceleration's sampled limit came to be refined by segment (better plans),
+# and when the dense check came to sample the forming table's corners (the motor's peak there, the same plans)
 GOLDEN = ROOT / "tests" / "data" / "golden_drive"
 GOLDEN_RUNS = {  # folder: the command's arguments
     "cup-max-spm": ["solve", str(DRIVE_CASES[1])],

@@ -102,7 +102,7 @@ class PowerFigures:
         return {k: v for k, v in self.__dict__.items() if k != "schedule"}
 
 
-def _breakpoints(profile: Profile, case: Case) -> np.ndarray:
+def breakpoints(profile: Profile, case: Case) -> np.ndarray:
     """Times [s] where the drive's integrands may kink: knots, theta2, BDC, table heights going down."""
     times = list(profile.knot_times)
     th0 = profile.theta0
@@ -128,7 +128,7 @@ def quadrature(
     """Nodes [s] and weights [s] of the cycle's quadrature (see the module docstring); ``extra_edges`` [s]:
     more breakpoints (the storage schedule's, where its power jumps); ``edges`` [s]: the breakpoints themselves
     (a pendulum stroke's, whose crank turns back: ``planning.solver.pendulum_check``), else a rotary cycle's."""
-    edges = _breakpoints(profile, case) if edges is None else np.unique(np.asarray(edges, dtype=float))
+    edges = breakpoints(profile, case) if edges is None else np.unique(np.asarray(edges, dtype=float))
     if extra_edges is not None:
         edges = np.unique(np.concatenate([edges, np.clip(extra_edges, profile.t0, profile.t0 + profile.duration)]))
         edges = edges[np.concatenate([[True], np.diff(edges) > SAME_TIME_S])]

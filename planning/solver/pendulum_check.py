@@ -68,7 +68,8 @@ def evaluate_pendulum(plan: PendulumPlan, case: Case, cam: bool = False) -> Eval
     each draw at one speed) are not the cam's; the cycle closes, never passes TDC, and every limit of the press
     and the process holds."""
     prof = plan.profile
-    t, uniform = sample_times(plan.period, prof.knot_times)
+    kinks = _breakpoints(plan, case) if case.drive is not None else prof.knot_times  # (the forming force's too)
+    t, uniform = sample_times(plan.period, kinks)
     th, om, al, je = prof.at_time(t)
     h, d1, d2, d3 = case.machine.jets(th)
     _, v, a, slide_jerk = slider_motion(h, d1, d2, d3, om, al, je)
@@ -81,7 +82,7 @@ def evaluate_pendulum(plan: PendulumPlan, case: Case, cam: bool = False) -> Eval
     figures, columns = None, None
     if case.drive is not None:  # the drive on either swing (``press.dynamics``: signed speeds)
         dense.drive_state = drive_state(th, om, al, case.machine, case.drive_model, swing_forming_N(case, th, om, h))
-        swings = (_breakpoints(plan, case), _forming(case))
+        swings = (kinks, _forming(case))
         dense.integrals = cycle_integrals(prof, case, swings)
         checks.append(energy_balance(dense.integrals))
         figures = drive_figures(prof, case, dense.integrals, (th, dense.drive_state))

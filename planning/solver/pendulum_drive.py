@@ -81,14 +81,16 @@ def swing_drive(case: Case, swing: Any) -> DriveSamples:
     forming = forming_on_path(case, swing.setup.name, u, h)  # the draw's and, past theta3 before BDC, the return's
     tc = crank_torque(om, al, d1, d2, forming, model, _links(case, swing.setup.name, u))
     tm = motor_torque(tc, al, model)
-    if swing.setup.name == "backward" and p.has_hold:  # standing at the hold: through the gear as the check
-        # takes a standing crank's (forward), the crank's own torque -T_u; on u its sign flipped again
+    if p.has_hold:  # standing at the hold: held through the gear as if driven (``press.dynamics.motor_torque``)
         standing = _hold_samples(swing, fractions.shape[0])
-        tm = ca.vertcat(*[-motor_torque(-tc[i], 0.0, model) if i in standing else tm[i] for i in range(tm.shape[0])])
-    # at rest at the swing's end the crank's torque is -T_u on the backward swing, through the gear as the
-    # verification takes a standing crank's (``press.dynamics.motor_torque``: standing counts as forward)
-    resting = tc[tc.shape[0] - 1] * (1.0 if swing.setup.name == "forward" else -1.0)
-    return DriveSamples(tc, tm, model.i * om, al, times, motor_torque(resting, 0.0, model))
+        tm = ca.vertcat(*[_held(tc[i], model) if i in standing else tm[i] for i in range(tm.shape[0])])
+    # at rest at the swing's end, held as at the hold (on u or in the crank's own angle: the same magnitude)
+    return DriveSamples(tc, tm, model.i * om, al, times, _held(tc[tc.shape[0] - 1], model))
+
+
+def _held(crank_torque_Nm: Any, model: Any) -> Any:
+    """The motor torque [N m] that holds a standing crank's torque (``press.dynamics.motor_torque`` at rest)."""
+    return crank_torque_Nm / (model.i * model.eta)
 
 
 def _hold_samples(swing: Any, per_segment: int) -> set[int]:

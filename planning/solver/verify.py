@@ -17,7 +17,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from planning.model.case import RPM, Case
-from planning.model.drive import DriveFigures, PowerFigures, cycle_integrals, drive_figures
+from planning.model.drive import DriveFigures, PowerFigures, breakpoints, cycle_integrals, drive_figures
 from planning.model.limits import field_of, limits_of
 from planning.model.limits.base import Check, Dense
 from planning.model.plan import Plan
@@ -144,7 +144,8 @@ def simulate(plan: Plan, case: Case) -> tuple[Dense, np.ndarray]:
     output reads): the profile in closed form on the uniform grid of at most 1 ms and every knot, the
     slide's motion, with a drive its state and the cycle's integrals; and the uniform grid's indices."""
     prof = plan.profile
-    t, uniform = sample_times(plan.period, prof.knot_times)
+    # every knot, and with a drive where the forming force starts, kinks and ends (its peaks may lie there)
+    t, uniform = sample_times(plan.period, prof.knot_times if case.drive is None else breakpoints(prof, case))
     th, om, al, je = prof.at_time(t)
     h, d1, d2, d3 = case.machine.jets(th)
     _, v, a, slide_jerk = slider_motion(h, d1, d2, d3, om, al, je)
