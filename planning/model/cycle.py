@@ -71,7 +71,7 @@ class CycleParameters:
     @property
     def brake_duration(self) -> Any:
         """The brake half's duration [s] from w2 to standstill over theta3 -> theta_h (0 without a hold)."""
-        return 2 * (self.hold_angle - self.draw_end) / self.draw_speed if self.has_hold else 0.0
+        return brake_time(self.hold_angle, self.draw_end, self.draw_speed) if self.has_hold else 0.0
 
     @property
     def return_start_speed(self) -> Any:
@@ -131,6 +131,12 @@ class CycleParameters:
         """J of the return S-curve [rad/s^3] (improved S-curve)."""
         T = self.return_accel_duration / sc.SUBSEGMENTS
         return (self.return_peak_speed - self.return_start_speed) / (sc.SPEED_GAIN * T**2)
+
+
+def brake_time(hold_angle: Any, draw_end: Any, draw_speed: Any) -> Any:
+    """[s] one half of the law from the draw speed to rest over ``draw_end -> hold_angle`` [rad]: every half
+    sweeps ``D (v0 + v1) / 2``, so ``D_b = 2 (theta_h - theta3) / w2`` (module docstring)."""
+    return 2 * (hold_angle - draw_end) / draw_speed
 
 
 def cycle_segments(p: CycleParameters) -> list[Segment]:

@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from planning.model.cycle import BRAKE, BRAKE_PREFIX, HOLD_SEGMENT
+from planning.model.cycle import BRAKE, BRAKE_PREFIX, HOLD_SEGMENT, brake_time
 from planning.model.laws import get_law
 from planning.model.limits import limits_of
 from planning.model.limits.base import DRAW_GRID, Draw
@@ -84,7 +84,7 @@ class SwingParameters:
     def brake_duration(self) -> Any:
         """The brake half's duration [s] from w2 to standstill over theta3 -> the hold (0 without a hold): every
         half sweeps ``D (v0 + v1) / 2`` (``planning.model.cycle``)."""
-        return 2 * (self.hold_angle - self.draw_end) / self.draw_speed if self.has_hold else 0.0
+        return brake_time(self.hold_angle, self.draw_end, self.draw_speed) if self.has_hold else 0.0
 
     @property
     def return_start_speed(self) -> Any:

@@ -25,7 +25,7 @@ from planning.model.case import RPM, Case
 from planning.model.drive import cycle_integrals, drive_figures
 from planning.model.limits import limits_of
 from planning.model.limits.base import Check, Dense
-from planning.model.limits.hold import longest_run_s
+from planning.model.limits.hold import HoldLimit, hold_check
 from planning.model.pendulum import SWINGS, PendulumPlan, swing_forming_N, swing_of, time_at, windows_of
 from planning.model.profile import sample_times
 from planning.solver.peak_shaving import power_columns, power_figures
@@ -41,7 +41,6 @@ from planning.solver.verify import (
 from planning.tolerances import (
     ACCEL_CLOSE_TOL_RAD_S2,
     ANGLE_TOL_RAD,
-    HOLD_STILL_MM,
     HOLD_STILL_RAD_S,
     LIMIT_REL_TOL,
     SPEED_TOL_RAD_S,
@@ -189,18 +188,8 @@ def _swing_checks(d: Dense, cam: bool) -> list[Check]:
 def _hold_checks(d: Dense, spans: dict[str, tuple[float, float]]) -> list[Check]:
     """The hold on each swing: the longest run of samples within the swing with the crank standing and the slide
     within ``HOLD_STILL_MM`` of its hold height lasts at least the hold time (``planning.model.limits.hold``)."""
-    case = d.case
-    still = (np.abs(d.h - case.hold_height_mm) <= HOLD_STILL_MM) & (np.abs(d.omega) <= HOLD_STILL_RAD_S)
-    limit = case.process.hold_time_s
-    out = []
-    for swing, (lo, hi) in spans.items():
-        inside = (d.t >= lo) & (d.t <= hi)
-        stood, start = longest_run_s(d.t[inside], still[inside]) if still[inside].any() else (0.0, lo)
-        name = f"{swing} swing: crank standing, the slide at its hold height"
-        check = Check.of("hold", name, stood, limit, "s", "min", TIME_TOL_S)
-        theta = float(np.interp(start, d.t, d.theta))
-        out.append(check.located(np.array([start]), np.array([theta]), np.array([stood]), limit))
-    return out
+    name = "{} swing: " + HoldLimit.name
+    return [hold_check(d, (d.t >= lo) & (d.t <= hi), name.format(swing)) for swing, (lo, hi) in spans.items()]
 
 
 def _law_checks(d: Dense, spans: dict[str, tuple[float, float]], times: dict[str, np.ndarray]) -> list[Check]:

@@ -29,6 +29,7 @@ import numpy as np
 from planning.model.case import RPM, Case
 from planning.model.cycle import HOLD_SEGMENT
 from planning.model.laws import get_law
+from planning.model.limits.grid import bus_power
 from planning.model.pendulum import TWO_PI, forming_on_path
 from planning.model.profile import advance_segment
 from planning.solver.nlp import DriveSamples as NLPDriveSamples
@@ -181,7 +182,7 @@ def _grid_rows(case: Case, add: Any, drives: dict[str, DriveSamples], limits: di
     d = case.drive
     copper = d.motor.copper_loss_at_rated_kW * 1e3 / d.motor.rated_torque_Nm**2
     for samples in drives.values():
-        power = (samples.tm * samples.speed + copper * samples.tm**2) / d.converter_efficiency
+        power = bus_power(samples.tm, samples.speed, copper, d.converter_efficiency)
         add("grid peak power", power / limits["grid_cap"], -math.inf, 1.0, GRID)
 
 

@@ -80,9 +80,7 @@ class GridPeakLimit(Limit):
         limit over the cycle within what the storage can give, ``integral (P_bus - L)+ dt <= eta_s U`` (the
         storage's energy budget; smooth max, trapezoids over the samples; without storage the allowance is
         out of reach and the cap is the limit)."""
-        tm = nlp.motor_torque
-        electrical = tm * nlp.motor_speed + nlp.param("grid_copper") * tm**2
-        bus = electrical / nlp.param("grid_converter")
+        bus = bus_power(nlp.motor_torque, nlp.motor_speed, nlp.param("grid_copper"), nlp.param("grid_converter"))
         limit = nlp.param("grid_limit")
         above = bus - limit
         eps = EXCESS_SMOOTHING * limit
@@ -152,6 +150,13 @@ class GridPeakLimit(Limit):
     def relaxed_rows(self, mesh: Any) -> None:
         """Not in the upper bound (the storage's state couples the whole cycle): left out."""
         return None
+
+
+def bus_power(motor_torque_Nm: Any, motor_speed_rad_s: Any, copper: Any, converter: Any) -> Any:
+    """The bus's power [W] an NLP's rows hold (numbers or symbols): ``(T_m omega_m + k T_m^2) / eta_c``, ``k``
+    the copper coefficient [W/(N m)^2], ``eta_c`` the converter's efficiency (a braking sample's is below the
+    cap anyway)."""
+    return (motor_torque_Nm * motor_speed_rad_s + copper * motor_torque_Nm**2) / converter
 
 
 def _storage_counts(case: Any) -> bool:

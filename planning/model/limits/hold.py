@@ -36,6 +36,20 @@ def longest_run_s(t: np.ndarray, inside: np.ndarray) -> tuple[float, float]:
     return float(times[last] - times[first]), float(times[first] % period)
 
 
+def hold_check(dense: Dense, within: np.ndarray, name: str) -> Check:
+    """The hold among the samples ``within`` (a mask of ``dense.t``: the cycle, or one swing of a pendulum
+    stroke, ``planning.solver.pendulum_check``): the longest run with the crank standing and the slide within
+    ``HOLD_STILL_MM`` of its hold height lasts at least the hold time; located where it starts."""
+    case = dense.case
+    still = (np.abs(dense.h - case.hold_height_mm) <= HOLD_STILL_MM) & (np.abs(dense.omega) <= HOLD_STILL_RAD_S)
+    t = dense.t[within]
+    stood, start = longest_run_s(t, still[within]) if still[within].any() else (0.0, float(t[0]))
+    limit = case.process.hold_time_s
+    check = Check.of(HoldLimit.id, name, stood, limit, HoldLimit.unit, "min", TIME_TOL_S)
+    theta = float(np.interp(start, dense.t, dense.theta))
+    return check.located(np.array([start]), np.array([theta]), np.array([stood]), limit)
+
+
 def least_rate(case: Any) -> float:
     """The least peak acceleration of a half of ``case``'s law in units of ``|dv| / D``: at its fixed shape
     parameter, else over :data:`RATE_GRID` values of the parameter's range."""
@@ -64,14 +78,7 @@ class HoldLimit(Limit):
         return case.process.hold_time_s is not None
 
     def check(self, dense: Dense) -> list[Check]:
-        case = dense.case
-        at_height = np.abs(dense.h - case.hold_height_mm) <= HOLD_STILL_MM
-        inside = at_height & (np.abs(dense.omega) <= HOLD_STILL_RAD_S)
-        stood, start = longest_run_s(dense.t, inside)
-        limit = case.process.hold_time_s
-        check = Check.of(self.id, self.name, stood, limit, self.unit, "min", TIME_TOL_S)
-        theta = float(np.interp(start, dense.t, dense.theta))
-        return [check.located(np.array([start]), np.array([theta]), np.array([stood]), limit)]
+        return [hold_check(dense, np.ones(dense.t.size, dtype=bool), self.name)]
 
     def draw_speed_bound(self, draw: Draw) -> float | None:
         """The highest draw speed [rad/s] the crank can brake from with the case's law under
