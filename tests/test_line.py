@@ -387,11 +387,71 @@ def test_a_press_with_a_hold_keeps_it_at_the_lines_period(tmp_path: Path) -> Non
     assert max(run[-1] - run[0] for run in runs if run.size) >= 0.2 - 1e-3  # the 1 ms grid's last step
 
 
-def test_a_pendulum_press_in_a_line_is_refused_in_one_line(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
-    """A station set to pendulum strokes: a line plans rotary strokes only (it planned the station as rotary
-    before, silently); one line naming the station's field, exit 2, nothing written."""
-    out = tmp_path / "out"
-    assert main(["line", str(SHIPPED), "--set", "pierce.planner.mode=pendulum", "--out", str(out)]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "pierce" in err[0] and "planner.mode: pendulum" in err[0]
-    assert not out.exists()
+@pytest.fixture(scope="module")
+def swinging(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, Path]:
+    """The slow line with its second press in pendulum strokes (docs/line.md)."""
+    out = tmp_path_factory.mktemp("swinging")
+    return _run(DATA / "slow.yaml", out, "--set", "second.planner.mode=pendulum"), out
+
+
+def test_a_pendulum_press_swings_once_a_master_cycle_its_robots_every_cycle(swinging: tuple[dict, Path]) -> None:
+    """A pendulum press in a line makes one swing a master cycle (a part a cycle), forward in one and back in
+    the next: the written trajectory runs two master cycles, the crank turning one way in the first and the
+    other in the second, and the replay (each robot at its line start every cycle, the slide by the closed
+    form from the written crank angle) finds every clearance and transfer gap held in both."""
+    result, out = swinging
+    assert result["status"] == "verified"
+    period = result["period_s"]
+    assert result["horizon_s"] == pytest.approx(2 * period, rel=1e-12)
+    assert result["stations"][1]["mode"] == "pendulum"
+    table = np.genfromtxt(out / "line_trajectory.csv", delimiter=",", names=True)
+    assert table["time_s"][-1] == pytest.approx(2 * period, abs=2e-3)
+    local = np.mod(table["time_s"] - result["stations"][1]["phase_offset_s"], 2 * period)  # the press's own time
+    order = np.argsort(local)
+    theta = np.radians(table["second_crank_angle_deg"])[order]
+    turn = int(np.argmax(theta))  # the turn at theta_e: forward up to it, back after it
+    assert np.all(np.diff(theta[: turn + 1]) >= -1e-9) and np.all(np.diff(theta[turn:]) <= 1e-9)
+    assert np.ptp(theta[: turn + 1]) > 1.0 and np.ptp(theta[turn:]) > 1.0
+    assert np.all(theta < 2 * np.pi) and np.all(theta > 0)  # never past TDC
+    clearance, gap, both = _replay(result, out, DATA / "slow.yaml")
+    assert clearance >= -REPLAY_TOL_MM and gap >= -REPLAY_TOL_S and not both
+    shifts = [c for c in result["checks"] if "after its start at theta_e" in c["name"]]
+    assert len(shifts) == 2 and all(c["value"] == pytest.approx(period, abs=1e-9) for c in shifts)
+
+
+def test_the_line_verification_fails_a_swing_whose_robots_drift_off_the_master(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    """The line's checks can fail for a pendulum press: its robots' starts in the window at theta_s 2 ms off a
+    master cycle after those at theta_e (the press's own check still passes): unverified, exit 3, nothing
+    written."""
+    from dataclasses import replace
+
+    from planning.solver import pendulum_line
+
+    at_period = pendulum_line.swings_at_period
+
+    def drifted(*args):  # noqa: ANN002, ANN202
+        solution = at_period(*args)
+        starts = {r: {**by, "at theta_s": by["at theta_s"] + 0.002} for r, by in solution.plan.robot_starts_s.items()}
+        return replace(solution, plan=replace(solution.plan, robot_starts_s=starts))
+
+    monkeypatch.setattr("planning.solver.line.swings_at_period", drifted)
+    args = ["line", str(DATA / "slow.yaml"), "--set", "second.planner.mode=pendulum", "--out", str(tmp_path)]
+    assert main([*args, "--no-plots"]) == 3
+    err = capsys.readouterr().err
+    assert "unverified" in err and "start at theta_s after its start at theta_e" in err, err
+    assert not (tmp_path / "line_result.json").exists()
+
+
+@pytest.mark.slow
+def test_an_asymmetric_pendulum_press_in_the_shipped_line_serves_its_robots_every_cycle(tmp_path: Path) -> None:
+    """The shipped line with its link-drive trim press in pendulum strokes (the swings differ): verified, the
+    robots' starts a master cycle apart in its two windows, the replay holding every clearance over both."""
+    sets = ["trim.planner.mode=pendulum", "trim.process.draw_speed_rpm=10"]
+    result = _run(SHIPPED, tmp_path, *[a for s in sets for a in ("--set", s)])
+    assert result["status"] == "verified"
+    own = result["stations"][1]["robot_starts_own_s"]
+    assert own["unloader"]["at theta_s"] - own["unloader"]["at theta_e"] == pytest.approx(result["period_s"], abs=1e-9)
+    clearance, gap, both = _replay(result, tmp_path, SHIPPED)
+    assert clearance >= -REPLAY_TOL_MM and gap >= -REPLAY_TOL_S and not both

@@ -108,12 +108,6 @@ def _station(model: LineModel, k: int, line_path: Path, overrides: dict[str, Any
             "on their interference curves)",
             field,
         )
-    if case.pendulum:  # (its robots serve each swing: a line of pendulum presses is not planned yet)
-        raise CaseFileError(
-            f"{where}{entry.case} sets planner.mode: pendulum; a line plans its presses' rotary strokes only (yet): "
-            "leave planner.mode out",
-            f"{entry.name}.planner.mode",
-        )
     if not LAWS[case.planner.motion_law].plans_at_rate:
         raise CaseFileError(
             f"{where}{entry.case} plans with the {case.planner.motion_law} law, which cannot run at a line's rate; "

@@ -3,7 +3,9 @@ timing chart (``planning.reports.plots.line_figure``); the files ``pressplan lin
 
 The line's master: time ``t`` [s] from 0 to the period, angle ``360 t / T`` [deg]. Station k's own master
 (its ``cam_table.csv`` with ``pressplan solve`` at the line's rate) is the line's shifted by its phase offset:
-``t_k = t - phi_k`` (a controller's ``MasterOffset`` of ``phi_k / T * 360`` deg).
+``t_k = t - phi_k`` (a controller's ``MasterOffset`` of ``phi_k / T * 360`` deg). A line with a pendulum press
+repeats every two master cycles (its swings alternate, ``planning.solver.pendulum_line``): its trajectory and
+cams run over both, the master from 0 to 720 deg.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from planning.reports.folder import write_atomic, write_json, write_table
-from planning.solver.line import LineSolution
+from planning.solver.line import LineSolution, horizon_s, line_starts, own_period_s, robot_position_mm
 
 LINE_FILES = ("line_summary.txt", "line_result.json", "line_trajectory.csv", "line_cams.csv", "line_timing.png")
 STEP_S = 1e-3  # [s] the line trajectory's step (the stations' verification grid's)
@@ -23,8 +25,9 @@ CAM_POINTS = 3600
 
 
 def station_times(solution: LineSolution, k: int, t_s: np.ndarray) -> np.ndarray:
-    """Station ``k``'s own time [s, within the period] at the line's master times ``t_s``."""
-    return np.mod(t_s - solution.offsets_s[k], solution.period_s)
+    """Station ``k``'s own time [s, within its cycle: two master cycles for a pendulum press] at the line's master
+    times ``t_s``."""
+    return np.mod(t_s - solution.offsets_s[k], solution.at_line[k].plan.period)
 
 
 def station_state(solution: LineSolution, k: int, t_s: np.ndarray) -> dict[str, np.ndarray]:
@@ -38,8 +41,7 @@ def station_state(solution: LineSolution, k: int, t_s: np.ndarray) -> dict[str, 
     out = {"crank_deg": np.mod(np.degrees(theta), 360.0), "crank_speed": omega, "slide_mm": slide}
     needs = []
     for robot in station.case.robots_on_path:
-        start = plan.robot_starts_s[robot.name]
-        out[f"{robot.name}_mm"] = robot.position(local, start, plan.period)
+        out[f"{robot.name}_mm"] = robot_position_mm(station, solution.at_line[k], robot.name, local)
         needs.append(robot.curve.need(out[f"{robot.name}_mm"]))
     out["needed_height_mm"] = np.max(needs, axis=0)
     out["clearance_mm"] = slide - out["needed_height_mm"]
@@ -47,9 +49,9 @@ def station_state(solution: LineSolution, k: int, t_s: np.ndarray) -> dict[str, 
 
 
 def trajectory(solution: LineSolution, step_s: float = STEP_S) -> tuple[np.ndarray, tuple[str, ...]]:
-    """One master cycle at ``step_s``: time, master angle, each station's crank angle, slide height, robots'
-    positions and least clearance."""
-    t = np.arange(0.0, solution.period_s, step_s)
+    """One master cycle (two with a pendulum press) at ``step_s``: time, master angle, each station's crank
+    angle, slide height, robots' positions and least clearance."""
+    t = np.arange(0.0, horizon_s(solution.at_line, solution.period_s), step_s)
     columns = {"time_s": t, "master_deg": t / solution.period_s * 360.0}
     for k, station in enumerate(solution.line.stations):
         state = station_state(solution, k, t)
@@ -63,8 +65,10 @@ def trajectory(solution: LineSolution, step_s: float = STEP_S) -> tuple[np.ndarr
 
 
 def cams(solution: LineSolution, points: int = CAM_POINTS) -> tuple[np.ndarray, tuple[str, ...]]:
-    """Each station's crank cam on the line's master (its angle modulo 360 deg and its slope [deg/deg])."""
-    master = np.arange(points) * (360.0 / points)
+    """Each station's crank cam on the line's master (its angle modulo 360 deg and its slope [deg/deg]) over
+    one master cycle, ``points`` points (two cycles with a pendulum press, twice the points)."""
+    cycles = round(horizon_s(solution.at_line, solution.period_s) / solution.period_s)
+    master = np.arange(cycles * points) * (360.0 / points)
     t = master / 360.0 * solution.period_s
     rate = 2 * math.pi / solution.period_s  # [rad/s] of the master
     columns = {"master_deg": master}
@@ -87,10 +91,10 @@ def result(solution: LineSolution, settings: dict[str, Any] | None = None) -> di
         if first in names:
             sets.setdefault(first, {})[rest] = value
     line, period = solution.line, solution.period_s
-    t = np.arange(0.0, period, STEP_S)
+    t = np.arange(0.0, horizon_s(solution.at_line, period), STEP_S)
     stations = []
     for k, station in enumerate(line.stations):
-        alone, plan = solution.alone[k].plan, solution.at_line[k].plan
+        plan = solution.at_line[k].plan
         offset = solution.offsets_s[k]
         state = station_state(solution, k, t)
         clearance = np.where(state["needed_height_mm"] > 0, state["clearance_mm"], np.inf)  # where a tool needs any
@@ -101,11 +105,14 @@ def result(solution: LineSolution, settings: dict[str, Any] | None = None) -> di
                 "name": station.name,
                 "case": str(station.path),
                 "mechanism": station.case.press.mechanism,
-                "spm_alone": alone.spm,
-                "period_alone_s": alone.period,
+                "mode": station.case.planner.mode,
+                "spm_alone": 60.0 / own_period_s(solution.alone[k]),
+                "period_alone_s": own_period_s(solution.alone[k]),
                 "phase_offset_s": offset,
                 "phase_offset_deg": offset / period * 360.0,
-                "robot_starts_s": {r: float(np.mod(s + offset, period)) for r, s in plan.robot_starts_s.items()},
+                "robot_starts_s": {
+                    r: float(np.mod(s + offset, period)) for r, s in line_starts(solution.at_line[k]).items()
+                },
                 "robot_starts_own_s": dict(plan.robot_starts_s),
                 "least_clearance_mm": float(clearance[least]) if needed else None,
                 "least_clearance_time_s": float(t[least]) if needed else None,
@@ -133,6 +140,7 @@ def result(solution: LineSolution, settings: dict[str, Any] | None = None) -> di
         "status": "verified" if solution.passed else "unverified",
         "spm": solution.spm,
         "period_s": period,
+        "horizon_s": horizon_s(solution.at_line, period),
         "bottleneck": {"kind": neck.kind, "name": neck.name, "period_s": neck.period_s, "spm": 60.0 / neck.period_s},
         "stations": stations,
         "robots": robots,
@@ -161,8 +169,9 @@ def summary_text(solution: LineSolution) -> str:
     for k, station in enumerate(line.stations):
         offset = solution.offsets_s[k]
         lines.append(
-            f"  {station.name:<12}{solution.alone[k].plan.spm:>12.3f}{solution.at_line[k].plan.spm:>13.3f}"
+            f"  {station.name:<12}{60 / own_period_s(solution.alone[k]):>12.3f}{solution.at_line[k].plan.spm:>13.3f}"
             f"{offset / period * 360:>14.2f}{offset:>12.4f}  {station.path.name}"
+            + (" (pendulum: a swing a master cycle)" if station.case.pendulum else "")
         )
     lines += ["", f"  {'robot':<16}{'loop [s]':>10}{'spare [s]':>11}  stretches (start on the line's master [s])"]
     for robot, loop, stretches in zip(line.robots, solution.loops_s, solution.schedules, strict=True):
@@ -178,7 +187,8 @@ def writers(solution: LineSolution, figures: bool, settings: dict[str, Any] | No
     cam_table, cam_columns = cams(solution)
     head = (
         f"# pressplan line cams for {solution.line.name}; period_s = {solution.period_s:.9f}; "
-        f"master 0 ... <360 deg; each crank angle modulo 360 deg from its TDC; dcrank_dmaster [deg/deg]"
+        f"master 0 ... <{360 * round(horizon_s(solution.at_line, solution.period_s) / solution.period_s)} deg; "
+        f"each crank angle modulo 360 deg from its TDC; dcrank_dmaster [deg/deg]"
     )
     out = {
         "line_summary.txt": lambda p: Path(p).write_text(summary_text(solution) + "\n", encoding="utf-8"),

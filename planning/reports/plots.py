@@ -684,13 +684,15 @@ LINE_COLOURS = (  # one per station, up to a line's most (planning.model.line.MA
 
 
 def line_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
-    """A press line over one master cycle (``planning.reports.line``): each press's slide and the height its
-    robots' tools need (dashed, where they need any); below, each robot's cycle as bars: inside a press in the
-    press's colour, its moves between the presses grey, away (the feeder's, the exit's) light."""
+    """A press line over one master cycle, two with a pendulum press (``planning.reports.line``): each press's
+    slide and the height its robots' tools need (dashed, where they need any); below, each robot's cycle as bars:
+    inside a press in the press's colour, its moves between the presses grey, away (the feeder's, the exit's)
+    light."""
     fig = Figure(figsize=(12, 7.2), layout="constrained")
     FigureCanvasAgg(fig)
     heights, bars = fig.subplots(2, 1, sharex=True, height_ratios=(3, 2))
     t, period = traj["time_s"], result["period_s"]
+    horizon = result.get("horizon_s", period)  # two master cycles with a pendulum press (its swings alternate)
     colour = {s["name"]: LINE_COLOURS[k % len(LINE_COLOURS)] for k, s in enumerate(result["stations"])}
     for s in result["stations"]:
         name = s["name"]
@@ -712,7 +714,7 @@ def line_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
                 continue
             inside = stretch["station"]
             face = colour[inside] if inside else ("#bbbbbb" if stretch["what"] != "away" else "#e6e6e6")
-            for start in (stretch["start_s"], stretch["start_s"] - period):  # a stretch over the cycle's end wraps
+            for start in np.arange(stretch["start_s"] - period, horizon, period):  # (a stretch over an end wraps)
                 bars.broken_barh([(start, stretch["duration_s"])], (row - 0.35, 0.7), facecolors=face)
     bars.set_yticks(range(len(names)), names, fontsize=8)
     bars.invert_yaxis()
@@ -721,7 +723,7 @@ def line_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
     bars.set_title(what, fontsize=9, loc="left")
     for ax in (heights, bars):
         ax.grid(alpha=0.3)
-        ax.set_xlim(0.0, period)
+        ax.set_xlim(0.0, horizon)
     return fig
 
 

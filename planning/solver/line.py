@@ -18,9 +18,11 @@ import numpy as np
 from planning.model.limits.base import Check
 from planning.model.line import Line, LineRobot, Station, occupancy_s, phase_offsets_s, tool
 from planning.model.outcome import Outcome
+from planning.model.pendulum import STROKES_PER_CYCLE, PendulumPlan
 from planning.solver.max_spm import solve_max_spm
 from planning.solver.objectives import solve_at_period
 from planning.solver.outcomes import Infeasible, PlanningError
+from planning.solver.pendulum_line import fastest_swings, line_period_s, line_starts_s, shifts_s, swings_at_period
 from planning.solver.solution import Solution
 from planning.tolerances import SAME_PERIOD_S, SAME_POSITION_MM, TIME_TOL_S
 
@@ -98,7 +100,7 @@ def solve_line(line: Line) -> LineSolution:
     at_line = tuple(
         _at_period(station, period_s, fastest) for station, fastest in zip(line.stations, alone, strict=True)
     )
-    starts = [solution.plan.robot_starts_s for solution in at_line]
+    starts = [line_starts(solution) for solution in at_line]
     offsets = phase_offsets_s(period_s, line.robots, line.stations, starts)
     schedules = tuple(_schedule(robot, line, period_s, offsets, starts) for robot in line.robots)
     checks = _station_checks(line, at_line, period_s) + _robot_checks(line, schedules)
@@ -114,11 +116,42 @@ def solve_line(line: Line) -> LineSolution:
     return solution
 
 
+def line_starts(solution: Solution) -> dict[str, float]:
+    """A station's robot starts on its own time [s] as the line's master sees them each cycle: a rotary plan's,
+    a pendulum plan's in its window at theta_e (``planning.solver.pendulum_line``)."""
+    plan = solution.plan
+    return line_starts_s(plan) if isinstance(plan, PendulumPlan) else dict(plan.robot_starts_s)
+
+
+def horizon_s(at_line: tuple[Solution, ...], period_s: float) -> float:
+    """The line's repeat [s]: its master cycle, two with a pendulum press (its swings alternate)."""
+    swings = any(isinstance(solution.plan, PendulumPlan) for solution in at_line)
+    return STROKES_PER_CYCLE * period_s if swings else period_s
+
+
+def robot_position_mm(station: Station, solution: Solution, role: str, t_s: np.ndarray) -> np.ndarray:
+    """``station``'s ``role`` robot's position on its path [mm] at the station's own times ``t_s`` [s] in its plan
+    at the line (a pendulum plan's robot in both its windows)."""
+    robot, plan = tool(station, role), solution.plan
+    if isinstance(plan, PendulumPlan):
+        return robot.position_of_starts(t_s, tuple(plan.robot_starts_s[role].values()), plan.period)
+    return robot.position(t_s, plan.robot_starts_s[role], plan.period)
+
+
+def own_period_s(solution: Solution) -> float:
+    """The shortest master cycle a station's plan takes: a rotary plan's cycle, a pendulum plan's swings each in
+    one master cycle (``planning.solver.pendulum_line.line_period_s``)."""
+    plan = solution.plan
+    return line_period_s(plan) if isinstance(plan, PendulumPlan) else plan.period
+
+
 def _check_slow_enough(line: Line, bottleneck: Bottleneck) -> None:
-    """:class:`Infeasible` when a station cannot turn as slowly as the line's period asks: its minimum crank
-    speed makes a cycle at most ``Case.longest_cycle_s`` long (a turn at it, ``60 / min_crank_speed_rpm`` [s],
-    without a hold)."""
+    """:class:`Infeasible` when a rotary station cannot turn as slowly as the line's period asks: its minimum
+    crank speed makes a cycle at most ``Case.longest_cycle_s`` long (a turn at it, ``60 / min_crank_speed_rpm``
+    [s], without a hold). A pendulum station stands at its turns (``planning.solver.pendulum_line``)."""
     for station in line.stations:
+        if station.case.pendulum:
+            continue
         slowest = station.case.limits.min_crank_speed_rpm
         longest = station.case.longest_cycle_s
         if bottleneck.period_s > longest:
@@ -141,7 +174,7 @@ def _alone(station: Station) -> Solution:
     key = case.model_dump_json()
     if key not in _ALONE:
         try:
-            solution = solve_max_spm(case, case.planner.placement)
+            solution = fastest_swings(case) if case.pendulum else solve_max_spm(case, case.planner.placement)
         except PlanningError as exc:
             raise StationError(station, exc, "alone") from None
         if len(_ALONE) >= ALONE_KEPT:
@@ -151,7 +184,10 @@ def _alone(station: Station) -> Solution:
 
 
 def _at_period(station: Station, period_s: float, fastest: Solution) -> Solution:
+    """The station's verified plan at the line's period (a pendulum press: one swing a master cycle)."""
     try:
+        if station.case.pendulum:
+            return swings_at_period(station.case, period_s, fastest)
         return solve_at_period(station.case, period_s, fastest)
     except PlanningError as exc:
         raise StationError(station, exc, f"at the line's {60 / period_s:.4g} strokes/min") from None
@@ -159,11 +195,12 @@ def _at_period(station: Station, period_s: float, fastest: Solution) -> Solution
 
 def _bottleneck(line: Line, alone: tuple[Solution, ...], loops: tuple[float, ...]) -> Bottleneck:
     """The longest of the stations' own periods and the robots' loops (a press where they tie)."""
-    press = max(range(len(alone)), key=lambda k: alone[k].plan.period)
+    own = [own_period_s(solution) for solution in alone]
+    press = max(range(len(alone)), key=lambda k: own[k])
     robot = max(range(len(loops)), key=lambda j: loops[j])
-    if loops[robot] > alone[press].plan.period + SAME_PERIOD_S:
+    if loops[robot] > own[press] + SAME_PERIOD_S:
         return Bottleneck("robot", line.robots[robot].name, loops[robot])
-    return Bottleneck("press", line.stations[press].name, alone[press].plan.period)
+    return Bottleneck("press", line.stations[press].name, own[press])
 
 
 def _schedule(
@@ -198,34 +235,35 @@ def _schedule(
 
 
 def _station_checks(line: Line, at_line: tuple[Solution, ...], period_s: float) -> tuple[Check, ...]:
-    """Each station's plan at the line's period: verified (its failed checks, none allowed), its cycle time."""
+    """Each station's plan at the line's period: verified (its failed checks, none allowed), its cycle time (a
+    pendulum press's two swings two master cycles, each robot's starts in its two windows one apart)."""
     checks = []
     for station, solution in zip(line.stations, at_line, strict=True):
         failed = len(solution.verification.failures())
         checks.append(Check.of("line_station", f"{station.name}: failed checks", failed, 0, "", "max", 0.0))
-        checks.append(
-            Check.of(
-                "line_period", f"{station.name}: cycle time", solution.plan.period, period_s, "s", "equal", TIME_TOL_S
-            )
-        )
+        swings = isinstance(solution.plan, PendulumPlan)
+        cycle = STROKES_PER_CYCLE * period_s if swings else period_s
+        name = f"{station.name}: cycle time" + (" (two swings)" if swings else "")
+        checks.append(Check.of("line_period", name, solution.plan.period, cycle, "s", "equal", TIME_TOL_S))
+        for robot, shift in (shifts_s(solution.plan) if swings else {}).items():
+            name = f"{station.name}: {robot}'s start at theta_s after its start at theta_e"
+            checks.append(Check.of("line_period", name, shift, period_s, "s", "equal", TIME_TOL_S))
     return tuple(checks)
 
 
 def _inside_checks(line: Line, at_line: tuple[Solution, ...], offsets_s: np.ndarray, period_s: float) -> tuple:
     """Each transfer robot on the line's master at :data:`INSIDE_STEP_S`, from the presses' plans and offsets
     (not from its schedule): the samples at which it is off its waiting point in both presses it serves
-    (none allowed)."""
-    t = np.arange(0.0, period_s, INSIDE_STEP_S)
+    (none allowed), over two master cycles with a pendulum press."""
+    t = np.arange(0.0, horizon_s(at_line, period_s), INSIDE_STEP_S)
     checks = []
     for robot in line.robots:
         if robot.unloads is None or robot.loads is None:
             continue
         inside = []
         for k, role in ((robot.unloads, "unloader"), (robot.loads, "loader")):
-            robot_in_press = tool(line.stations[k], role)
-            plan = at_line[k].plan
-            x = robot_in_press.position(t - offsets_s[k], plan.robot_starts_s[role], plan.period)
-            inside.append(x < robot_in_press.path_mm - SAME_POSITION_MM)
+            x = robot_position_mm(line.stations[k], at_line[k], role, t - offsets_s[k])
+            inside.append(x < tool(line.stations[k], role).path_mm - SAME_POSITION_MM)
         both = int(np.count_nonzero(inside[0] & inside[1]))
         name = f"{robot.name}: samples inside both presses"
         checks.append(Check.of("line_robot", name, both, 0, "", "max", 0.0))
