@@ -38,7 +38,7 @@ def with_jerk(case, jerk: float, law: str = "optimal"):  # noqa: ANN001, ANN201 
 # the robots' case in the slow tier: its optimal law's NLP ties every segment to the robots' rows (about 30 s)
 # a case with a hold at the bottom is not the optimal law's (it plans no hold yet: tests/test_hold.py), a draw at
 # constant slide speed not the laws' with halves (tests/test_slide_draw.py): neither compares the two
-WITHOUT_HOLD = [p for p in CASES if read_case(p).process.hold_time_s is None and not read_case(p).free_draw]
+WITHOUT_HOLD = [p for p in CASES if not read_case(p).free_draw]
 # the robots' case (about 30 s) and the linkages (about 6 s each) in the slow tier
 SLOW_BEATEN = ("robots", "link-drive", "knuckle-joint")
 BEATEN = [

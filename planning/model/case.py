@@ -921,8 +921,9 @@ def _curve_checks(where: str, robot: RobotModel, stroke: float) -> None:
 
 
 def _hold_checks(case: Case) -> None:
-    """A hold stands below the stroke's top, after the draw's end and before the opening, under a law with
-    halves (the crank brakes from the draw speed to stand at it, ``planning.model.cycle``)."""
+    """A hold stands below the stroke's top, after the draw's end and before the opening (the crank brakes
+    from the draw to stand at it: a law's half, ``planning.model.cycle``, or the optimal law's brake phase,
+    ``planning.model.free_profile``)."""
     process = case.process
     if process.hold_time_s is None:
         if process.hold_height_mm is not None:
@@ -932,9 +933,6 @@ def _hold_checks(case: Case) -> None:
     if not case.hold_height_mm < case.machine.stroke:
         reason = f"must lie below the stroke's top ({case.machine.stroke:.1f} mm above BDC)"
         raise CaseError("process.hold_height_mm", reason, process.hold_height_mm)
-    if LAWS[case.planner.motion_law].transcription != HALVES:
-        reason = "the optimal law plans no hold yet: choose a law with halves (improved-s-curve, ...)"
-        raise CaseError("planner.motion_law", reason, case.planner.motion_law)
     hold_deg = math.degrees(case.hold_angle)
     k = case.key_points
     if not k.draw_end_deg < hold_deg - HOLD_BRAKE_MIN_DEG:
@@ -998,23 +996,19 @@ def _pendulum_checks(case: Case) -> None:
 
 def _slide_draw_checks(case: Case) -> None:
     """A draw at constant slide speed: planned by the optimal law (its draw a free profile; a law's halves end at
-    a constant crank speed), without a given draw speed, a hold or (not yet) robots."""
+    a constant crank speed), without a given draw speed (with a hold: the draw to theta3, then the brake)."""
     speed = case.process.draw_slide_speed_mm_s
     if speed is None:
         return
-    for key, what in (("draw_speed_rpm", "a constant crank speed"), ("hold_time_s", "a hold at the bottom")):
-        if getattr(case.process, key) is not None:
-            reason = f"and process.draw_slide_speed_mm_s ask for two draws: {what} or a constant slide speed"
-            raise CaseError(f"process.{key}", reason, getattr(case.process, key))
+    if case.process.draw_speed_rpm is not None:
+        reason = "and process.draw_slide_speed_mm_s ask for two draws: a constant crank speed or a constant slide speed"
+        raise CaseError("process.draw_speed_rpm", reason, case.process.draw_speed_rpm)
     if LAWS[case.planner.motion_law].transcription == HALVES:
         reason = (
             "a draw at constant slide speed is planned by the optimal law (planner.motion_law: optimal, with "
             "limits.crank_jerk_rad_s3); a law with halves draws at a constant crank speed"
         )
         raise CaseError("planner.motion_law", reason, case.planner.motion_law)
-    if case.robots is not None:
-        reason = "a draw at constant slide speed is planned without a robots: section yet"
-        raise CaseError("robots", reason, None, False)
 
 
 def _law_checks(case: Case) -> None:

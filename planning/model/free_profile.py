@@ -7,6 +7,10 @@ segment of a phase lasting the phase's step ``h`` [s]; it arrives at theta2 + 2 
 acceleration and draws at w2 to theta3. A draw at constant slide speed (``Case.free_draw``) is a fourth phase
 (:data:`DRAW_PHASE`, theta2 + 2 pi -> theta3 + 2 pi): the cycle then starts at theta3 with the speed ``w2`` and the
 acceleration ``draw_accel`` it returns to there (:data:`FREE_DRAW`).
+A hold at the bottom (``process.hold_time_s``) puts two phases before the return (:func:`first_layout`): the
+brake (:data:`BRAKE_PHASE`, theta3 -> the hold's angle theta_h, arriving at rest with zero acceleration) and the
+standstill (:data:`STAND_PHASE`: one segment of the hold's time, its jerk zero); the return then rises from rest
+at theta_h to theta4.
 The acceleration is continuous everywhere (piecewise linear); the jerk steps at the knots. There are no
 halves, peaks or dwell: :class:`FreeProfileParameters` reports what a press engineer reads off any
 plan (speed at TDC, highest speed before and after the draw, peak acceleration and jerk).
@@ -26,11 +30,33 @@ Layout = tuple[tuple[str, int], ...]  # (phase, segments) in the order theta3 ->
 PHASES: Layout = (("return", 40), ("transfer", 24), ("feed", 40))  # the layout every solve starts with
 DRAW_PHASE = ("draw", 40)  # a draw at constant slide speed: the crank's speed planned through it too
 FREE_DRAW: Layout = (*PHASES, DRAW_PHASE)  # the first layout of a case whose draw is free (Case.free_draw)
+BRAKE_PHASE = ("brake", 16)  # a hold's brake: theta3 -> the hold's angle, to rest
+STAND_PHASE = ("stand", 1)  # a hold's standstill: one segment of the hold's time, no jerk
+REST_PHASES = (BRAKE_PHASE[0], STAND_PHASE[0])  # the phases that end at rest
 
 
-def first_layout(free_draw: bool) -> Layout:
-    """The layout a solve starts with: :data:`PHASES`, or :data:`FREE_DRAW` for a draw at constant slide speed."""
-    return FREE_DRAW if free_draw else PHASES
+def first_layout(free_draw: bool, hold: bool = False) -> Layout:
+    """The layout a solve starts with: :data:`PHASES`, or :data:`FREE_DRAW` for a draw at constant slide speed;
+    with a ``hold`` the brake and the standstill first."""
+    layout = FREE_DRAW if free_draw else PHASES
+    return (BRAKE_PHASE, STAND_PHASE, *layout) if hold else layout
+
+
+def holds(layout: Layout) -> bool:
+    """Whether ``layout`` brakes to a hold and stands there (its first phases :data:`REST_PHASES`)."""
+    return any(phase == STAND_PHASE[0] for phase, _ in layout)
+
+
+def phase_ends(layout: Layout, key_angles: tuple, hold_angle=None) -> tuple:  # noqa: ANN001 - floats or symbols
+    """Each phase's end angle [rad] counted on from theta3's (0): the brake's and the standstill's the hold's
+    angle, the return's theta4, the window's theta1 a turn on, the feed's theta2 a turn on, a free draw's
+    theta3 a turn on (``key_angles`` theta1 .. theta4)."""
+    th1, th2, th3, th4 = key_angles
+    two_pi = 2 * math.pi
+    ends = {"return": th4 - th3, "transfer": th1 + two_pi - th3, "feed": th2 + two_pi - th3, "draw": two_pi}
+    if hold_angle is not None:
+        ends |= {"brake": hold_angle - th3, "stand": hold_angle - th3}
+    return tuple(ends[phase] for phase, _ in layout)
 
 
 def draws_freely(layout: Layout) -> bool:
@@ -42,8 +68,8 @@ FINE_FACTOR = 2.5  # the finer layout: this many times the segments of each phas
 
 
 def finer(layout: Layout, factor: float = FINE_FACTOR) -> Layout:
-    """``layout`` with ``factor`` times the segments in each phase."""
-    return tuple((phase, round(n * factor)) for phase, n in layout)
+    """``layout`` with ``factor`` times the segments in each phase (a hold's standstill stays one)."""
+    return tuple((phase, n if phase == STAND_PHASE[0] else round(n * factor)) for phase, n in layout)
 
 
 def free_segments(durations, jerks, layout: Layout = PHASES) -> list[Segment]:  # noqa: ANN001 - floats or symbols
@@ -62,8 +88,8 @@ def closed_jerks(
 ) -> tuple[float, ...]:
     """The jerks [rad/s^3] nearest ``jerks`` (least squares) with which the profile from theta3 (speed ``w2``,
     acceleration ``a0``: 0 but for a free draw) meets its ends exactly: each phase's end angle ``ends`` [rad]
-    (theta4, theta1 + 2 pi, theta2 + 2 pi, with a free draw theta3 + 2 pi, counted on from theta3's), and the
-    speed ``w2`` with the acceleration ``a0`` at the last.
+    (:func:`phase_ends`), the speed ``w2`` with the acceleration ``a0`` at the last; a hold's brake ends at rest
+    (speed and acceleration 0) and its standstill's jerk is not moved (it stays 0).
 
     The NLP joins its shooting nodes to IPOPT's constraint tolerance, so the profile propagated through the
     segments' closed forms gathers their defects at its end (1e-9 rad/s of speed over 104 segments: more than
@@ -75,7 +101,7 @@ def closed_jerks(
     T, j = np.asarray(durations, dtype=float), np.asarray(jerks, dtype=float)
     cut = np.cumsum([n for _, n in layout])  # the phases' last segments (+1)
     rows, targets, values = [], [], []
-    for end, (index, target) in enumerate(zip(cut, ends, strict=True)):
+    for end, ((phase, _), index, target) in enumerate(zip(layout, cut, ends, strict=True)):
         after = np.concatenate([np.cumsum(T[:index][::-1])[::-1][1:], [0.0]])  # from each segment's end to this
         gain = np.zeros_like(T)
         gain[:index] = T[:index] ** 3 / 6 + T[:index] ** 2 * after / 2 + T[:index] * after**2 / 2
@@ -83,13 +109,16 @@ def closed_jerks(
         targets.append(target)
         span = float(np.sum(T[:index]))
         values.append(w2 * span + a0 * span**2 / 2 + float(gain @ j))  # the angle past theta3 there
-        if end == len(cut) - 1:
+        if end == len(cut) - 1 or phase == BRAKE_PHASE[0]:  # the cycle closes, or the crank comes to rest
             speed = np.zeros_like(T)
             speed[:index] = T[:index] ** 2 / 2 + T[:index] * after
             rows += [speed, np.where(np.arange(T.size) < index, T, 0.0)]
-            targets += [w2, a0]
+            w_end, a_end = (w2, a0) if end == len(cut) - 1 else (0.0, 0.0)
+            targets += [w_end, a_end]
             values += [w2 + a0 * span + float(speed @ j), a0 + float(T[:index] @ j[:index])]
     A, residual = np.array(rows), np.array(values) - np.array(targets)
+    fixed = np.repeat([phase == STAND_PHASE[0] for phase, _ in layout], [n for _, n in layout])
+    A[:, fixed] = 0.0  # (the least-norm correction leaves the standstill's jerk as it is)
     correction = np.linalg.lstsq(A, residual, rcond=None)[0]  # the least-norm one (least squares if degenerate)
     return tuple((j - correction).tolist())
 
@@ -112,6 +141,30 @@ class FreeProfileParameters:
     law_parameter: float = 0.0
     layout: Layout = PHASES
     draw_accel: float = 0.0  # [rad/s^2] at theta3: a free draw's (0 after a draw at constant crank speed)
+    hold_angle: float | None = None  # [rad] where a hold's standstill stands (None: no hold)
+    hold_time: float = 0.0  # [s] the standstill's time
+
+    @property
+    def has_hold(self) -> bool:
+        """The crank brakes after the draw and stands at ``hold_angle`` for ``hold_time``."""
+        return self.hold_angle is not None
+
+    @property
+    def brake_duration(self) -> float:
+        """[s] the brake from theta3 to the hold (0 without one)."""
+        return float(sum(T for T, name in zip(self.durations, self._phase_names(), strict=True) if name == "brake"))
+
+    def _phase_names(self) -> list[str]:
+        return [phase for phase, n in self.layout for _ in range(n)]
+
+    def stop_end_angle(self) -> float:
+        """[rad] where a hold's stop ends: the crank's first speed peak after the standstill (the end of its rise
+        from rest, as a law's return half up to its peak); the hold's angle without a rise."""
+        knots = self._knots()
+        first = sum(n for phase, n in self.layout if phase in REST_PHASES)  # the knot where the return starts
+        rising = knots[first + 1 :, 2] > 0.0
+        peak = first + 1 + (int(np.argmin(rising)) if not rising.all() else rising.size - 1)
+        return float(knots[peak, 0]) if rising.any() else float(self.hold_angle)
 
     def segments(self) -> list[Segment]:
         return free_segments(self.durations, self.jerks, self.layout)

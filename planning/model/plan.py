@@ -10,7 +10,14 @@ import numpy as np
 
 from planning.model.case import Placement
 from planning.model.cycle import CycleParameters, cycle_segments
-from planning.model.free_profile import FreeProfileParameters, Layout, closed_jerks, draws_freely
+from planning.model.free_profile import (
+    FreeProfileParameters,
+    Layout,
+    closed_jerks,
+    draws_freely,
+    holds,
+    phase_ends,
+)
 from planning.model.laws import DEFAULT_LAW
 from planning.model.profile import Profile, Segment, advance_segment, knot_states, split_segment
 from planning.tolerances import ANGLE_TOL_RAD, KNOT_TIME_S, TIME_TOL_S, TINY
@@ -124,10 +131,13 @@ class Plan:
 
     def planned_stop(self) -> tuple[float, float] | None:
         """``(from, to)`` [rad]: the crank angles of the hold's planned stop, theta3 to the end of the return's
-        rise from rest (which sweeps ``D (0 + wm2) / 2``); None without a hold."""
+        rise from rest (a law's half sweeps ``D (0 + wm2) / 2``; the optimal law's rises to its first speed
+        peak); None without a hold."""
         p = self.parameters
         if not getattr(p, "has_hold", False):
             return None
+        if isinstance(p, FreeProfileParameters):  # the optimal law's rise ends at its first speed peak
+            return float(p.draw_end), p.stop_end_angle()
         rise = float(p.return_accel_duration) * float(p.return_peak_speed) / 2
         return float(p.draw_end), float(p.hold_angle) + rise
 
@@ -192,13 +202,13 @@ def plan_of(
             durations += [values[f"{phase}_step"]] * n
             jerks += [values[f"{phase}_jerk_{k}"] for k in range(n)]
         # the phases' ends met exactly: the shooting's defects gathered at the end taken out (closed_jerks)
-        ends = (th4 - th3, th1 + 2 * math.pi - th3, th2 + 2 * math.pi - th3)
+        hold = hold_of(case) if holds(layout) else {}
+        ends = phase_ends(layout, (th1, th2, th3, th4), hold.get("hold_angle"))
         free = draws_freely(layout)  # a draw at constant slide speed: a phase of its own, from theta3's accel
         a0 = values.get("draw_accel", 0.0) if free else 0.0
-        ends += (2 * math.pi,) if free else ()
         jerks = closed_jerks(tuple(durations), tuple(jerks), values["draw_speed"], ends, layout, a0)
         params = FreeProfileParameters(
-            tuple(durations), tuple(jerks), values["draw_speed"], th2, th3, layout=layout, draw_accel=a0
+            tuple(durations), tuple(jerks), values["draw_speed"], th2, th3, layout=layout, draw_accel=a0, **hold
         )
         segs = [seg for seg in params.segments() if seg.duration > 0]
         segs += [] if free else [Segment("draw:constant", params.draw_time, 0.0, 0.0)]

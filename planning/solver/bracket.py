@@ -26,7 +26,6 @@ import time
 from dataclasses import dataclass
 
 from planning.model.case import Case
-from planning.model.errors import CaseError
 from planning.model.free_profile import finer, first_layout
 from planning.model.laws.optimal import OptimalLaw
 from planning.model.profile import max_abs_jerk
@@ -104,9 +103,6 @@ def bracket(case: Case, tolerance_pct: float = BRACKET_TOL_PCT) -> Bracket:
     """The bracket of ``case`` (module docstring); raises a :class:`PlanningError` when no verified motion
     or no upper bound is found."""
     t_start = time.perf_counter()
-    if case.hold_angle is not None:  # its verified side is the optimal law's plan
-        reason = "bound --bracket plans with the optimal law, which plans no hold yet (bound --certified does)"
-        raise CaseError("process.hold_time_s", reason, case.process.hold_time_s)
     allowance = None if case.limits.crank_jerk_rad_s3 is not None else jerk_allowance(case)
     planned = case.with_objective("max-spm")
     if allowance is not None:
@@ -119,7 +115,8 @@ def bracket(case: Case, tolerance_pct: float = BRACKET_TOL_PCT) -> Bracket:
     rounds = [BracketRound(verified.plan.spm, upper.spm, gap_pct(verified.plan.spm, upper.spm))]
     # with robots the verified motion stays on the first layout: their rows tie every segment of the profile
     # (the slide's height at a robot's time sums them all), so a finer layout's NLP grows with its square
-    layouts = [finer(first_layout(case.free_draw), f) for f in LAYOUT_FACTORS] if case.robots is None else []
+    first = first_layout(case.free_draw, case.hold_angle is not None)
+    layouts = [finer(first, f) for f in LAYOUT_FACTORS] if case.robots is None else []
     meshes = list(UPPER_MESHES[1:])
     turn = 0
     while rounds[-1].gap_pct > tolerance_pct and (layouts or meshes):

@@ -28,7 +28,17 @@ import casadi as ca
 import numpy as np
 
 from planning.model.case import RPM, Case
-from planning.model.free_profile import FREE_DRAW, PHASES, Layout, draws_freely
+from planning.model.free_profile import (
+    BRAKE_PHASE,
+    FREE_DRAW,
+    PHASES,
+    REST_PHASES,
+    STAND_PHASE,
+    Layout,
+    draws_freely,
+    first_layout,
+    holds,
+)
 from planning.model.limits.base import Extremes, Transcription
 from planning.model.plan import Plan, SolverInfo, plan_of
 from planning.model.profile import advance
@@ -58,7 +68,7 @@ from press.mechanism import Formula
 # the limits are held at every knot and at evenly spaced points inside each segment, this many per
 # segment (knot included) in each phase: the robot's window has the longest segments and the highest
 # speeds (around TDC, where the slider acceleration peaks), so it is sampled finer
-SAMPLES_PER_SEGMENT = {"return": 4, "transfer": 8, "feed": 4, "draw": 8}
+SAMPLES_PER_SEGMENT = {"return": 4, "transfer": 8, "feed": 4, "draw": 8, "brake": 4, "stand": 2}
 STATES = ("angle", "speed", "accel")
 TOP_SPEED = 1e3  # [rad/s] upper bound of the crank speeds (far above any press)
 # a re-solve with a refined limit starts nearer the optimum than the laws' (about half the iterations
@@ -126,8 +136,12 @@ def variable_bounds(
     lo, hi = np.full(len(variables), -np.inf), np.full(len(variables), np.inf)
     for name, kind in variables:
         i = index[name]
-        if kind == "jerk":
+        if kind == "jerk" and name.startswith(f"{STAND_PHASE[0]}_"):  # the crank stands: no jerk
+            lo[i], hi[i] = 0.0, 0.0
+        elif kind == "jerk":
             lo[i], hi[i] = -J, J
+        elif kind == "step" and name == f"{STAND_PHASE[0]}_step":  # a hold's standstill: its time
+            lo[i], hi[i] = case.standstill_s, case.standstill_s
         elif kind == "step":
             phase = name.removesuffix("_step")
             lo[i], hi[i] = 0.0, longest / dict(phases)[phase]
@@ -160,10 +174,12 @@ def _shooting(phases: Layout, physical: ca.MX, v: dict, unit: dict, q: dict, ind
     crossings in closed form (clip), the last state and the time at the feed's end."""
     ends = {"return": q["theta4"], "transfer": q["theta1"] + 2 * np.pi, "feed": q["theta2"] + 2 * np.pi}
     ends["draw"] = q["theta3"] + 2 * np.pi  # a free draw (a draw at constant slide speed)
+    if holds(phases):  # the brake to the hold's angle and the standstill there
+        ends |= {phase: q["hold_angle"] for phase in REST_PHASES}
     start = (q["theta3"], v["draw_speed"], v.get("draw_accel", ca.MX(0.0)))
     t0 = ca.MX(0.0)
     shooting, boundary, samples, times, knot_accels, pieces = [], [], [], [], [], []
-    crossings = {}
+    crossings, rest = {}, None
     for phase, n in phases:
         h = v[f"{phase}_step"]
         first = index[f"{phase}_jerk_0"]
@@ -171,8 +187,8 @@ def _shooting(phases: Layout, physical: ca.MX, v: dict, unit: dict, q: dict, ind
         # the knots 1 .. n of the phase: n rows of (angle, speed, accel), stored row after row
         states = ca.reshape(physical[first + n : first + 4 * n], 3, n).T
         nxt = [states[:, i] for i in range(3)]
-        th0, om0, al0 = (ca.vertcat(start[i], nxt[i][: n - 1]) for i in range(3))
-        if phase in ("return", "feed"):  # the die-height crossing of this phase, in closed form (clip)
+        th0, om0, al0 = (ca.vertcat(start[i], nxt[i][: n - 1]) if n > 1 else start[i] for i in range(3))
+        if phase in ("return", "feed", "brake"):  # the die-height crossing of this phase, in closed form (clip)
             when = v["die_up_time" if phase == "return" else "die_down_time"]
             tau = ca.fmin(ca.fmax(when - h * ca.DM(np.arange(n)), 0), h)
             crossings[phase] = (clipped_advance(tau, start[0], start[1], om0, al0, jerk, 0.0), when, n * h)
@@ -183,6 +199,8 @@ def _shooting(phases: Layout, physical: ca.MX, v: dict, unit: dict, q: dict, ind
         )
         end = tuple(states[n - 1, i] for i in range(3))
         boundary.append(end[0] - ends[phase])
+        if phase == BRAKE_PHASE[0]:
+            rest = (end[1] / unit["draw_speed"], end[2] / unit[f"{phase}_accel_1"])  # at rest at the hold
         # samples in time order: every knot of the phase and the points inside each segment
         fractions = [k / SAMPLES_PER_SEGMENT[phase] for k in range(1, SAMPLES_PER_SEGMENT[phase])]
         parts = [advance(th0, om0, al0, jerk, 0.0, h * f) for f in fractions]
@@ -206,6 +224,8 @@ def _shooting(phases: Layout, physical: ca.MX, v: dict, unit: dict, q: dict, ind
         "free_draw": draws_freely(phases),
         "t_draw_start": feed_end,
         "pieces": pieces,
+        "rest": rest,
+        "phases": phases,
     }
 
 
@@ -214,12 +234,22 @@ def _structure_rows(rows: Rows, s: dict[str, Any], v: dict, unit: dict, q: dict)
     crossings at their angles; the crossings' speeds (rising, falling)."""
     w2, start = v["draw_speed"], s["end"]
     rows.add("segments join (closed form)", ca.vertcat(*s["shooting"]), 0.0, 0.0, "planner.motion_law")
-    rows.add("key angles", ca.vertcat(*s["boundary"][:2]), 0.0, 0.0, "key_points")
+    closing = 2 if s["free_draw"] else 1  # the feed's end (and a free draw's) closes the cycle
+    rows.add("key angles", ca.vertcat(*s["boundary"][:-closing]), 0.0, 0.0, "key_points")
+    if s["rest"] is not None:
+        rows.add("the crank at rest at the hold", ca.vertcat(*s["rest"]), 0.0, 0.0, "process.hold_time_s")
     end_accel = start[2] - v["draw_accel"] if "draw_accel" in v else start[2]  # a free draw's at theta3, else 0
-    closes = ca.vertcat(*s["boundary"][2:], (start[1] - w2) / unit["draw_speed"], end_accel / unit["feed_accel_1"])
+    closes = ca.vertcat(
+        *s["boundary"][-closing:], (start[1] - w2) / unit["draw_speed"], end_accel / unit["feed_accel_1"]
+    )
     rows.add("cycle closes", closes, 0.0, 0.0, "key_points")
     (thu, omu), t_up, span_up = s["crossings"]["return"]
     (thd, omd), t_down, span_down = s["crossings"]["feed"]
+    if "brake" in s["crossings"]:  # a descending crossing in a hold's brake (its angle a turn back, < 0)
+        braking = q["die_down_angle"] < 0
+        (thb, omb), _, span_brake = s["crossings"]["brake"]
+        thd, omd = ca.if_else(braking, thb, thd), ca.if_else(braking, omb, omd)
+        span_down = ca.if_else(braking, span_brake, span_down)
     rows.add("key points in order", ca.vertcat(span_up - t_up, span_down - t_down), 0.0, np.inf, "key_points")
     crossing = ca.vertcat(
         q["die_up_active"] * (thu - q["die_up_angle"]),
@@ -246,6 +276,16 @@ def _all_samples(s: dict[str, Any], q: dict, w2: ca.MX, drive: bool) -> tuple[tu
         states = (ca.vertcat(th, th_d), ca.vertcat(om, om_d), ca.vertcat(al, al_d))
         t_all = ca.vertcat(t_all, s["t_end"] + since)
     return states, t_all, count, om
+
+
+def _moving_speeds(s: dict[str, Any], speeds: ca.MX) -> ca.MX:
+    """The free profile's sample ``speeds`` where the least crank speed holds: all but, with a hold, the stop's
+    (the brake, the standstill and the return, which rises from rest)."""
+    if not holds(s["phases"]):
+        return speeds
+    stopped = (*REST_PHASES, "return")
+    kept = [sm[1] for sm, (phase, _) in zip(s["samples"], s["phases"], strict=True) if phase not in stopped]
+    return ca.vertcat(*kept)
 
 
 def _free_draw_forming(theta: ca.MX, count: int, layout: ParameterLayout, p_case: ca.MX, q: dict) -> ca.MX:
@@ -292,7 +332,7 @@ def _build(
     # MX with vector operations (every segment of a phase at once): CasADi derives the Jacobian and the
     # Hessian of this graph in a fraction of the time a scalar SX graph of the same problem takes, and
     # evaluates them about as fast
-    layout = ParameterLayout(formula, limit_ids, drive, False, links if drive else ())
+    layout = ParameterLayout(formula, limit_ids, drive, False, links if drive else (), hold=holds(phases))
     robots = "robots" in limit_ids
     variables, index = variables_of(phases, robots), index_of(phases, robots)
     x = ca.MX.sym("x", len(variables))
@@ -316,11 +356,11 @@ def _build(
         **samples,
         **_robot_terms(shot, period, w2, physical, robots, layout, q),
         period=period,
-        window_time=phases[1][1] * v["transfer_step"],
+        window_time=dict(phases)["transfer"] * v["transfer_step"],
         speeds=Extremes(speeds, signed=False, sampled=True),
         accelerations=Extremes(ca.vertcat(*shot["knot_accels"]), signed=True),
         jerks=None,  # the bounds of the segments' jerks
-        lowest_speeds=speeds,
+        lowest_speeds=_moving_speeds(shot, speeds),
         crossings=[(omu, q["die_up_slope"]), (omd, q["die_down_slope"])],
         zone=True,
         rate=False,
@@ -331,8 +371,9 @@ def _build(
 
     problem = {"x": x, "p": ca.vertcat(p_case, p_scale), "f": nlp.period, "g": ca.vertcat(*rows.g)}
     options = {**CYCLE_OPTIONS, **DRIVE_OPTIONS}  # MUMPS's AMD ordering: the same iterations, 5-10 % faster here
-    fine = phases not in (PHASES, FREE_DRAW)
+    fine = phases not in (PHASES, FREE_DRAW, first_layout(False, True), first_layout(True, True))
     name = "press_cycle_optimal" + ("_fine" if fine else "") + ("_slide" if free else "") + ("_drive" if drive else "")
+    name += "_hold" if holds(phases) else ""
     program = NLPSolver(name, problem, options, None, WARM_OPTIONS, lift)
     return CycleNLP(
         program,
@@ -354,7 +395,7 @@ def complete_robots(phases: Layout, values: dict[str, float]) -> dict[str, float
     if "unloader_start" in values:
         return values
     steps = dict(phases)
-    t4 = values["return_step"] * steps["return"]
+    t4 = sum(values[f"{phase}_step"] * steps[phase] for phase in (*REST_PHASES, "return") if phase in steps)
     t1 = t4 + values["transfer_step"] * steps["transfer"]
     return {**values, "unloader_start": t4, "loader_start": 0.5 * (t4 + t1)}
 
@@ -378,9 +419,10 @@ def free_nlp(
     return _build(formula, limit_ids, drive, links, phases)
 
 
-def free_nlp_for(case: Case, phases: Layout = PHASES, drive: bool = True) -> CycleNLP:
-    """The optimal law's NLP of ``case``'s mechanism and limits, with the motor's rows when it has a drive (and
-    ``drive``)."""
+def free_nlp_for(case: Case, phases: Layout | None = None, drive: bool = True) -> CycleNLP:
+    """The optimal law's NLP of ``case``'s mechanism and limits on the phases' ``layout`` (the case's first by
+    default), with the motor's rows when it has a drive (and ``drive``)."""
+    phases = phases or first_layout(case.free_draw, case.hold_angle is not None)
     drive = drive and case.drive is not None
     links = drive_links(case) if drive else ()
     return free_nlp(case.machine.formula, nlp_limits(case, drive), drive, links, phases)

@@ -21,7 +21,8 @@ from __future__ import annotations
 import numpy as np
 
 from planning.model.case import RPM, Case
-from planning.model.free_profile import PHASES, Layout, draws_freely, finer, first_layout
+from planning.model.cycle import HOLD_SEGMENT
+from planning.model.free_profile import PHASES, STAND_PHASE, Layout, draws_freely, finer, first_layout, holds
 from planning.model.laws.optimal import OptimalLaw
 from planning.model.limits import Draw, draw_speed_bounds
 from planning.model.plan import Plan
@@ -29,6 +30,7 @@ from planning.solver.free_nlp import free_nlp_for
 from planning.solver.max_spm import converged_plan, solve_max_spm
 from planning.solver.neighbour import can_answer, can_start, known_evaluation, plan_of
 from planning.solver.outcomes import Infeasible
+from planning.solver.parameters import structure_values
 from planning.solver.search import Search, prepare
 from planning.solver.solution import Solution
 from planning.solver.verify import evaluate
@@ -38,15 +40,20 @@ SEED_LAW = "seven-segment"  # a jerk-limited law whose plan starts the NLP
 FINE_JERK_SHARE = 0.5  # a plan using less than this share of the jerk limit is solved again on the finer layout
 
 
-def seed_values(seed: Plan, phases: Layout = PHASES) -> dict[str, float]:
+def seed_values(seed: Plan, phases: Layout = PHASES, case: Case | None = None) -> dict[str, float]:
     """A plan of another law (or an optimal plan on another layout) as the optimal NLP's values on the
     phases' ``layout``: its profile sampled on each phase's uniform grid between the key points, the jerk of
-    each segment from the change of acceleration across it; the robots' starts as they were."""
+    each segment from the change of acceleration across it; the robots' starts as they were. With a hold
+    (``case``'s, needed then) the brake, the standstill and the return from rest from the seed's own."""
     prof, period = seed.profile, seed.period
     t1, t2, t3, t4 = (float(t) for t in seed.key_times())
     spans = {"return": (t3, t4), "transfer": (t4, t1 + period), "feed": (t1 + period, t2 + period)}
     spans["draw"] = (t2 + period, t3 + period)  # a free draw's phase (a draw at constant slide speed)
     values = {"draw_speed": float(seed.parameters.draw_speed), "die_up_time": seed.nlp_values["die_up_time"]}
+    if holds(phases):  # the brake, the standstill, then the return from rest (its die crossing counted from there)
+        stands, stood = _standstill(seed)
+        spans |= {"brake": (t3, stands), "stand": (stands, stood), "return": (stood, t4)}
+        values["die_up_time"] = _rising_through_die(seed, case, stood, t4)
     if draws_freely(phases):  # the speed at theta3 and the acceleration there
         values["draw_speed"], values["draw_accel"] = (float(x) for x in prof.at_time(t3)[1:3])
     if seed.motion_law == OptimalLaw.name:  # the descending crossing's time counts from theta1 already
@@ -70,6 +77,23 @@ def seed_values(seed: Plan, phases: Layout = PHASES) -> dict[str, float]:
         if name in seed.nlp_values:
             values[name] = seed.nlp_values[name]
     return values
+
+
+def _standstill(plan: Plan) -> tuple[float, float]:
+    """``(start, end)`` [s] of a plan's hold standstill (a law's or the optimal law's segment)."""
+    names = [seg.name for seg in plan.profile.segments]
+    k = next(i for i, name in enumerate(names) if name in (HOLD_SEGMENT, f"{STAND_PHASE[0]}:1"))
+    return float(plan.profile.knot_times[k]), float(plan.profile.knot_times[k + 1])
+
+
+def _rising_through_die(plan: Plan, case: Case, start: float, end: float) -> float:
+    """[s] from ``start`` to where ``plan``'s slide rises through ``case``'s die height before ``end`` (0: it does
+    not, the crossing inactive)."""
+    up = structure_values(case)["die_up_angle"]
+    theta = plan.profile.at_time(np.array([start, end]))[0]
+    if not theta[0] < up < theta[1]:
+        return 0.0
+    return float(plan.profile.time_at_angle(up)) - start
 
 
 def seed_case(case: Case) -> Case:
@@ -100,16 +124,21 @@ def _layout_of(plan: Plan, case: Case) -> Layout:
     """The phases' layout of an optimal plan that draws as ``case`` does (freely or at a constant crank speed);
     else (a plan of another law, or of the other draw) ``case``'s first layout."""
     layout = getattr(plan.parameters, "layout", None) if plan.motion_law == OptimalLaw.name else None
-    if layout is None or draws_freely(layout) != case.free_draw:
-        return first_layout(case.free_draw)
+    if layout is None or draws_freely(layout) != case.free_draw or holds(layout) != (case.hold_angle is not None):
+        return _first(case)
     return layout
+
+
+def _first(case: Case) -> Layout:
+    """The first layout of ``case``: its draw free or not, with or without a hold."""
+    return first_layout(case.free_draw, case.hold_angle is not None)
 
 
 def _search(case: Case, phases: Layout | None = None, drive: bool = True) -> Search:
     """The optimal law's search on the phases' ``layout`` (the case's first by default): prechecks, parameters,
     bounds, scales; the minimum crank speed backed off. ``drive`` False: the NLP without the motor's rows (its
     plans verified against the whole case, motor included)."""
-    search = prepare(case, "free", free_nlp_for(case, phases or first_layout(case.free_draw), drive))
+    search = prepare(case, "free", free_nlp_for(case, phases or _first(case), drive))
     search.parameters = search.parameters.copy()
     search.parameters[search.parameter("min_crank_speed")] *= 1 + MIN_SPEED_BACKOFF
     return search
@@ -119,7 +148,8 @@ def _from(search: Search, neighbour: Plan | Solution) -> bool:
     """A neighbouring case's optimal plan: a candidate when it answers this case and holds here, and a start
     (``planning.solver.neighbour``); whether either verified."""
     case, plan = search.case, plan_of(neighbour)
-    same_draw = draws_freely(getattr(plan.parameters, "layout", PHASES)) == case.free_draw
+    layout = getattr(plan.parameters, "layout", PHASES)
+    same_draw = draws_freely(layout) == case.free_draw and holds(layout) == (case.hold_angle is not None)
     if not can_start(plan, case, "free") or not same_draw:
         return False
     if can_answer(plan, case, "free", search.draw_speed_range):
@@ -158,7 +188,7 @@ def solve_optimal(case: Case, neighbour: Plan | Solution | None = None) -> Solut
     seed = converged_plan(seeded) or solve_max_spm(seeded, "free").plan
     search.iterations += seed.solver.iterations
     search.starts += seed.solver.starts
-    start = seed_values(seed, first_layout(case.free_draw))
+    start = seed_values(seed, _first(case), case)
     starts = [start] + (_kinematic_candidate(search, start) if case.drive is not None and case.free_draw else [])
     for values in starts:  # each start runs (the better verified plan kept)
         search.multi_start([values], "free", confirm=False)
@@ -191,7 +221,7 @@ def _on_the_finer_layout(case: Case, search: Search) -> Solution:
     the jerk limit (the layout held it back, not the limit), the faster of it and the finer layout's plan
     started from it."""
     answer = search.answer()
-    fine_layout = finer(first_layout(case.free_draw))
+    fine_layout = finer(_first(case))
     used = answer.plan.parameters.peak_jerks()[0]
     if _layout_of(answer.plan, case) == fine_layout or used >= FINE_JERK_SHARE * case.limits.crank_jerk_rad_s3:
         return answer
@@ -206,5 +236,5 @@ def on_layout(case: Case, answer: Solution, layout: Layout, search: Search | Non
     fine.consider(answer, answer.plan.period)
     if search is not None:
         fine.iterations, fine.starts, fine.t_start = search.iterations, search.starts, search.t_start
-    fine.multi_start([seed_values(answer.plan, layout)], "free", confirm=False)
+    fine.multi_start([seed_values(answer.plan, layout, case)], "free", confirm=False)
     return fine.answer()

@@ -54,6 +54,8 @@ def least_rate(case: Any) -> float:
     """The least peak acceleration of a half of ``case``'s law in units of ``|dv| / D``: at its fixed shape
     parameter, else over :data:`RATE_GRID` values of the parameter's range."""
     law = LAWS[case.planner.motion_law]
+    if not hasattr(law, "peak_rate"):  # the optimal law brakes in any shape: at least w^2 / (2 D), rate 1
+        return 1.0
     if law.parameter is None:
         return float(law.peak_rate())
     fixed = case.planner.law_parameter
