@@ -91,6 +91,12 @@ IPOPT_TOL = 1e-10  # IPOPT's overall tolerance (scaled): far below the verificat
 IPOPT_CONSTR_VIOL_TOL = 1e-10  # IPOPT's constraint violation (rows scaled to 1 at their limits)
 IPOPT_RATE_TOL = 1e-6  # the rate NLPs' tolerance: their objective (heat, energy) is flat at the optimum; the
 # limits still hold to IPOPT_CONSTR_VIOL_TOL
+IPOPT_FREE_RATE_ACCEPTABLE = 1e-3  # the optimal law's rate NLP stops at IPOPT's "acceptable" level: its scaled
+# optimality error this low (the free profile's rounded torque kinks leave a dual residual near 1e-4 that IPOPT's
+# line search cycles on for hundreds of iterations, the objective fixed to 1e-7) ...
+IPOPT_FREE_RATE_OBJ_CHANGE = 1e-6  # ... while the objective (normalised to 1 at the baseline) moves less than
+# this from one iteration to the next (the millionth the rate NLPs want) ...
+IPOPT_FREE_RATE_COMPL = 1e-4  # ... and the complementarity is this low; the rows still hold to IPOPT_CONSTR_VIOL_TOL
 IPOPT_MU_INIT = 1e-6  # a warm start's barrier parameter: the start is near the optimum
 IPOPT_FREE_WARM_MU_INIT = 1e-8  # the optimal law's warm start (hundreds of variables near their bounds)
 IPOPT_WARM_PUSH = 1e-9  # a warm start's bound pushes (bound, multiplier, slack): stay where the start is

@@ -455,3 +455,28 @@ def test_an_asymmetric_pendulum_press_in_the_shipped_line_serves_its_robots_ever
     assert own["unloader"]["at theta_s"] - own["unloader"]["at theta_e"] == pytest.approx(result["period_s"], abs=1e-9)
     clearance, gap, both = _replay(result, tmp_path, SHIPPED)
     assert clearance >= -REPLAY_TOL_MM and gap >= -REPLAY_TOL_S and not both
+
+
+@pytest.mark.slow  # the optimal law with robots, alone and at the line's period: about 2 minutes
+def test_a_press_drawing_at_a_slide_speed_keeps_it_at_the_lines_period(tmp_path: Path) -> None:
+    """The slow line with its first press drawing at 60 mm/s slide speed (the optimal law): verified at the
+    robot's loop, the replay holding every clearance, and the slide, by the closed form from the written crank
+    angle, never faster than 60 mm/s in the draw and at it (within 0.1 %) over a third of the draw's samples."""
+    sets = [
+        "first.planner.motion_law=optimal",
+        "first.limits.crank_jerk_rad_s3=3000",
+        "first.limits.crank_accel_rad_s2=60",
+        "first.process.draw_slide_speed_mm_s=60",
+    ]
+    result = _run(DATA / "slow.yaml", tmp_path, *[a for s in sets for a in ("--set", s)])
+    assert result["status"] == "verified" and result["bottleneck"]["kind"] == "robot"
+    clearance, gap, both = _replay(result, tmp_path, DATA / "slow.yaml")
+    assert clearance >= -REPLAY_TOL_MM and gap >= -REPLAY_TOL_S and not both
+    table = np.genfromtxt(tmp_path / "line_trajectory.csv", delimiter=",", names=True)
+    theta = np.radians(table["first_crank_angle_deg"])
+    R, L = 50.0, 250.0  # tests/data/line/press_a.yaml
+    h = R * (1 + np.cos(theta)) + L - np.sqrt(L**2 - (R * np.sin(theta)) ** 2)
+    speed = np.abs(np.gradient(h, table["time_s"]))
+    drawing = (np.degrees(theta) > 145.5) & (np.degrees(theta) < 184.5)  # theta2 .. theta3, the ends left out
+    assert np.max(speed[drawing]) <= 60.0 * (1 + 1e-3)  # (finite differences of the 1 ms grid)
+    assert np.mean(np.abs(speed[drawing] - 60.0) <= 0.06) > 1 / 3

@@ -1037,6 +1037,9 @@ def _objective_checks(case: Case) -> None:
             f"the {planner.motion_law} law plans for the most strokes only (max-spm); choose a law with halves",
             planner.objective,
         )
+    if planner.objective == "min-grid-peak" and LAWS[planner.motion_law].transcription != HALVES:
+        reason = "the optimal law plans min-rms-torque and min-energy at a rate, not yet the least grid peak"
+        raise CaseError("planner.objective", reason, planner.objective)
 
 
 def _machine(press: PressModel) -> Mechanism:

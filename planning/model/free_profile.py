@@ -150,6 +150,11 @@ class FreeProfileParameters:
         return self.hold_angle is not None
 
     @property
+    def window_time(self) -> float:
+        """[s] the robot's window phase, theta4 -> theta1 (at a line's rate the spare time goes there)."""
+        return float(sum(T for T, name in zip(self.durations, self._phase_names(), strict=True) if name == "transfer"))
+
+    @property
     def brake_duration(self) -> float:
         """[s] the brake from theta3 to the hold (0 without one)."""
         return float(sum(T for T, name in zip(self.durations, self._phase_names(), strict=True) if name == "brake"))

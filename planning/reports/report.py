@@ -500,12 +500,13 @@ def _objective_lines(r: dict[str, Any]) -> list[str]:
     if not r.get("baseline"):
         return []
     b, saving, d = r["baseline"], r["saving_pct"], r["drive"]
+    where = "robot's window" if r.get("motion_law") == "optimal" else "transfer dwell"  # (the optimal law: no dwell)
     return [
         "",
         f"  objective {r['objective']} at {r['target_spm']:g} strokes/min (the limits allow up to "
         f"{r['fastest_spm']:.3f}): RMS motor torque {d['rms_motor_torque_Nm'] / 1e3:.2f} kN m, "
         f"energy from the supply {r['energy_kJ']:.1f} kJ per stroke ({ENERGY_AT[r['energy_at']]})",
-        f"  baseline (max-SPM plan, spare time in the transfer dwell; window {b['transfer_window_s']:.3f} s): "
+        f"  baseline (max-SPM plan, spare time in the {where}; window {b['transfer_window_s']:.3f} s): "
         f"RMS {b['rms_motor_torque_Nm'] / 1e3:.2f} kN m, energy {b['energy_kJ']:.1f} kJ; "
         f"saving {saving['rms_torque']:.1f} % "
         f"RMS torque, {saving['energy']:.1f} % energy"

@@ -47,12 +47,14 @@ from planning.solver.ipopt import NLPSolver
 from planning.solver.nlp import (
     CYCLE_OPTIONS,
     DRIVE_OPTIONS,
+    RATE_OPTIONS,
     CycleNLP,
     Rows,
     add_limit_rows,
     clipped_advance,
     draw_states,
     nlp_limits,
+    objective_terms,
     sample_states,
 )
 from planning.solver.parameters import (
@@ -62,7 +64,13 @@ from planning.solver.parameters import (
     drive_links,
     time_limit,
 )
-from planning.tolerances import IPOPT_FREE_WARM_MU_INIT
+from planning.tolerances import (
+    IPOPT_CONSTR_VIOL_TOL,
+    IPOPT_FREE_RATE_ACCEPTABLE,
+    IPOPT_FREE_RATE_COMPL,
+    IPOPT_FREE_RATE_OBJ_CHANGE,
+    IPOPT_FREE_WARM_MU_INIT,
+)
 from press.mechanism import Formula
 
 # the limits are held at every knot and at evenly spaced points inside each segment, this many per
@@ -71,6 +79,20 @@ from press.mechanism import Formula
 SAMPLES_PER_SEGMENT = {"return": 4, "transfer": 8, "feed": 4, "draw": 8, "brake": 4, "stand": 2}
 STATES = ("angle", "speed", "accel")
 TOP_SPEED = 1e3  # [rad/s] upper bound of the crank speeds (far above any press)
+# at a rate: the rate NLPs' tolerance, and IPOPT's acceptable level where its line search cycles near the
+# optimum (planning.tolerances: IPOPT_FREE_RATE_ACCEPTABLE)
+FREE_RATE_OPTIONS = {
+    **RATE_OPTIONS,
+    "ipopt.acceptable_tol": IPOPT_FREE_RATE_ACCEPTABLE,
+    "ipopt.acceptable_iter": 10,
+    "ipopt.acceptable_obj_change_tol": IPOPT_FREE_RATE_OBJ_CHANGE,
+    "ipopt.acceptable_compl_inf_tol": IPOPT_FREE_RATE_COMPL,
+    "ipopt.acceptable_constr_viol_tol": IPOPT_CONSTR_VIOL_TOL,
+}
+# with robots the rows tie every segment of the profile together (the slide's height at a robot's time sums them):
+# its exact Hessian is dense over them, about 0.1 s an iteration, 6-20 s an IPOPT call alone on 2 cores and twice
+# that beside another solve; its calls may take this long [s] (the wrapper's guard is for calls of under a second)
+ROBOTS_WALL_S = 150.0
 # a re-solve with a refined limit starts nearer the optimum than the laws' (about half the iterations
 # with this barrier parameter; the laws keep the wrapper's, which finds their optima as before)
 WARM_OPTIONS = {"ipopt.mu_init": IPOPT_FREE_WARM_MU_INIT}
@@ -326,13 +348,37 @@ def _robot_terms(
     return {"height_at": height_at, "robot_starts": starts, "draw_start_time": shot["t_draw_start"]}
 
 
+def _objective(  # noqa: ANN202 - an MX expression
+    q: dict, times_s: tuple[ca.MX, ca.MX, ca.MX], torque: Any, states: tuple, times: ca.MX, rate: bool
+):
+    """The cycle time; at a rate (its ``target_period`` held by the cycle-time row) the weighted period, the
+    motor's heat and supply energy (with a drive; ``planning.solver.nlp.objective_terms``, the losses' terms
+    exact where the case gives none: ``k = 0``, ``eta_c = 1``), the draw's time (a draw at constant slide speed
+    first: the slide at its set speed wherever the crank allows, as at the most strokes) and, subtracted, the
+    robot's window's time (the optimal law's analogue of a law's transfer dwell: a press run slower spends its
+    spare time there). ``times_s``: the period, the window's and the draw's time."""
+    period, window_time, draw_time = times_s
+    if not rate:
+        return period
+    objective = q["weight_period"] * period - q["weight_dwell"] * window_time + q["weight_draw"] * draw_time
+    if torque is not None:
+        heat, energy = objective_terms(q, torque, states[2], times, losses=True)
+        objective = objective + q["weight_heat"] * heat + q["weight_energy"] * energy
+    return objective
+
+
 def _build(
-    formula: Formula, limit_ids: tuple[str, ...], drive: bool, links: tuple[str, ...] = (), phases: Layout = PHASES
+    formula: Formula,
+    limit_ids: tuple[str, ...],
+    drive: bool,
+    links: tuple[str, ...] = (),
+    phases: Layout = PHASES,
+    rate: bool = False,
 ) -> CycleNLP:
     # MX with vector operations (every segment of a phase at once): CasADi derives the Jacobian and the
     # Hessian of this graph in a fraction of the time a scalar SX graph of the same problem takes, and
     # evaluates them about as fast
-    layout = ParameterLayout(formula, limit_ids, drive, False, links if drive else (), hold=holds(phases))
+    layout = ParameterLayout(formula, limit_ids, drive, rate, links if drive else (), hold=holds(phases))
     robots = "robots" in limit_ids
     variables, index = variables_of(phases, robots), index_of(phases, robots)
     x = ca.MX.sym("x", len(variables))
@@ -350,30 +396,35 @@ def _build(
     free = draws_freely(phases)  # the draw a phase (sampled: its samples the last) or at the constant w2
     free_count = dict(phases).get("draw", 0) * SAMPLES_PER_SEGMENT["draw"] + int(free)  # a free draw's, and its end
     forming = _free_draw_forming(states[0], free_count, layout, p_case, q) if free and drive else None
-    samples, _, lift = sample_states(formula, layout, q, p_case, states, t_all, count, forming)
+    samples, torque, lift = sample_states(formula, layout, q, p_case, states, t_all, count, forming)
     period = shot["t_end"] if free else shot["t_end"] + (q["theta3"] - q["theta2"]) / w2
+    window_time = dict(phases)["transfer"] * v["transfer_step"]
     nlp = Transcription(
         **samples,
         **_robot_terms(shot, period, w2, physical, robots, layout, q),
         period=period,
-        window_time=dict(phases)["transfer"] * v["transfer_step"],
+        window_time=window_time,
         speeds=Extremes(speeds, signed=False, sampled=True),
         accelerations=Extremes(ca.vertcat(*shot["knot_accels"]), signed=True),
         jerks=None,  # the bounds of the segments' jerks
         lowest_speeds=_moving_speeds(shot, speeds),
         crossings=[(omu, q["die_up_slope"]), (omd, q["die_down_slope"])],
         zone=True,
-        rate=False,
+        rate=rate,
         free_draw_count=free_count,
         speed_unit=unit["draw_speed"],
     )
     refinable = add_limit_rows(rows, nlp, layout)
 
-    problem = {"x": x, "p": ca.vertcat(p_case, p_scale), "f": nlp.period, "g": ca.vertcat(*rows.g)}
+    draw_time = period - shot["t_draw_start"]  # from theta2 to theta3 (a free draw's phase or at w2)
+    objective = _objective(q, (period, window_time, draw_time), torque, states, t_all, rate)
+    problem = {"x": x, "p": ca.vertcat(p_case, p_scale), "f": objective, "g": ca.vertcat(*rows.g)}
     options = {**CYCLE_OPTIONS, **DRIVE_OPTIONS}  # MUMPS's AMD ordering: the same iterations, 5-10 % faster here
+    options |= FREE_RATE_OPTIONS if rate else {}
+    options |= {"ipopt.max_wall_time": ROBOTS_WALL_S} if robots else {}
     fine = phases not in (PHASES, FREE_DRAW, first_layout(False, True), first_layout(True, True))
     name = "press_cycle_optimal" + ("_fine" if fine else "") + ("_slide" if free else "") + ("_drive" if drive else "")
-    name += "_hold" if holds(phases) else ""
+    name += ("_hold" if holds(phases) else "") + ("_rate" if rate else "")
     program = NLPSolver(name, problem, options, None, WARM_OPTIONS, lift)
     return CycleNLP(
         program,
@@ -412,17 +463,19 @@ def free_nlp(
     drive: bool = False,
     links: tuple[str, ...] = (),
     phases: Layout = PHASES,
+    rate: bool = False,
 ) -> CycleNLP:
     """The compiled NLP of the optimal law for a mechanism's ``formula`` and the limits ``limit_ids``, with
-    the motor's torque when ``drive`` (the mechanism's massive ``links`` in it), on the phases' ``layout``;
-    built on first use in a process, then reused."""
-    return _build(formula, limit_ids, drive, links, phases)
+    the motor's torque when ``drive`` (the mechanism's massive ``links`` in it), on the phases' ``layout``, at a
+    ``rate`` (:func:`_objective`); built on first use in a process, then reused."""
+    return _build(formula, limit_ids, drive, links, phases, rate)
 
 
-def free_nlp_for(case: Case, phases: Layout | None = None, drive: bool = True) -> CycleNLP:
+def free_nlp_for(case: Case, phases: Layout | None = None, drive: bool = True, rate: bool = False) -> CycleNLP:
     """The optimal law's NLP of ``case``'s mechanism and limits on the phases' ``layout`` (the case's first by
-    default), with the motor's rows when it has a drive (and ``drive``)."""
+    default), with the motor's rows when it has a drive (and ``drive``), at a ``rate`` (its cycle time held by a
+    search with ``fixed_period``, the objective's weights its parameters)."""
     phases = phases or first_layout(case.free_draw, case.hold_angle is not None)
     drive = drive and case.drive is not None
     links = drive_links(case) if drive else ()
-    return free_nlp(case.machine.formula, nlp_limits(case, drive), drive, links, phases)
+    return free_nlp(case.machine.formula, nlp_limits(case, drive), drive, links, phases, rate)

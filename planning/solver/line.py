@@ -19,8 +19,7 @@ from planning.model.limits.base import Check
 from planning.model.line import Line, LineRobot, Station, occupancy_s, phase_offsets_s, tool
 from planning.model.outcome import Outcome
 from planning.model.pendulum import STROKES_PER_CYCLE, PendulumPlan
-from planning.solver.max_spm import solve_max_spm
-from planning.solver.objectives import solve_at_period
+from planning.solver.objectives import solve_at_period, solve_fastest
 from planning.solver.outcomes import Infeasible, PlanningError
 from planning.solver.pendulum_line import fastest_swings, line_period_s, line_starts_s, shifts_s, swings_at_period
 from planning.solver.solution import Solution
@@ -174,7 +173,7 @@ def _alone(station: Station) -> Solution:
     key = case.model_dump_json()
     if key not in _ALONE:
         try:
-            solution = fastest_swings(case) if case.pendulum else solve_max_spm(case, case.planner.placement)
+            solution = fastest_swings(case) if case.pendulum else solve_fastest(case, case.planner.placement)
         except PlanningError as exc:
             raise StationError(station, exc, "alone") from None
         if len(_ALONE) >= ALONE_KEPT:

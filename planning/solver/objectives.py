@@ -36,10 +36,14 @@ import math
 from dataclasses import replace
 
 from planning.model.case import Case, Placement
+from planning.model.free_profile import FreeProfileParameters
+from planning.model.laws import FREE, get_law
 from planning.model.plan import Plan
-from planning.solver.halves_nlp import PEAK_VARIABLE, ROBOT_VARIABLES, VARIABLE_INDEX, VARIABLES, halves_nlp_for
+from planning.solver.free_nlp import free_nlp_for
+from planning.solver.halves_nlp import PEAK_VARIABLE, ROBOT_VARIABLES, VARIABLE_INDEX, halves_nlp_for
 from planning.solver.max_spm import solve_max_spm
 from planning.solver.neighbour import can_start
+from planning.solver.optimal import solve_optimal
 from planning.solver.outcomes import Infeasible, NoPlanFound, Unverified
 from planning.solver.search import Search, prepare
 from planning.solver.solution import AtRate, Solution, objective_value
@@ -50,6 +54,10 @@ from planning.tolerances import RATE_TOLERANCE, SAME_PERIOD_S
 HEAT_TIE_BREAK = 1e-3  # min-energy, min-grid-peak: the heat's weight against the objective's (both normalised)
 PEAK_START_HEADROOM = 1.05  # min-grid-peak: a start's bus peak this much above the slower starts' grid peak
 BASELINE_SCORE = 1.0  # the objective's score of the baseline (the objectives are normalised by its figures)
+# a draw at constant slide speed at a rate: the draw's time, relative to the baseline's, weighs this many times
+# the objective (1 at the baseline), so the slide keeps its set speed wherever the crank's limits allow (as at
+# the most strokes) and the heat or energy is saved elsewhere
+DRAW_FIRST = 100.0
 
 
 def solve_at_rate(
@@ -68,10 +76,10 @@ def solve_at_rate(
     ``confirm``: run the objective's starts until two agree on the optimum (else the first verified
     start is the answer: a trade-off's speed).
     """
-    placement = placement or case.planner.placement
+    placement = "free" if _free(case) else placement or case.planner.placement
     objective, target = case.planner.objective, case.planner.target_spm
     if fastest is None:
-        fastest = solve_max_spm(case.with_objective("max-spm"), placement)
+        fastest = solve_fastest(case.with_objective("max-spm"), placement)
     if case.electrical and fastest.drive.power is None:  # the max-SPM case leaves the grid out: its figures here
         fastest = replace(fastest, evaluation=evaluate(fastest.plan, case))
     check_reachable(target, fastest, case)
@@ -93,6 +101,8 @@ def solve_at_rate(
     else:  # the energy has flat directions (a plan's speeds can trade without changing it): the heat breaks ties
         search.parameters[search.parameter("weight_energy")] = 1.0 / (scale * 1e3)
         search.parameters[search.parameter("weight_heat")] = HEAT_TIE_BREAK * heat_weight
+    if case.free_draw:  # the slide at its set speed first: the draw's time weighed far above the objective
+        search.parameters[search.parameter("weight_draw")] = DRAW_FIRST / _draw_time_s(baseline.plan)
     search.score = lambda solution: objective_value(solution, objective) / scale
     search.consider(baseline, BASELINE_SCORE)
     starts = [_slowed(fastest.plan, period / fastest.plan.period, search), baseline.plan.nlp_values]
@@ -114,6 +124,23 @@ def solve_at_rate(
     return replace(answer, at_rate=AtRate(objective, target, fastest.plan.spm, baseline, improved))
 
 
+def _free(case: Case) -> bool:
+    """The case's law plans a free profile (the optimal law), in free placement."""
+    return get_law(case.planner.motion_law).transcription == FREE
+
+
+def solve_fastest(case: Case, placement: Placement) -> Solution:
+    """The case's max-SPM solution by its law's solve (the optimal law's in free placement)."""
+    return solve_optimal(case) if _free(case) else solve_max_spm(case, placement)
+
+
+def dwell_s(plan: Plan) -> float:
+    """[s] where a plan run slower spends its spare time: a law's constant-speed transfer dwell, the optimal
+    law's window phase (theta4 -> theta1)."""
+    p = plan.parameters
+    return p.window_time if isinstance(p, FreeProfileParameters) else float(p.transfer_dwell)
+
+
 def check_reachable(target: float, fastest: Solution, case: Case) -> None:
     """:class:`Infeasible` when the target rate is above what the limits allow, naming the ones that bind."""
     if target <= fastest.plan.spm * (1 + RATE_TOLERANCE):
@@ -133,7 +160,10 @@ def _rate_search(case: Case, placement: Placement, period: float, peak: bool = F
     """The rate NLP's search (``peak``: its peak variant) with the cycle time held at ``period`` [s] and every
     objective weight 0."""
     drive = case.drive is not None  # a kinematic case (a press in a line): its baseline only
-    search = prepare(case, placement, halves_nlp_for(case, drive=drive, rate=True, peak=peak))
+    if _free(case):  # the optimal law's free profile at the rate (min-grid-peak refused with it)
+        search = prepare(case, "free", free_nlp_for(case, drive=drive, rate=True))
+    else:
+        search = prepare(case, placement, halves_nlp_for(case, drive=drive, rate=True, peak=peak))
     search.parameters = search.parameters.copy()
     search.parameters[search.parameter("target_period")] = period
     search.parameters[search.parameter("weight_period")] = 0.0
@@ -149,12 +179,13 @@ def solve_at_period(case: Case, period_s: float, fastest: Solution | None = None
     ``fastest``: the case's max-SPM solution when the caller has it. :class:`Infeasible` for a period
     shorter than the fastest plan's."""
     case = case.with_objective("max-spm")
-    placement = case.planner.placement
+    placement = "free" if _free(case) else case.planner.placement
     if fastest is None:
-        fastest = solve_max_spm(case, placement)
+        fastest = solve_fastest(case, placement)
     check_reachable(60.0 / period_s, fastest, case)
     at_rate = case.with_objective(None, 60.0 / period_s)
-    guesses = guesses_at_period(case, fastest.plan.nlp_values["draw_speed"], period_s)
+    draw_speed = fastest.plan.nlp_values["draw_speed"]
+    guesses = [] if _free(case) else guesses_at_period(case, draw_speed, period_s)
     try:
         return _baseline(at_rate, placement, fastest, period_s, None, True)
     except (NoPlanFound, Unverified):  # far slower than the fastest: starts built for the period (draw speed kept)
@@ -172,7 +203,7 @@ def _at_period_feasible(
     problem, every weight 0), from the slowed fastest plan and the period's guesses; of those verified, the
     longest transfer dwell."""
     search = _rate_search(case, placement, period)
-    search.score = lambda solution: -float(solution.plan.parameters.transfer_dwell) / period
+    search.score = lambda solution: -dwell_s(solution.plan) / period
     starts = [_slowed(fastest.plan, period / fastest.plan.period, search), *guesses]
     _run_starts(search, starts, None, placement, True)
     try:
@@ -197,9 +228,8 @@ def _baseline(
     if abs(fastest.plan.period - period) <= SAME_PERIOD_S:
         return fastest
     search = _rate_search(case, placement, period)
-    time_unit = search.scale[VARIABLE_INDEX["transfer_dwell"]]
-    search.parameters[search.parameter("weight_dwell")] = 1.0 / time_unit
-    search.score = lambda solution: -float(solution.plan.parameters.transfer_dwell) / period
+    search.parameters[search.parameter("weight_dwell")] = 1.0 / _dwell_unit(search)
+    search.score = lambda solution: -dwell_s(solution.plan) / period
     starts = [_slowed(fastest.plan, period / fastest.plan.period, search)] if slowed else []
     starts += list(more_starts)
     _run_starts(search, starts, neighbour, placement, confirm)
@@ -209,18 +239,36 @@ def _baseline(
         raise NoPlanFound(f"no baseline at {60 / period:.4g} strokes/min: {exc.reason}", exc.attempts) from None
 
 
+def _draw_time_s(plan: Plan) -> float:
+    """[s] a plan's draw, theta2 -> theta3."""
+    t2, t3 = plan.key_times()[1:3]
+    return float((t3 - t2) % plan.period)
+
+
+def _dwell_unit(search: Search) -> float:
+    """[s] the scale of the dwell the baseline lengthens: a law's dwell variable's, the optimal law's window
+    phase's (its step's scale times its segments)."""
+    if not _free(search.case):
+        return float(search.scale[VARIABLE_INDEX["transfer_dwell"]])
+    names = [name for name, _ in search.nlp.variables]
+    segments = sum(1 for name in names if name.startswith("transfer_jerk_"))
+    return float(search.scale[names.index("transfer_step")]) * segments
+
+
+SLOWED_POWER = {"speed": -1, "half": 1, "time": 1, "step": 1, "accel": -2, "jerk": -3}  # a kind's time power
+
+
 def _slowed(plan: Plan, factor: float, search: Search) -> dict[str, float]:
     """``plan``'s NLP values run ``factor`` times slower: every angle, so every key point and the cycle's
-    closure, stays where it was (a start; speeds held within their bounds, the draw's in particular); the
-    robots' starts, where it has robots, at the same angles too (their times ``factor`` times later)."""
+    closure, stays where it was (a start; values held within their bounds, the draw speed's in particular); the
+    robots' starts, where it has robots, at the same angles too (their times ``factor`` times later). Each value
+    scales by ``factor`` to the power of its kind's time (:data:`SLOWED_POWER`: a speed's -1, a time's 1, an
+    acceleration's -2, a jerk's -3)."""
     values = {name: plan.nlp_values[name] * factor for name, _ in ROBOT_VARIABLES if name in plan.nlp_values}
-    for name, j in VARIABLE_INDEX.items():
-        kind = VARIABLES[j][1]
-        value = plan.nlp_values[name]
-        if kind == "speed":
-            value /= factor
-        elif kind in ("half", "time"):
-            value *= factor
+    for j, (name, kind) in enumerate(search.nlp.variables):
+        if name not in plan.nlp_values:
+            continue
+        value = plan.nlp_values[name] * factor ** SLOWED_POWER.get(kind, 0)
         values[name] = float(min(max(value, search.lbx[j]), search.ubx[j]))
     return values
 

@@ -62,6 +62,7 @@ OBJECTIVE = (
     "weight_peak",  # [1/W] the bus power's peak (the rate NLP's peak variant)
     "copper_coefficient",  # [W/(N m)^2] copper loss = k T_m^2 (drive.motor.copper_loss_at_rated_kW / rated^2)
     "converter_efficiency",  # eta_c, the bus power's P_el / eta_c
+    "weight_draw",  # [1/s] the draw's time (the optimal law's free draw at a rate: the slide at its set speed first)
 )
 # the die exit (a halves NLP's denser variant): where the draw ends with the slide below the die height, the
 # die speed is held at fixed crank angles from theta3 to the die-height crossing (smooth rows, exact there)
@@ -264,6 +265,7 @@ def objective_values(case: Case) -> dict[str, float]:
         "weight_peak": 0.0,
         "copper_coefficient": motor.copper_loss_at_rated_kW * 1e3 / motor.rated_torque_Nm**2,
         "converter_efficiency": case.drive.converter_efficiency,
+        "weight_draw": 0.0,
     }
 
 
