@@ -556,6 +556,11 @@ def _compare(case, args) -> int:
         raise CommandError(f"{args.case}: published.solution: the case has no published solution to compare")
     if case.robots is not None:  # the published solution is the one-height model's (its transfer time)
         raise CommandError(f"{args.case}: robots: the published solution has one safety height and one transfer time")
+    if case.free_draw:  # the published solution's draw is at one crank speed, under the improved S-curve
+        raise CommandError(
+            f"{args.case}: process.draw_slide_speed_mm_s: the published solution draws at a constant crank speed "
+            "(process.draw_speed_rpm); compare takes a case that draws as it does"
+        )
     # the paper's notation describes its own law: compare under the improved S-curve
     case = case.with_law(ImprovedSCurve.name)
     out = _output_folder(case, args, COMPARE_FILES)

@@ -317,3 +317,21 @@ def test_at_a_rate_the_slide_keeps_its_set_speed_and_the_motor_saves(tmp_path):
 def _fastest_result(case, tmp_path):  # noqa: ANN001, ANN202
     assert main(["solve", str(case), "--out", str(tmp_path / "fastest"), "--no-plots"]) == 0
     return tmp_path / "fastest" / "result.json"
+
+
+def test_compare_of_a_slide_speed_draw_says_the_paper_draws_at_a_crank_speed(tmp_path, capsys):
+    """``compare`` sets the paper's plan beside ours: its draw is at one crank speed, so a case drawing at a slide
+    speed is refused in one line naming the field (exit 2), nothing written."""
+    import yaml
+
+    data = yaml.safe_load((ROOT / "cases" / "wang2023-side-panel.yaml").read_text())
+    data["process"].pop("draw_speed_rpm")
+    data["process"]["draw_slide_speed_mm_s"] = 150
+    data["planner"] = {"motion_law": "optimal"}
+    data["limits"]["crank_jerk_rad_s3"] = 20
+    path = tmp_path / "slide.yaml"
+    path.write_text(yaml.safe_dump(data))
+    assert main(["compare", str(path), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"pressplan: {path}: process.draw_slide_speed_mm_s: the published solution draws at")
+    assert len(err.splitlines()) == 1 and not (tmp_path / "out").exists()

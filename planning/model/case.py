@@ -958,11 +958,6 @@ PENDULUM_NOT_WITH = (  # what a pendulum stroke does not plan with yet: (field, 
         "the paper's structure is a rotary cycle's",
     ),
     (
-        "planner.objective",
-        lambda c: c.planner.objective if c.planner.objective == "min-grid-peak" else None,
-        "the least grid peak is not planned for swings yet; a grid peak limit without a storage is",
-    ),
-    (
         "process.transfer_time_s",
         lambda c: t if (t := c.process.transfer_time_s) is not None and t > MAX_HOLD_S else None,
         f"at most {MAX_HOLD_S:g} s: the swings stand at the turns, a cycle's times within the plan's precision",

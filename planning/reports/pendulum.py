@@ -17,7 +17,7 @@ from planning.reports.folder import write_json, write_table
 from planning.reports.report import MAX_ROWS, columns_at, drive_block, trajectory_columns
 from planning.reports.robots import robot_lines, robots_block
 from planning.solver.pendulum import PendulumSolution
-from planning.solver.solution import ENERGY
+from planning.solver.solution import ENERGY, GRID_PEAK
 
 KEY_NAMES = ("closing", "draw_start", "draw_end", "opening")
 PENDULUM_FILES = (  # what a pendulum solve owns
@@ -106,9 +106,10 @@ def _hold(case: Case) -> dict[str, Any]:
 
 def _at_rate(solution: PendulumSolution) -> dict[str, Any]:
     """``result.json``'s ``at_rate`` block: the objective, the rate, the fastest swing's, the figure weighed (the
-    RMS motor torque [N m], or the supply energy a stroke [kJ]) of the plan and of the baseline."""
+    RMS motor torque [N m], the supply energy a stroke [kJ], or the grid's peak [kW]) of the plan and of the
+    baseline."""
     at = solution.at_rate
-    key = "rms_motor_torque_Nm" if at.objective == "min-rms-torque" else ENERGY
+    key = {"min-rms-torque": "rms_motor_torque_Nm", "min-grid-peak": GRID_PEAK}.get(at.objective, ENERGY)
     return {
         "objective": at.objective,
         "target_spm": at.target_spm,
@@ -125,8 +126,10 @@ def _at_rate(solution: PendulumSolution) -> dict[str, Any]:
 
 def _rate_line(a: dict[str, Any]) -> str:
     """The summary's line of a plan at the line's rate."""
-    rms = a["figure"] == "rms_motor_torque_Nm"
-    what, unit = ("RMS motor torque", "N m") if rms else ("supply energy", "kJ a stroke")
+    what, unit = {
+        "rms_motor_torque_Nm": ("RMS motor torque", "N m"),
+        GRID_PEAK: ("grid peak", "kW"),
+    }.get(a["figure"], ("supply energy", "kJ a stroke"))
     failed = a["baseline_failed"]
     return (
         f"  {a['objective']} at {a['target_spm']:g} strokes/min (the swings make at most {a['fastest_spm']:.3f}): "

@@ -186,6 +186,17 @@ def _grid_rows(case: Case, add: Any, drives: dict[str, DriveSamples], limits: di
         add("grid peak power", power / limits["grid_cap"], -math.inf, 1.0, GRID)
 
 
+def bus_peak_rows(case: Case, add: Any, drives: dict[str, DriveSamples], peak: Any, unit: float) -> None:
+    """min-grid-peak (``planning.solver.pendulum_rate``): the bus power ``(T_m omega_m + k T_m^2) / eta_c`` at or
+    below the epigraph variable ``peak`` [W] at every sample of both swings (``unit`` [W] scales the rows); the
+    standstills' holding copper loss is far below any peak."""
+    d = case.drive
+    copper = d.motor.copper_loss_at_rated_kW * 1e3 / d.motor.rated_torque_Nm**2
+    for samples in drives.values():
+        power = bus_power(samples.tm, samples.speed, copper, d.converter_efficiency)
+        add("bus power under its peak", (power - peak) / unit, -math.inf, 0.0, "planner.objective")
+
+
 def draw_torque(case: Case, setup: Any, speed: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The drive through a swing's draw at the constant crank ``speed`` [rad/s] (numbers): ``(u [rad], motor
     torque on u [N m], motor speed [rad/s], crank torque on u [N m])`` (``setup``: the swing's ``SwingSetup``)."""

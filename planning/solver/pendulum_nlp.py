@@ -65,7 +65,7 @@ from planning.solver.halves_nlp import MIN_HALF_S, TOP_SPEED, VARIABLE_INDEX, an
 from planning.solver.ipopt import NLPSolver
 from planning.solver.nlp import RATE_OPTIONS, Rows
 from planning.solver.parameters import time_limit
-from planning.solver.pendulum_drive import drive_rows, rate_terms, swing_drive
+from planning.solver.pendulum_drive import bus_peak_rows, drive_rows, rate_terms, swing_drive
 from planning.solver.pendulum_robots import (
     NEED_FACTOR,
     ROBOTS_CHECK,
@@ -110,8 +110,10 @@ SAMPLED_LIMITS = (
 SAMPLED_PARAMETER = {"grid_peak_power": "grid_cap"}  # a sampled limit's parameter where it is not the limit's id
 ACCEL, JERK, SLIDE_ACCEL = "limits.crank_accel_rad_s2", "limits.crank_jerk_rad_s3", "limits.slider_accel_mm_s2"
 OPTIONS = {"ipopt.constr_viol_tol": IPOPT_CONSTR_VIOL_TOL, "ipopt.max_iter": 600}
-# at a target rate: the cycle's time [s] and the weights of the heat [1/(N^2 m^2 s)] and the energy [1/J]
-RATE_PARAMETERS = ("target_period", "weight_heat", "weight_energy")
+# at a target rate: the cycle's time [s] and the weights of the heat [1/(N^2 m^2 s)], the energy [1/J] and the
+# bus power's peak [1/W] (min-grid-peak: its epigraph variable PEAK_VARIABLE)
+RATE_PARAMETERS = ("target_period", "weight_heat", "weight_energy", "weight_peak")
+PEAK_VARIABLE = "bus_peak"  # [W] min-grid-peak: at or above the bus power at every sample of both swings
 TARGET = "planner.target_spm"
 
 
@@ -270,6 +272,9 @@ def _variables(case: Case) -> tuple[tuple[str, ...], np.ndarray]:
     for name in start_variables(case):  # the robots' starts (with robots: ``planning.solver.pendulum_robots``)
         names.append(name)
         scales.append(halves_scale[VARIABLE_INDEX["closing_time"]])
+    if case.planner.objective == "min-grid-peak":  # the bus's peak [W], scaled by the motor's rated power
+        names.append(PEAK_VARIABLE)
+        scales.append(case.drive.motor.rated_torque_Nm * case.drive.motor.base_speed_rpm * RPM)
     return tuple(names), np.array(scales)
 
 
@@ -316,6 +321,9 @@ def build(case: Case) -> PendulumNLP:
             rows.add("the cycle at the target rate", period / limits["target_period"] - 1.0, 0.0, 0.0, TARGET)
             heat, energy = rate_terms(case, drives, turns)
             objective = limits["weight_heat"] * heat + limits["weight_energy"] * energy
+        if PEAK_VARIABLE in phys:  # min-grid-peak: the bus's peak as an epigraph, weighed
+            bus_peak_rows(case, rows.add, drives, phys[PEAK_VARIABLE], scales[names.index(PEAK_VARIABLE)])
+            objective = objective + limits["weight_peak"] * phys[PEAK_VARIABLE]
     problem = {"x": x, "p": p, "f": objective, "g": ca.vertcat(*rows.g)}
     solver = NLPSolver(
         "pendulum_rate" if rate else "pendulum", problem, {**OPTIONS, **(RATE_OPTIONS if rate else {})}, scales

@@ -23,11 +23,12 @@ from dataclasses import replace
 
 from planning.model.case import Case
 from planning.model.pendulum import STROKES_PER_CYCLE
-from planning.solver.objectives import HEAT_TIE_BREAK, check_reachable
+from planning.solver.objectives import HEAT_TIE_BREAK, PEAK_START_HEADROOM, check_reachable
 from planning.solver.outcomes import Unverified
 from planning.solver.pendulum import PendulumSolution, solve_pendulum, solved_starts
 from planning.solver.pendulum_check import evaluate_pendulum
 from planning.solver.pendulum_nlp import (
+    PEAK_VARIABLE,
     PendulumNLP,
     build,
     elapsed_info,
@@ -56,7 +57,9 @@ def rate_nlp(case: Case) -> PendulumNLP:
     """The rate NLP of ``case``, built once for every rate and either objective of it (the rate and the weights
     its parameters): kept by the fields the NLP reads (not the case's name, title or source, the target rate or
     which objective), the last :data:`KEPT_RATE_NLPS` only (each holds tens of MB)."""
-    planner = case.planner.model_copy(update={"objective": "min-rms-torque", "target_spm": None})  # any at a rate
+    peak = case.planner.objective == "min-grid-peak"  # (its NLP has the bus peak's variable and rows)
+    kind = "min-grid-peak" if peak else "min-rms-torque"  # any other at a rate
+    planner = case.planner.model_copy(update={"objective": kind, "target_spm": None})
     key = case.model_copy(update={"planner": planner}).model_dump_json(exclude={"name", "title", "source"})
     if key not in _RATE_NLPS:
         while len(_RATE_NLPS) >= KEPT_RATE_NLPS:
@@ -124,18 +127,26 @@ def _baseline(case: Case, fastest: PendulumSolution, period: float) -> PendulumS
 def _weights(baseline: Evaluation, objective: str, period: float) -> dict[str, float]:
     """The rate NLP's parameters: the cycle's time and the weights that make the baseline's objective 1."""
     heat_weight = 1.0 / (baseline.drive.rms_motor_torque_Nm**2 * period)
+    weights = {"target_period": period, "weight_heat": heat_weight, "weight_energy": 0.0, "weight_peak": 0.0}
     if objective == "min-rms-torque":
-        return {"target_period": period, "weight_heat": heat_weight, "weight_energy": 0.0}
+        return weights
+    if objective == "min-grid-peak":  # the bus's peak [W], the heat breaking ties (as the rotary rate NLP's)
+        peak_W = baseline.drive.power.bus_peak_kW * 1e3
+        return weights | {"weight_heat": HEAT_TIE_BREAK * heat_weight, "weight_peak": 1.0 / peak_W}
     energy = max(abs(baseline.drive.supply_energy_kJ), baseline.drive.crank_work_abs_kJ) * 1e3
-    return {"target_period": period, "weight_heat": HEAT_TIE_BREAK * heat_weight, "weight_energy": 1.0 / energy}
+    return weights | {"weight_heat": HEAT_TIE_BREAK * heat_weight, "weight_energy": 1.0 / energy}
 
 
 def _starts(case: Case, nlp: PendulumNLP, baseline: PendulumSolution, period: float) -> list[dict[str, float]]:
-    """The baseline's values, then the NLP's own starts with both standstills lengthened to the rate."""
+    """The baseline's values, then the NLP's own starts with both standstills lengthened to the rate (with the
+    least grid peak the bus peak's variable above the baseline's peak)."""
     out = [dict(baseline.plan.nlp_values)]
     for start in starts(case, nlp):
         extra = 0.5 * max(period - plan_of_values(case, start, baseline.plan.solver).period, 0.0)
         out.append({**start, "turn_end_s": start["turn_end_s"] + extra, "turn_start_s": start["turn_start_s"] + extra})
+    if PEAK_VARIABLE in nlp.names:
+        top = PEAK_START_HEADROOM * 1e3 * baseline.drive.power.bus_peak_kW
+        out = [{**values, PEAK_VARIABLE: top} for values in out]
     return out
 
 
