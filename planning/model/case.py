@@ -963,18 +963,7 @@ PENDULUM_NOT_WITH = (  # what a pendulum stroke does not plan with yet: (field, 
         f"at most {MAX_HOLD_S:g} s: the swings stand at the turns, a cycle's times within the plan's precision",
     ),
     ("process.draw_slide_speed_mm_s", lambda c: c.process.draw_slide_speed_mm_s, "a swing draws at a crank speed"),
-    (
-        "drive.storage",
-        lambda c: "a storage" if c.drive is not None and c.drive.storage is not None and _grid_limited(c) else None,
-        "with a grid peak limit: the storage's schedule over two swings is not planned yet; without a storage the "
-        "limit caps the bus at every sample",
-    ),
 )
-
-
-def _grid_limited(case: Case) -> bool:
-    """The drive has a grid peak limit (``drive.grid.peak_power_kW``)."""
-    return case.drive.grid is not None and case.drive.grid.peak_power_kW is not None
 
 
 def _pendulum_checks(case: Case) -> None:

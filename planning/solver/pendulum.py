@@ -174,9 +174,10 @@ def _precheck_draw_torque(case: Case) -> None:
                 ("press.capacity.crank_torque_kNm", np.abs(crank) / (1e3 * capacity), crank / 1e3, capacity, "kN m")
             )
         grid = case.drive.grid.peak_power_kW if case.drive.grid is not None else None
-        if grid is not None:  # no storage with swings: the bus's power is the grid's
+        if grid is not None:  # the bus's power is the grid's, but what a storage carries
             bus = drive_chain(torque, torque * speed, case.drive)["bus_power_W"] / 1e3
-            uses.append(("drive.grid.peak_power_kW", bus / grid, bus, grid, "kW"))
+            if not _storage_carries(case, setup.name, u, bus, lowest):
+                uses.append(("drive.grid.peak_power_kW", bus / grid, bus, grid, "kW"))
         for field, use, needed, value, unit in uses:
             k = int(np.argmax(use))
             if use[k] > 1.0:
@@ -186,6 +187,29 @@ def _precheck_draw_torque(case: Case) -> None:
                     f"{lowest / RPM:.3g} rpm it must give {abs(needed[k]):.0f} {unit}"
                 )
                 raise Infeasible(reason, field, value, float(abs(needed[k])), angle)
+
+
+def _storage_carries(case: Case, swing: str, u: np.ndarray, bus_kW: np.ndarray, speed: float) -> bool:
+    """Whether the case's storage can carry a swing's draw above the grid limit (its bus power ``bus_kW`` at
+    angles ``u`` [rad] at the constant ``speed`` [rad/s]): within the storage's power, and the energy above the
+    limit, ``integral (P - L)+ du / w``, within ``eta_s U`` (it cannot start fuller); :class:`Infeasible` naming the
+    storage where the draw's excess is more than it holds; False without a storage."""
+    d = case.drive
+    s = d.storage
+    if s is None:
+        return False
+    excess = np.maximum(bus_kW - d.grid.peak_power_kW, 0.0)
+    if s.max_power_kW is not None and float(np.max(excess)) > s.max_power_kW:
+        return False
+    energy_kJ = float(np.sum(np.diff(u) * (excess[1:] + excess[:-1]) / 2)) / speed
+    if energy_kJ <= s.efficiency * s.usable_energy_kJ:
+        return True
+    reason = (
+        f"drive.storage.usable_energy_kJ = {s.usable_energy_kJ:g} cannot carry the {swing} swing's draw above "
+        f"drive.grid.peak_power_kW = {d.grid.peak_power_kW:g}: at {speed / RPM:.3g} rpm it draws {energy_kJ:.1f} kJ "
+        "above the limit"
+    )
+    raise Infeasible(reason, "drive.storage.usable_energy_kJ", s.usable_energy_kJ, energy_kJ / s.efficiency)
 
 
 def _with_rotary(case: Case, best: tuple, t0: float, iterations: int, tried: int, compare: bool) -> PendulumSolution:

@@ -29,7 +29,7 @@ import numpy as np
 from planning.model.case import RPM, Case
 from planning.model.cycle import HOLD_SEGMENT
 from planning.model.laws import get_law
-from planning.model.limits.grid import bus_power
+from planning.model.limits.grid import EXCESS_SMOOTHING, bus_power
 from planning.model.pendulum import TWO_PI, forming_on_path
 from planning.model.profile import advance_segment
 from planning.solver.nlp import DriveSamples as NLPDriveSamples
@@ -176,14 +176,26 @@ def drive_rows(
 
 
 def _grid_rows(case: Case, add: Any, drives: dict[str, DriveSamples], limits: dict[str, float]) -> None:
-    """The grid's limit without storage (``planning.model.limits.grid``): the bus power
-    ``(T_m omega_m + k T_m^2) / eta_c`` under the cap at every sample of both swings (the grid's power where the
-    bus draws; at the standstills the holding torque's copper loss, far below any limit)."""
+    """The grid's limit (``planning.model.limits.grid``): the bus power ``(T_m omega_m + k T_m^2) / eta_c`` under
+    the cap at every sample of both swings (the grid's power where the bus draws; at the standstills the holding
+    torque's copper loss, far below any limit). With a storage (``grid_allowance`` among ``limits``) the cap is
+    where the storage's power ends, and the energy the bus draws above the limit ``L`` over each swing,
+    ``integral (P_bus - L)+ dt`` (a smooth max, trapezoids over the swing's samples), within what the storage can
+    give, ``eta_s U``: each swing's draw is carried by the storage apart, which recharges between them (its exact
+    periodic schedule over the cycle is the dense check's, ``planning.solver.peak_shaving``)."""
     d = case.drive
     copper = d.motor.copper_loss_at_rated_kW * 1e3 / d.motor.rated_torque_Nm**2
+    limit = d.grid.peak_power_kW * 1e3
+    eps = EXCESS_SMOOTHING * limit
     for samples in drives.values():
         power = bus_power(samples.tm, samples.speed, copper, d.converter_efficiency)
         add("grid peak power", power / limits["grid_cap"], -math.inf, 1.0, GRID)
+        if "grid_allowance" in limits:
+            excess = (power - limit + ca.sqrt((power - limit) ** 2 + eps**2)) / 2
+            n = samples.times.shape[0]
+            t = samples.times
+            energy = ca.sum1((t[1:n] - t[0 : n - 1]) * (excess[1:n] + excess[0 : n - 1]) / 2)
+            add("storage energy above the grid limit", energy / limits["grid_allowance"], -math.inf, 1.0, GRID)
 
 
 def bus_peak_rows(case: Case, add: Any, drives: dict[str, DriveSamples], peak: Any, unit: float) -> None:

@@ -42,7 +42,7 @@ from planning.model.case import RPM, Case
 from planning.model.laws import get_law
 from planning.model.limits import limits_of
 from planning.model.limits.capacity import torque_capacity_kNm
-from planning.model.limits.grid import GridPeakLimit
+from planning.model.limits.grid import NO_STORAGE_J, GridPeakLimit
 from planning.model.pendulum import (
     DIE_ZONE_POINTS,
     SWING_HALVES,
@@ -555,8 +555,11 @@ def sampled_limit_values(case: Case) -> dict[str, float]:
         if cap is not None:
             out["crank_torque"] = cap * (1 - DRIVE_BACKOFF)
         grid = GridPeakLimit()
-        if grid.applies(case):  # the bus's cap, no storage (``planning.model.limits.grid``)
-            out["grid_cap"] = grid.parameter_values(case)["grid_cap"]
+        if grid.applies(case):  # the bus's cap (``planning.model.limits.grid``); with a storage its energy too
+            values = grid.parameter_values(case)
+            out["grid_cap"] = values["grid_cap"]
+            if values["grid_allowance"] < NO_STORAGE_J:
+                out["grid_allowance"] = values["grid_allowance"]
     if case.robots is not None:
         out[NEED_FACTOR] = 1.0  # the robots' needs at the samples as the curves say (raised on a dense failure)
     return out
