@@ -26,6 +26,7 @@ import numpy as np
 
 from planning.model.cam import DEG, TURN_DEG, Cam, Interpolation, quintic_coefficients
 from planning.model.cycle import HOLD_SEGMENT
+from planning.model.free_profile import STAND_SEGMENT
 from planning.model.pendulum import TURN_SEGMENT, PendulumPlan
 from planning.model.plan import Plan
 from planning.model.profile import sample_times
@@ -128,7 +129,7 @@ def standstill_samples(plan: CamPlan, times: np.ndarray) -> list[int]:
     ends = [
         t
         for k, seg in enumerate(plan.profile.segments)
-        if seg.name in (HOLD_SEGMENT, TURN_SEGMENT)
+        if seg.name in (HOLD_SEGMENT, TURN_SEGMENT, STAND_SEGMENT)
         for t in (knots[k], knots[k + 1])
     ]
     return sorted(int(np.argmin(np.abs(times - t))) for t in ends)

@@ -33,6 +33,7 @@ FREE_DRAW: Layout = (*PHASES, DRAW_PHASE)  # the first layout of a case whose dr
 BRAKE_PHASE = ("brake", 16)  # a hold's brake: theta3 -> the hold's angle, to rest
 STAND_PHASE = ("stand", 1)  # a hold's standstill: one segment of the hold's time, no jerk
 REST_PHASES = (BRAKE_PHASE[0], STAND_PHASE[0])  # the phases that end at rest
+STAND_SEGMENT = f"{STAND_PHASE[0]}:1"  # the standstill's segment (a cam's points stand at its ends)
 
 
 def first_layout(free_draw: bool, hold: bool = False) -> Layout:

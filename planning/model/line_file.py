@@ -11,7 +11,6 @@ from typing import Any
 from pydantic import ValidationError
 
 from planning.model.case_file import CaseFileError, _pydantic_field, _pydantic_line, _read_text, load_yaml, read_case
-from planning.model.laws import LAWS
 from planning.model.line import EndModel, Line, LineModel, LineRobot, Station, TransferModel, transfer_robot
 
 LINE_FIELDS = ("path_mm", "speed_mm_s", "accel_mm_s2")  # a transfer's move, when no time_s is given
@@ -106,12 +105,6 @@ def _station(model: LineModel, k: int, line_path: Path, overrides: dict[str, Any
         raise CaseFileError(
             f"{where}{entry.case} has no robots.{missing[0]} (a station of a line needs its unloader and its loader "
             "on their interference curves)",
-            field,
-        )
-    if not LAWS[case.planner.motion_law].plans_at_rate:
-        raise CaseFileError(
-            f"{where}{entry.case} plans with the {case.planner.motion_law} law, which cannot run at a line's rate; "
-            "choose a law with halves (planner.motion_law)",
             field,
         )
     return Station(entry.name, case, case_path)

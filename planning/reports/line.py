@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from planning.reports.folder import write_atomic, write_json, write_table
-from planning.solver.line import LineSolution, horizon_s, line_starts, own_period_s, robot_position_mm
+from planning.solver.line import LineSolution, horizon_s, own_period_s, robot_position_mm, station_starts_s
 
 LINE_FILES = ("line_summary.txt", "line_result.json", "line_trajectory.csv", "line_cams.csv", "line_timing.png")
 STEP_S = 1e-3  # [s] the line trajectory's step (the stations' verification grid's)
@@ -111,7 +111,7 @@ def result(solution: LineSolution, settings: dict[str, Any] | None = None) -> di
                 "phase_offset_s": offset,
                 "phase_offset_deg": offset / period * 360.0,
                 "robot_starts_s": {
-                    r: float(np.mod(s + offset, period)) for r, s in line_starts(solution.at_line[k]).items()
+                    r: float(np.mod(s + offset, period)) for r, s in station_starts_s(solution.at_line[k]).items()
                 },
                 "robot_starts_own_s": dict(plan.robot_starts_s),
                 "least_clearance_mm": float(clearance[least]) if needed else None,

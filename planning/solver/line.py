@@ -99,7 +99,7 @@ def solve_line(line: Line) -> LineSolution:
     at_line = tuple(
         _at_period(station, period_s, fastest) for station, fastest in zip(line.stations, alone, strict=True)
     )
-    starts = [line_starts(solution) for solution in at_line]
+    starts = [station_starts_s(solution) for solution in at_line]
     offsets = phase_offsets_s(period_s, line.robots, line.stations, starts)
     schedules = tuple(_schedule(robot, line, period_s, offsets, starts) for robot in line.robots)
     checks = _station_checks(line, at_line, period_s) + _robot_checks(line, schedules)
@@ -115,7 +115,7 @@ def solve_line(line: Line) -> LineSolution:
     return solution
 
 
-def line_starts(solution: Solution) -> dict[str, float]:
+def station_starts_s(solution: Solution) -> dict[str, float]:
     """A station's robot starts on its own time [s] as the line's master sees them each cycle: a rotary plan's,
     a pendulum plan's in its window at theta_e (``planning.solver.pendulum_line``)."""
     plan = solution.plan

@@ -22,7 +22,7 @@ import numpy as np
 
 from planning.model.case import RPM, Case
 from planning.model.cycle import HOLD_SEGMENT
-from planning.model.free_profile import PHASES, STAND_PHASE, Layout, draws_freely, finer, first_layout, holds
+from planning.model.free_profile import PHASES, STAND_SEGMENT, Layout, draws_freely, finer, first_layout, holds
 from planning.model.laws.optimal import OptimalLaw
 from planning.model.limits import Draw, draw_speed_bounds
 from planning.model.plan import Plan
@@ -82,7 +82,7 @@ def seed_values(seed: Plan, phases: Layout = PHASES, case: Case | None = None) -
 def _standstill(plan: Plan) -> tuple[float, float]:
     """``(start, end)`` [s] of a plan's hold standstill (a law's or the optimal law's segment)."""
     names = [seg.name for seg in plan.profile.segments]
-    k = next(i for i, name in enumerate(names) if name in (HOLD_SEGMENT, f"{STAND_PHASE[0]}:1"))
+    k = next(i for i, name in enumerate(names) if name in (HOLD_SEGMENT, STAND_SEGMENT))
     return float(plan.profile.knot_times[k]), float(plan.profile.knot_times[k + 1])
 
 
