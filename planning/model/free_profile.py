@@ -7,10 +7,12 @@ segment of a phase lasting the phase's step ``h`` [s]; it arrives at theta2 + 2 
 acceleration and draws at w2 to theta3. A draw at constant slide speed (``Case.free_draw``) is a fourth phase
 (:data:`DRAW_PHASE`, theta2 + 2 pi -> theta3 + 2 pi): the cycle then starts at theta3 with the speed ``w2`` and the
 acceleration ``draw_accel`` it returns to there (:data:`FREE_DRAW`).
-A hold at the bottom (``process.hold_time_s``) puts two phases before the return (:func:`first_layout`): the
-brake (:data:`BRAKE_PHASE`, theta3 -> the hold's angle theta_h, arriving at rest with zero acceleration) and the
-standstill (:data:`STAND_PHASE`: one segment of the hold's time, its jerk zero); the return then rises from rest
-at theta_h to theta4.
+A hold at the bottom (``process.hold_time_s``) puts three phases before the return (:func:`first_layout`): the
+brake (:data:`BRAKE_PHASE`, theta3 -> the hold's angle theta_h, arriving at rest with zero acceleration, the crank
+never turning back), the standstill (:data:`STAND_PHASE`: one segment of the hold's time, its jerk zero) and the
+rise (:data:`RISE_PHASE`: from rest, the crank speeding up all the way, to an angle the planner chooses); the
+return then runs from there to theta4. The least crank speed does not hold in these three (:data:`STOP_PHASES`:
+the planned stop).
 The acceleration is continuous everywhere (piecewise linear); the jerk steps at the knots. There are no
 halves, peaks or dwell: :class:`FreeProfileParameters` reports what a press engineer reads off any
 plan (speed at TDC, highest speed before and after the draw, peak acceleration and jerk).
@@ -32,7 +34,9 @@ DRAW_PHASE = ("draw", 40)  # a draw at constant slide speed: the crank's speed p
 FREE_DRAW: Layout = (*PHASES, DRAW_PHASE)  # the first layout of a case whose draw is free (Case.free_draw)
 BRAKE_PHASE = ("brake", 16)  # a hold's brake: theta3 -> the hold's angle, to rest
 STAND_PHASE = ("stand", 1)  # a hold's standstill: one segment of the hold's time, no jerk
+RISE_PHASE = ("rise", 16)  # a hold's rise from rest: the crank speeding up, to an angle of the planner's
 REST_PHASES = (BRAKE_PHASE[0], STAND_PHASE[0])  # the phases that end at rest
+STOP_PHASES = (*REST_PHASES, RISE_PHASE[0])  # the planned stop: the least crank speed does not hold there
 STAND_SEGMENT = f"{STAND_PHASE[0]}:1"  # the standstill's segment (a cam's points stand at its ends)
 
 
@@ -40,7 +44,7 @@ def first_layout(free_draw: bool, hold: bool = False) -> Layout:
     """The layout a solve starts with: :data:`PHASES`, or :data:`FREE_DRAW` for a draw at constant slide speed;
     with a ``hold`` the brake and the standstill first."""
     layout = FREE_DRAW if free_draw else PHASES
-    return (BRAKE_PHASE, STAND_PHASE, *layout) if hold else layout
+    return (BRAKE_PHASE, STAND_PHASE, RISE_PHASE, *layout) if hold else layout
 
 
 def holds(layout: Layout) -> bool:
@@ -50,13 +54,13 @@ def holds(layout: Layout) -> bool:
 
 def phase_ends(layout: Layout, key_angles: tuple, hold_angle=None) -> tuple:  # noqa: ANN001 - floats or symbols
     """Each phase's end angle [rad] counted on from theta3's (0): the brake's and the standstill's the hold's
-    angle, the return's theta4, the window's theta1 a turn on, the feed's theta2 a turn on, a free draw's
-    theta3 a turn on (``key_angles`` theta1 .. theta4)."""
+    angle, the rise's None (the planner's), the return's theta4, the window's theta1 a turn on, the feed's theta2
+    a turn on, a free draw's theta3 a turn on (``key_angles`` theta1 .. theta4)."""
     th1, th2, th3, th4 = key_angles
     two_pi = 2 * math.pi
     ends = {"return": th4 - th3, "transfer": th1 + two_pi - th3, "feed": th2 + two_pi - th3, "draw": two_pi}
     if hold_angle is not None:
-        ends |= {"brake": hold_angle - th3, "stand": hold_angle - th3}
+        ends |= {"brake": hold_angle - th3, "stand": hold_angle - th3, RISE_PHASE[0]: None}
     return tuple(ends[phase] for phase, _ in layout)
 
 
@@ -106,10 +110,11 @@ def closed_jerks(
         after = np.concatenate([np.cumsum(T[:index][::-1])[::-1][1:], [0.0]])  # from each segment's end to this
         gain = np.zeros_like(T)
         gain[:index] = T[:index] ** 3 / 6 + T[:index] ** 2 * after / 2 + T[:index] * after**2 / 2
-        rows.append(gain)
-        targets.append(target)
         span = float(np.sum(T[:index]))
-        values.append(w2 * span + a0 * span**2 / 2 + float(gain @ j))  # the angle past theta3 there
+        if target is not None:  # (a hold's rise ends where the planner put it)
+            rows.append(gain)
+            targets.append(target)
+            values.append(w2 * span + a0 * span**2 / 2 + float(gain @ j))  # the angle past theta3 there
         if end == len(cut) - 1 or phase == BRAKE_PHASE[0]:  # the cycle closes, or the crank comes to rest
             speed = np.zeros_like(T)
             speed[:index] = T[:index] ** 2 / 2 + T[:index] * after
@@ -164,13 +169,9 @@ class FreeProfileParameters:
         return [phase for phase, n in self.layout for _ in range(n)]
 
     def stop_end_angle(self) -> float:
-        """[rad] where a hold's stop ends: the crank's first speed peak after the standstill (the end of its rise
-        from rest, as a law's return half up to its peak); the hold's angle without a rise."""
-        knots = self._knots()
-        first = sum(n for phase, n in self.layout if phase in REST_PHASES)  # the knot where the return starts
-        rising = knots[first + 1 :, 2] > 0.0
-        peak = first + 1 + (int(np.argmin(rising)) if not rising.all() else rising.size - 1)
-        return float(knots[peak, 0]) if rising.any() else float(self.hold_angle)
+        """[rad] where a hold's stop ends: the end of the rise from rest (:data:`RISE_PHASE`)."""
+        last = sum(n for phase, n in self.layout if phase in STOP_PHASES)  # the knot where the rise ends
+        return float(self._knots()[last, 0])
 
     def segments(self) -> list[Segment]:
         return free_segments(self.durations, self.jerks, self.layout)

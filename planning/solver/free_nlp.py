@@ -33,7 +33,9 @@ from planning.model.free_profile import (
     FREE_DRAW,
     PHASES,
     REST_PHASES,
+    RISE_PHASE,
     STAND_PHASE,
+    STOP_PHASES,
     Layout,
     draws_freely,
     first_layout,
@@ -76,7 +78,7 @@ from press.mechanism import Formula
 # the limits are held at every knot and at evenly spaced points inside each segment, this many per
 # segment (knot included) in each phase: the robot's window has the longest segments and the highest
 # speeds (around TDC, where the slider acceleration peaks), so it is sampled finer
-SAMPLES_PER_SEGMENT = {"return": 4, "transfer": 8, "feed": 4, "draw": 8, "brake": 4, "stand": 2}
+SAMPLES_PER_SEGMENT = {"return": 4, "transfer": 8, "feed": 4, "draw": 8, "brake": 4, "stand": 2, "rise": 4}
 STATES = ("angle", "speed", "accel")
 TOP_SPEED = 1e3  # [rad/s] upper bound of the crank speeds (far above any press)
 # at a rate: the rate NLPs' tolerance, and IPOPT's acceptable level where its line search cycles near the
@@ -201,7 +203,7 @@ def _shooting(phases: Layout, physical: ca.MX, v: dict, unit: dict, q: dict, ind
     start = (q["theta3"], v["draw_speed"], v.get("draw_accel", ca.MX(0.0)))
     t0 = ca.MX(0.0)
     shooting, boundary, samples, times, knot_accels, pieces = [], [], [], [], [], []
-    crossings, rest = {}, None
+    crossings, rest, rise, monotone = {}, None, None, []
     for phase, n in phases:
         h = v[f"{phase}_step"]
         first = index[f"{phase}_jerk_0"]
@@ -210,23 +212,28 @@ def _shooting(phases: Layout, physical: ca.MX, v: dict, unit: dict, q: dict, ind
         states = ca.reshape(physical[first + n : first + 4 * n], 3, n).T
         nxt = [states[:, i] for i in range(3)]
         th0, om0, al0 = (ca.vertcat(start[i], nxt[i][: n - 1]) if n > 1 else start[i] for i in range(3))
+        piece = (t0, h, n, start, om0, al0, jerk)
         if phase in ("return", "feed", "brake"):  # the die-height crossing of this phase, in closed form (clip)
             when = v["die_up_time" if phase == "return" else "die_down_time"]
-            tau = ca.fmin(ca.fmax(when - h * ca.DM(np.arange(n)), 0), h)
-            crossings[phase] = (clipped_advance(tau, start[0], start[1], om0, al0, jerk, 0.0), when, n * h)
-        pieces.append((t0, h, n, start, om0, al0, jerk))
+            crossings[phase] = _crossing(when, piece, rise if phase == "return" else None)
+        rise = piece if phase == RISE_PHASE[0] else rise
+        if phase == RISE_PHASE[0]:  # the rise from rest speeds the crank up all the way (it cannot crawl there)
+            monotone.append(nxt[2] / unit[f"{phase}_accel_1"])
+        pieces.append(piece)
         th1, om1, al1, _ = advance(th0, om0, al0, jerk, 0.0, h)
         shooting.append(
             ca.vertcat(th1 - nxt[0], (om1 - nxt[1]) / unit["draw_speed"], (al1 - nxt[2]) / unit[f"{phase}_accel_1"])
         )
         end = tuple(states[n - 1, i] for i in range(3))
-        boundary.append(end[0] - ends[phase])
+        boundary += [end[0] - ends[phase]] if ends.get(phase) is not None else []  # (a rise's end: the planner's)
         if phase == BRAKE_PHASE[0]:
             rest = (end[1] / unit["draw_speed"], end[2] / unit[f"{phase}_accel_1"])  # at rest at the hold
         # samples in time order: every knot of the phase and the points inside each segment
         fractions = [k / SAMPLES_PER_SEGMENT[phase] for k in range(1, SAMPLES_PER_SEGMENT[phase])]
         parts = [advance(th0, om0, al0, jerk, 0.0, h * f) for f in fractions]
         samples.append(tuple(_interleave([(th0, om0, al0)[i], *(part[i] for part in parts)]) for i in range(3)))
+        if phase == BRAKE_PHASE[0]:  # the brake may speed up first, never turn back
+            monotone.append(samples[-1][1] / unit["draw_speed"])
         local = ca.DM(np.arange(n))
         times.append(_interleave([t0 + local * h, *(t0 + (local + f) * h for f in fractions)]))
         knot_accels.append(ca.vertcat(al0, end[2]))
@@ -247,8 +254,25 @@ def _shooting(phases: Layout, physical: ca.MX, v: dict, unit: dict, q: dict, ind
         "t_draw_start": feed_end,
         "pieces": pieces,
         "rest": rest,
+        "monotone": monotone,
         "phases": phases,
     }
+
+
+def _crossing(when: ca.MX, piece: tuple, rise: tuple | None) -> tuple:
+    """The die-height crossing ``when`` [s] after a phase's start (``piece``: its start time, step, segments, start
+    state, the segments' start speeds and accelerations, jerks): ``((angle, speed), when, span)`` in closed form
+    (clip); after a hold's ``rise`` (its piece) counted from the rise's start, over both phases."""
+    _, h, n, start, om0, al0, jerk = piece
+    if rise is None:
+        tau = ca.fmin(ca.fmax(when - h * ca.DM(np.arange(n)), 0), h)
+        return clipped_advance(tau, start[0], start[1], om0, al0, jerk, 0.0), when, n * h
+    _, h_r, n_r, start_r, om0_r, al0_r, jerk_r = rise
+    tau_r = ca.fmin(ca.fmax(when - h_r * ca.DM(np.arange(n_r)), 0), h_r)
+    th_r, om_r = clipped_advance(tau_r, start_r[0], start_r[1], om0_r, al0_r, jerk_r, 0.0)
+    tau = ca.fmin(ca.fmax(when - n_r * h_r - h * ca.DM(np.arange(n)), 0), h)
+    th, om = clipped_advance(tau, 0.0, 0.0, om0, al0, jerk, 0.0)
+    return (th_r + th, om_r + om), when, n_r * h_r + n * h
 
 
 def _structure_rows(rows: Rows, s: dict[str, Any], v: dict, unit: dict, q: dict) -> tuple[ca.MX, ca.MX]:
@@ -260,6 +284,8 @@ def _structure_rows(rows: Rows, s: dict[str, Any], v: dict, unit: dict, q: dict)
     rows.add("key angles", ca.vertcat(*s["boundary"][:-closing]), 0.0, 0.0, "key_points")
     if s["rest"] is not None:
         rows.add("the crank at rest at the hold", ca.vertcat(*s["rest"]), 0.0, 0.0, "process.hold_time_s")
+        monotone = ca.vertcat(*s["monotone"])
+        rows.add("forward in the brake, speeding up in the rise", monotone, 0.0, np.inf, "process.hold_time_s")
     end_accel = start[2] - v["draw_accel"] if "draw_accel" in v else start[2]  # a free draw's at theta3, else 0
     closes = ca.vertcat(
         *s["boundary"][-closing:], (start[1] - w2) / unit["draw_speed"], end_accel / unit["feed_accel_1"]
@@ -302,10 +328,10 @@ def _all_samples(s: dict[str, Any], q: dict, w2: ca.MX, drive: bool) -> tuple[tu
 
 def _moving_speeds(s: dict[str, Any], speeds: ca.MX) -> ca.MX:
     """The free profile's sample ``speeds`` where the least crank speed holds: all but, with a hold, the stop's
-    (the brake, the standstill and the return, which rises from rest)."""
+    (the brake, the standstill and the rise from rest)."""
     if not holds(s["phases"]):
         return speeds
-    stopped = (*REST_PHASES, "return")
+    stopped = STOP_PHASES
     kept = [sm[1] for sm, (phase, _) in zip(s["samples"], s["phases"], strict=True) if phase not in stopped]
     return ca.vertcat(*kept)
 
@@ -422,7 +448,7 @@ def _build(
     options = {**CYCLE_OPTIONS, **DRIVE_OPTIONS}  # MUMPS's AMD ordering: the same iterations, 5-10 % faster here
     options |= FREE_RATE_OPTIONS if rate else {}
     options |= {"ipopt.max_wall_time": ROBOTS_WALL_S} if robots else {}
-    fine = phases not in (PHASES, FREE_DRAW, first_layout(False, True), first_layout(True, True))
+    fine = phases not in (PHASES, FREE_DRAW, first_layout(False, True), first_layout(True, True))  # (a name's part)
     name = "press_cycle_optimal" + ("_fine" if fine else "") + ("_slide" if free else "") + ("_drive" if drive else "")
     name += ("_hold" if holds(phases) else "") + ("_rate" if rate else "")
     program = NLPSolver(name, problem, options, None, WARM_OPTIONS, lift)
@@ -440,13 +466,20 @@ def _build(
     )
 
 
+def layout_of(nlp: CycleNLP) -> Layout:
+    """The phases' layout of an optimal law's NLP, read off its variables (each phase's step, then its jerks)."""
+    names = [name for name, _ in nlp.variables]
+    phases = [name.removesuffix("_step") for name in names if name.endswith("_step")]
+    return tuple((phase, sum(1 for name in names if name.startswith(f"{phase}_jerk_"))) for phase in phases)
+
+
 def complete_robots(phases: Layout, values: dict[str, float]) -> dict[str, float]:
     """``values`` with the robots' starts where a start lacks them: the unloader at theta4, the loader
     halfway to theta1 (the transfer phase's ends)."""
     if "unloader_start" in values:
         return values
     steps = dict(phases)
-    t4 = sum(values[f"{phase}_step"] * steps[phase] for phase in (*REST_PHASES, "return") if phase in steps)
+    t4 = sum(values[f"{phase}_step"] * steps[phase] for phase in (*STOP_PHASES, "return") if phase in steps)
     t1 = t4 + values["transfer_step"] * steps["transfer"]
     return {**values, "unloader_start": t4, "loader_start": 0.5 * (t4 + t1)}
 

@@ -36,14 +36,14 @@ import math
 from dataclasses import replace
 
 from planning.model.case import Case, Placement
-from planning.model.free_profile import FreeProfileParameters
+from planning.model.free_profile import FreeProfileParameters, draws_freely, holds
 from planning.model.laws import FREE, get_law
 from planning.model.plan import Plan
-from planning.solver.free_nlp import free_nlp_for
+from planning.solver.free_nlp import free_nlp_for, layout_of
 from planning.solver.halves_nlp import PEAK_VARIABLE, ROBOT_VARIABLES, VARIABLE_INDEX, halves_nlp_for
 from planning.solver.max_spm import solve_max_spm
 from planning.solver.neighbour import can_start
-from planning.solver.optimal import solve_optimal
+from planning.solver.optimal import seed_values, solve_optimal
 from planning.solver.outcomes import Infeasible, NoPlanFound, Unverified
 from planning.solver.search import Search, prepare
 from planning.solver.solution import AtRate, Solution, objective_value
@@ -260,17 +260,41 @@ SLOWED_POWER = {"speed": -1, "half": 1, "time": 1, "step": 1, "accel": -2, "jerk
 
 def _slowed(plan: Plan, factor: float, search: Search) -> dict[str, float]:
     """``plan``'s NLP values run ``factor`` times slower: every angle, so every key point and the cycle's
-    closure, stays where it was (a start; values held within their bounds, the draw speed's in particular); the
-    robots' starts, where it has robots, at the same angles too (their times ``factor`` times later). Each value
-    scales by ``factor`` to the power of its kind's time (:data:`SLOWED_POWER`: a speed's -1, a time's 1, an
-    acceleration's -2, a jerk's -3)."""
-    values = {name: plan.nlp_values[name] * factor for name, _ in ROBOT_VARIABLES if name in plan.nlp_values}
+    closure, stays where it was (a start; values held within their bounds, the draw speed's in particular, and a
+    hold's standstill at its time, so a cycle with a hold is not quite ``factor`` times longer); the robots'
+    starts, where it has robots, at the same angles too (their times ``factor`` times later). Each value scales by
+    ``factor`` to the power of its kind's time (:data:`SLOWED_POWER`: a speed's -1, a time's 1, an acceleration's
+    -2, a jerk's -3); an optimal plan on another layout than the search's is sampled onto it first."""
+    given = _on_layout(search, plan) if _free(search.case) else plan.nlp_values
+    values = {name: given[name] * factor for name, _ in ROBOT_VARIABLES if name in given}
     for j, (name, kind) in enumerate(search.nlp.variables):
-        if name not in plan.nlp_values:
+        if name not in given:
             continue
-        value = plan.nlp_values[name] * factor ** SLOWED_POWER.get(kind, 0)
+        value = given[name] * factor ** SLOWED_POWER.get(kind, 0)
         values[name] = float(min(max(value, search.lbx[j]), search.ubx[j]))
     return values
+
+
+def _on_layout(search: Search, plan: Plan) -> dict[str, float]:
+    """An optimal plan's values on the layout of ``search``'s NLP (its own, or sampled from its profile where it
+    was planned on another: a finer layout's names include the first's, with other meanings)."""
+    layout = layout_of(search.nlp)
+    if getattr(plan.parameters, "layout", None) == layout:
+        return plan.nlp_values
+    return seed_values(plan, layout, search.case)
+
+
+def _neighbour_fits(search: Search, neighbour: Plan | None, placement: Placement) -> Plan | None:
+    """``neighbour`` as a start of ``search`` (None where it cannot start it): an optimal plan of the same draw and
+    hold on the search's layout (its values sampled there from its profile)."""
+    if not can_start(neighbour, search.case, placement):
+        return None
+    if not _free(search.case):
+        return neighbour
+    layout, own = layout_of(search.nlp), getattr(neighbour.parameters, "layout", None)
+    if own is None or (draws_freely(own), holds(own)) != (draws_freely(layout), holds(layout)):
+        return None
+    return replace(neighbour, nlp_values=_on_layout(search, neighbour))
 
 
 def _run_starts(
@@ -287,7 +311,8 @@ def _run_starts(
     neighbour's start alone when it leads to a verified plan scoring below ``to_beat`` (the objective's
     ``to_beat`` is the baseline's score: a neighbour's start can end in a local optimum worse than
     waiting), else the ``starts`` until one verifies."""
-    fits = can_start(neighbour, search.case, placement)
+    neighbour = _neighbour_fits(search, neighbour, placement)
+    fits = neighbour is not None
     if confirm:
         search.multi_start(starts, placement, confirm=True)
         if fits and not search.stopped:

@@ -30,7 +30,7 @@ from planning.solver.free_nlp import free_nlp_for
 from planning.solver.max_spm import converged_plan, solve_max_spm
 from planning.solver.neighbour import can_answer, can_start, known_evaluation, plan_of
 from planning.solver.outcomes import Infeasible
-from planning.solver.parameters import structure_values
+from planning.solver.parameters import brake_crossing, structure_values
 from planning.solver.search import Search, prepare
 from planning.solver.solution import Solution
 from planning.solver.verify import evaluate
@@ -50,13 +50,15 @@ def seed_values(seed: Plan, phases: Layout = PHASES, case: Case | None = None) -
     spans = {"return": (t3, t4), "transfer": (t4, t1 + period), "feed": (t1 + period, t2 + period)}
     spans["draw"] = (t2 + period, t3 + period)  # a free draw's phase (a draw at constant slide speed)
     values = {"draw_speed": float(seed.parameters.draw_speed), "die_up_time": seed.nlp_values["die_up_time"]}
-    if holds(phases):  # the brake, the standstill, then the return from rest (its die crossing counted from there)
+    if holds(phases):  # the brake, the standstill, the rise from rest (its die crossing counted from there), the return
         stands, stood = _standstill(seed)
-        spans |= {"brake": (t3, stands), "stand": (stands, stood), "return": (stood, t4)}
+        peak = _first_peak(seed, stood, t4)
+        spans |= {"brake": (t3, stands), "stand": (stands, stood), "rise": (stood, peak), "return": (peak, t4)}
         values["die_up_time"] = _rising_through_die(seed, case, stood, t4)
     if draws_freely(phases):  # the speed at theta3 and the acceleration there
         values["draw_speed"], values["draw_accel"] = (float(x) for x in prof.at_time(t3)[1:3])
-    if seed.motion_law == OptimalLaw.name:  # the descending crossing's time counts from theta1 already
+    braking = case is not None and brake_crossing(case)  # a descending crossing in a hold's brake: from theta3
+    if seed.motion_law == OptimalLaw.name or braking:  # (else from theta1 in the free NLP, theta3 in a law's)
         values["die_down_time"] = seed.nlp_values["die_down_time"]
     else:
         values["die_down_time"] = max(seed.nlp_values["die_down_time"] - seed.nlp_values["closing_time"], 0.0)
@@ -84,6 +86,19 @@ def _standstill(plan: Plan) -> tuple[float, float]:
     names = [seg.name for seg in plan.profile.segments]
     k = next(i for i, name in enumerate(names) if name in (HOLD_SEGMENT, STAND_SEGMENT))
     return float(plan.profile.knot_times[k]), float(plan.profile.knot_times[k + 1])
+
+
+RISE_SHARE = 0.25  # a seed's rise from rest ends at its speed's peak, at most this share of the way to theta4 (a
+# law's half rises monotonically to its peak; the optimum's rise may end early, where the die zone caps the speed)
+PEAK_GRID = 400  # points on which a seed's speed peak after its standstill is looked for
+
+
+def _first_peak(plan: Plan, start: float, end: float) -> float:
+    """[s] where ``plan``'s crank speed peaks between ``start`` (rest after a hold) and ``end`` (theta4): a seed's
+    rise from rest ends there, at most :data:`RISE_SHARE` of the way."""
+    t = np.linspace(start, end, PEAK_GRID)
+    speed = plan.profile.at_time(t)[1]
+    return float(min(t[int(np.argmax(speed))], start + RISE_SHARE * (end - start)))
 
 
 def _rising_through_die(plan: Plan, case: Case, start: float, end: float) -> float:
