@@ -505,18 +505,11 @@ def _cam_outputs() -> tuple:
 
 
 def _with_law(case, args):  # noqa: ANN001, ANN202 - a Case and the parsed arguments
-    """The case under ``--law``; the refusal that does not depend on the case comes first (the optimal
-    law with an objective at a rate), then what the case lacks, named with the ``--set`` that adds it."""
+    """The case under ``--law``; what the case lacks for it named with the ``--set`` that adds it."""
     from planning.model.case import CaseError
 
     if args.law is None:
         return case
-    objective = getattr(args, "objective", None)
-    if not LAWS[args.law].plans_at_rate and objective not in (None, "max-spm"):
-        raise CommandError(
-            f"--law {args.law}: the {args.law} law plans for the most strokes only; it takes no --objective "
-            f"{objective} (choose a law with halves, e.g. --law improved-s-curve)"
-        )
     try:
         return case.with_law(args.law)
     except CaseError as exc:

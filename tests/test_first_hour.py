@@ -192,12 +192,13 @@ def test_an_objective_without_a_rate_names_the_option(tmp_path, capsys):
     assert "--objective min-energy" in err and "--spm" in err and "planner.target_spm" not in err
 
 
-def test_the_refusal_that_does_not_depend_on_the_case_comes_first(tmp_path, capsys):
-    """The optimal law takes no objective: said before the case's missing jerk limit."""
+def test_the_optimal_law_at_a_rate_names_the_jerk_limit_it_lacks(tmp_path, capsys):
+    """The optimal law plans at a rate too; a case without a crank-jerk limit is told which ``--set`` adds it."""
     args = ["solve", DRIVE_CASE, "--law", "optimal", "--objective", "min-energy", "--spm", "8", "--out", str(tmp_path)]
     assert main(args) == 2
-    err = capsys.readouterr().err
-    assert "takes no --objective min-energy" in err and "crank_jerk" not in err
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--law optimal: limits.crank_jerk_rad_s3" in err
+    assert "(add it: --set limits.crank_jerk_rad_s3=VALUE)" in err
 
 
 def test_an_objective_without_a_drive_names_the_option(tmp_path, capsys):

@@ -1015,12 +1015,6 @@ def _objective_checks(case: Case) -> None:
         raise CaseError("planner.target_spm", f"the {planner.objective} objective needs the line's rate", None, False)
     if case.drive is None:
         raise CaseError("planner.objective", "needs a drive: section (the motor it weighs)", planner.objective)
-    if not LAWS[planner.motion_law].plans_at_rate:
-        raise CaseError(
-            "planner.objective",
-            f"the {planner.motion_law} law plans for the most strokes only (max-spm); choose a law with halves",
-            planner.objective,
-        )
     if planner.objective == "min-grid-peak" and LAWS[planner.motion_law].transcription != HALVES:
         reason = "the optimal law plans min-rms-torque and min-energy at a rate, not yet the least grid peak"
         raise CaseError("planner.objective", reason, planner.objective)

@@ -38,15 +38,13 @@ class Law:
     of the speed that is continuous), ``source``, ``transcription`` (:data:`HALVES`: the law shapes the
     halves of a cycle, :class:`MotionLaw`; :data:`FREE`: the profile is planned whole, the optimal law;
     the solver picks the NLP by it), ``needs_jerk_limit`` (it plans under ``limits.crank_jerk_rad_s3`` and
-    needs one), ``plans_at_rate`` (it takes an objective at the line's rate), ``parameter`` (a
-    :class:`ShapeParameter` or None)."""
+    needs one), ``parameter`` (a :class:`ShapeParameter` or None)."""
 
     name: ClassVar[str]
     continuity: ClassVar[str]
     source: ClassVar[str]
     transcription: ClassVar[str]
     needs_jerk_limit: ClassVar[bool] = False
-    plans_at_rate: ClassVar[bool] = True
     parameter: ClassVar[ShapeParameter | None] = None
 
     def __repr__(self) -> str:

@@ -17,4 +17,3 @@ class OptimalLaw(Law):
     source = "this project: jerk-limited time-optimal profile, piecewise-constant jerk"
     transcription = FREE
     needs_jerk_limit = True
-    plans_at_rate = True  # at a line's rate too (min-rms-torque, min-energy; not yet min-grid-peak)
