@@ -137,11 +137,15 @@ def test_splitting_a_half_keeps_its_motion(law, cut):
 
 
 # a draw at constant slide speed is the optimal law's alone (tests/test_slide_draw.py)
-WITH_HALVES = [p for p in CASES if not read_case(p).free_draw]
+WITH_HALVES = [  # the robots' case (about 4 s a law) in the slow tier
+    pytest.param(p, marks=pytest.mark.slow) if read_case(p).robots is not None else p
+    for p in CASES
+    if not read_case(p).free_draw
+]
 
 
 @pytest.mark.parametrize("law", [law for law in SHAPED_LAWS if law != "improved-s-curve"])
-@pytest.mark.parametrize("path", WITH_HALVES, ids=lambda p: p.stem)
+@pytest.mark.parametrize("path", WITH_HALVES, ids=lambda p: getattr(p, "stem", None))
 def test_every_law_solves_every_case(path, law):
     """Every law with halves gives a verified plan on every case under both placements, free never worse
     (the improved S-curve: tests/test_cases.py; the optimal law: tests/test_optimal.py)."""

@@ -367,6 +367,7 @@ def _least_gap(result: dict, line: dict, line_file: Path) -> float:
         back = period - occupancy["u"] - there - occupancy["l"]
         least = min(least, there - move, back - move)
     return least
+@pytest.mark.slow  # a line solve: about 7 s
 
 
 def test_a_press_with_a_hold_keeps_it_at_the_lines_period(tmp_path: Path) -> None:
@@ -417,6 +418,7 @@ def test_a_pendulum_press_swings_once_a_master_cycle_its_robots_every_cycle(swin
     assert clearance >= -REPLAY_TOL_MM and gap >= -REPLAY_TOL_S and not both
     shifts = [c for c in result["checks"] if "after its start at theta_e" in c["name"]]
     assert len(shifts) == 2 and all(c["value"] == pytest.approx(period, abs=1e-9) for c in shifts)
+@pytest.mark.slow  # a line solve: about 10 s
 
 
 def test_the_line_verification_fails_a_swing_whose_robots_drift_off_the_master(

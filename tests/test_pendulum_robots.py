@@ -103,6 +103,7 @@ def test_a_failed_clearance_raises_the_needs_at_the_samples():
 
     limits = {"slider_accel": 19000.0, NEED_FACTOR: 1.0}
     assert refined(limits, [Failed()]) == {"slider_accel": 19000.0, NEED_FACTOR: 1.03}
+@pytest.mark.slow  # about 9 s
 
 
 def test_solve_writes_both_occupancies_as_robot_cams(tmp_path, capsys):

@@ -357,6 +357,7 @@ def test_every_command_runs_on_a_robot_case(tmp_path: Path) -> None:
 def _solved(data: dict):  # noqa: ANN202 - (Solution, Case)
     case = case_from_data(data, "robots.yaml")
     return solve(case), case
+@pytest.mark.slow  # about 25 s
 
 
 def test_a_step_in_the_curve_is_held_on_its_needing_side() -> None:

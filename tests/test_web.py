@@ -248,6 +248,7 @@ def test_two_pages_stay_separate(site) -> None:
         context.close()
 
 
+@pytest.mark.slow  # the browser: about 9 s
 @browser
 def test_a_drive_case_shows_its_motor(site) -> None:
     url, browser = site
@@ -286,6 +287,7 @@ def test_a_drive_case_shows_its_motor(site) -> None:
     context.close()
 
 
+@pytest.mark.slow  # the browser: about 7 s
 @browser
 def test_a_linkage_case_shows_its_mechanism_and_follows_a_geometry_edit(site) -> None:
     """The link drive: its own fields (not the crank-slider's), a drawing of the linkage that follows the
@@ -717,6 +719,7 @@ def test_every_field_has_words_a_unit_and_help() -> None:
         assert unit in spec["title"], spec
 
 
+@pytest.mark.slow  # the browser: about 5 s
 @browser
 def test_a_drive_added_and_its_forming_force_edited_in_the_page(page) -> None:
     """No drive on the published case: "add a drive" puts in the template press's drive and forming force
@@ -816,6 +819,7 @@ def test_a_hold_is_shown_and_its_time_edited_with_the_mouse_and_keys(page) -> No
     screenshot(page, "web-hold")
 
 
+@pytest.mark.slow  # the browser: about 7 s
 @browser
 def test_a_draw_at_slide_speed_is_planned_and_its_speed_edited_with_the_mouse_and_keys(page) -> None:
     """The cup drawn at 60 mm/s (the optimal law's free draw): the page's strokes are the CLI's and its summary
@@ -837,6 +841,7 @@ def test_a_draw_at_slide_speed_is_planned_and_its_speed_edited_with_the_mouse_an
     screenshot(page, "web-slide-draw")
 
 
+@pytest.mark.slow  # the browser: about 7 s
 @browser
 def test_a_pendulum_stroke_on_the_page(page) -> None:
     """The shallow cup's press set to pendulum strokes with the mouse and the keys: the page's strokes are the CLI's

@@ -61,6 +61,7 @@ def type_and_confirm(tab, selector: str, text: str) -> None:  # noqa: ANN001 - a
 
 def spm(tab) -> float:  # noqa: ANN001
     return float(tab.evaluate("state.last.result.spm"))
+@pytest.mark.slow  # the browser: about 10 s
 
 
 def test_the_robots_fields_edit_the_plan(page) -> None:
@@ -150,6 +151,7 @@ def test_one_robot_removed_and_added_back(page) -> None:
     assert page.locator('[data-field="robots.loader.path_mm"]').count() == 1
     assert page.evaluate("state.last.result.verified")
     assert page.errors == []
+@pytest.mark.slow  # the browser: about 23 s
 
 
 def test_robots_on_pendulum_strokes(site) -> None:

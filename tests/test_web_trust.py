@@ -105,6 +105,7 @@ def test_d1_a_mouse_click_after_typing_lands_on_its_button(site) -> None:
     wait_rendered(page, before)
     assert page.locator('[data-field="drive.motor.peak_torque_Nm"]').count() == 1, "the click was lost"
     context.close()
+@pytest.mark.slow  # the browser and a bound: about 6 s
 
 
 def test_d2_the_bound_answering_after_a_refused_upload_throws_nothing(page, tmp_path: Path) -> None:
