@@ -160,7 +160,11 @@ def _every_law():
     return [(path, law) for path in SHIPPED_CASES for law in LAWS]
 
 
-@pytest.mark.parametrize("path", SHIPPED_CASES, ids=lambda p: p.stem)
+@pytest.mark.parametrize(  # the robots' case (about 4 s) in the slow tier
+    "path",
+    [pytest.param(p, marks=pytest.mark.slow) if "robots" in p.stem else p for p in SHIPPED_CASES],
+    ids=lambda p: getattr(p, "stem", None),
+)
 def test_every_mechanism_exports_a_proved_cam(path):
     """Every shipped case (crank-slider in line and offset, link drive, knuckle joint) under its own law: the
     default cam keeps every limit, its ends join."""

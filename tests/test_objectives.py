@@ -115,6 +115,7 @@ def test_tradeoff_never_worse_than_the_baseline(path: Path, objective: str, star
         assert all(b > a for a, b in zip(rms, rms[1:], strict=False))
 
 
+@pytest.mark.slow  # about 6 s a case
 @pytest.mark.parametrize(("path", "start", "count"), [(CUP, 20.0, 7), (SIDE_PANEL, 5.0, 2)], ids=["cup", "side panel"])
 def test_min_grid_peak_never_worse_than_the_baseline(path: Path, start: float, count: int) -> None:
     """The least grid peak at each rate (no storage: the grid sees the bus, here the motors' shaft power):

@@ -330,6 +330,7 @@ def test_a_swing_with_its_drive_mirrors_and_balances(tmp_path):
     forward_tm = np.interp(tau, t, c["motor_torque_Nm"])
     backward_tm = np.interp(back0 + tau, t, c["motor_torque_Nm"])
     assert np.max(np.abs(backward_tm + forward_tm)) < 1e-3 * np.max(np.abs(forward_tm))
+@pytest.mark.slow  # about 4 s
 
 
 def test_a_swing_with_its_electrical_side_balances_from_the_trajectory(tmp_path):
@@ -361,6 +362,7 @@ def test_a_swing_with_its_electrical_side_balances_from_the_trajectory(tmp_path)
     assert float(np.trapezoid(c["grid_power_kW"], t)) == pytest.approx(p["grid_energy_kJ"], rel=3e-3)  # (switches)
     assert float(np.max(c["grid_power_kW"])) == pytest.approx(p["grid_peak_kW"], rel=1e-9)
     assert p["grid_energy_kWh_per_1000_strokes"] == pytest.approx(p["grid_energy_kJ"] / 2 / 3.6, rel=1e-12)
+@pytest.mark.slow  # two solves with the grid: about 14 s
 
 
 def test_a_grid_limit_caps_the_swings_bus_power(tmp_path, capsys):

@@ -215,6 +215,7 @@ def test_a_robot_that_is_no_section_is_one_line(robot, words, tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and words in err[0] and str(path) in err[0]
     assert not (tmp_path / "out").exists()
+@pytest.mark.slow  # about 6 s
 
 
 def test_in_turns_the_next_windows_unloader_waits_for_the_loader():

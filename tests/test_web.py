@@ -218,6 +218,7 @@ def test_downloads_equal_the_files_of_solve(page, tmp_path: Path) -> None:
     assert shown[len(expected) :] == [["the cycle", "", ", ".join(cli_result["binding_over_cycle"])]]
 
 
+@pytest.mark.slow  # the browser: about 4 s
 @browser
 def test_two_pages_stay_separate(site) -> None:
     url, browser = site
@@ -760,6 +761,7 @@ def test_a_drive_added_and_its_forming_force_edited_in_the_page(page) -> None:
     assert page.locator("#add-drive").count() == 1
 
 
+@pytest.mark.slow  # the browser: about 4 s
 @browser
 def test_the_cam_is_proved_on_the_page_and_downloaded_as_the_cli_writes_it(page, tmp_path: Path) -> None:
     """The cam panel, with the mouse: a CODESYS cam of the confirmed plan is proved (its numbers beside the

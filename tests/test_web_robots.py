@@ -85,6 +85,7 @@ def test_the_robots_fields_edit_the_plan(page) -> None:
     assert page.evaluate("state.last.result.verified")
     assert spm(page) < fast
     assert page.errors == []
+@pytest.mark.slow  # the browser: about 6 s
 
 
 def test_robots_added_and_removed(page) -> None:
