@@ -28,6 +28,11 @@ IPOPT often crawls for hundreds of iterations where the baseline's dwell is long
 is the verified plan with the lowest exact objective (``planning.solver.solution.objective_value``, from
 the drive's figures every verified plan carries); the baseline is one candidate, so the answer never
 does worse than waiting, and ``AtRate.improved`` says whether a solve beat it.
+
+Under the optimal law the same steps run on its free profile's rate NLP (``planning.solver.free_nlp``,
+``rate``; ``min-grid-peak`` is refused with it): its baseline lengthens the robot's window phase instead of a
+dwell (it has none, :func:`dwell_s`), its starts are its plans sampled onto the rate NLP's layout, and a draw at
+constant slide speed weighs its draw time first (:data:`DRAW_FIRST`), so the slide keeps its set speed.
 """
 
 from __future__ import annotations
