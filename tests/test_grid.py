@@ -426,6 +426,7 @@ def test_a_grid_limit_below_the_draws_power_is_refused_before_solving(tmp_path, 
         assert code == 3 and "drive.grid.peak_power_kW = 1000" in err and "139.2 deg" in err and "1389 kW" in err
         assert words in err
     assert not (tmp_path / "o").exists()
+@pytest.mark.slow  # about 3 s
 
 
 def test_min_energy_counts_the_losses():

@@ -218,6 +218,7 @@ def _optimal_cup(objective: str):  # noqa: ANN202 - a Case
     data["limits"]["crank_jerk_rad_s3"] = 4000.0
     data["planner"] = {"motion_law": "optimal", "objective": objective, "target_spm": 30.0}
     return case_from_data(data, "x.yaml")
+@pytest.mark.slow  # three solves: about 5 s
 
 
 def test_the_optimal_law_plans_at_a_rate() -> None:

@@ -160,6 +160,7 @@ robots:
 """
 
 
+@pytest.mark.slow  # about 4 s a stroke
 @pytest.mark.parametrize("mode", ["pendulum", "rotary"])
 def test_a_lone_robot_dwells_between_the_draws(mode, tmp_path):
     """An outside trial's case: a lone unloader whose tool needs less than the draw's heights, gripping 1 s. It

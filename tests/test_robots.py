@@ -392,6 +392,7 @@ def test_in_turns_the_loader_is_back_before_the_next_unloader_leaves() -> None:
     starts["loader"] += wrap.value + 0.01  # its return 10 ms after the next unloader has left
     moved = evaluate(replace(solution.plan, robot_starts_s=starts), case, least_energy=False)
     assert any(c.name.startswith("the loader back before") for c in moved.verification.failures())
+@pytest.mark.slow  # about 4 s
 
 
 def test_a_robot_slower_than_the_plan_fails_its_check_without_an_exception() -> None:
