@@ -201,6 +201,7 @@ def test_the_certified_bound_is_above_the_independent_optimum_at_each_jerk_limit
 # issue 28's targets for the optimal law on the published case: within 0.1 % of the independent optimum at
 # 3263 rad/s^3, and no lower than before at 32.63 rad/s^3
 OPTIMAL_LAW_AT_LEAST_SPM = {32.63: 12.397, 3263: 13.023}
+@pytest.mark.slow  # about 3 s
 
 
 def test_the_optimal_law_comes_up_to_the_independent_optimum_at_any_jerk_limit(case):

@@ -137,8 +137,9 @@ def test_splitting_a_half_keeps_its_motion(law, cut):
 
 
 # a draw at constant slide speed is the optimal law's alone (tests/test_slide_draw.py)
-WITH_HALVES = [  # the robots' case and the servo-limited side panel (3-4 s a law) in the slow tier
-    pytest.param(p, marks=pytest.mark.slow) if read_case(p).robots is not None or "servo" in p.stem else p
+SLOW_LAWS = ("side-panel-servo", "link-drive", "knuckle-joint")  # 1.5-3 s a law
+WITH_HALVES = [  # the robots' case, the servo-limited side panel and the linkages in the slow tier
+    pytest.param(p, marks=pytest.mark.slow) if read_case(p).robots is not None or p.stem.startswith(SLOW_LAWS) else p
     for p in CASES
     if not read_case(p).free_draw
 ]

@@ -393,6 +393,7 @@ def swinging(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, Path]:
     """The slow line with its second press in pendulum strokes (docs/line.md)."""
     out = tmp_path_factory.mktemp("swinging")
     return _run(DATA / "slow.yaml", out, "--set", "second.planner.mode=pendulum"), out
+@pytest.mark.slow  # a line with a swinging press: about 10 s
 
 
 def test_a_pendulum_press_swings_once_a_master_cycle_its_robots_every_cycle(swinging: tuple[dict, Path]) -> None:

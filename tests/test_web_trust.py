@@ -126,6 +126,7 @@ def test_d2_the_bound_answering_after_a_refused_upload_throws_nothing(page, tmp_
         held[0].continue_()
     page.wait_for_timeout(300)  # the answer's handler has run
     assert page.console == []
+@pytest.mark.slow  # the browser: the slow tier keeps the fast one under 5 minutes
 
 
 def test_d3_the_same_file_uploaded_again_is_read_again(page, tmp_path: Path) -> None:
@@ -140,6 +141,7 @@ def test_d3_the_same_file_uploaded_again_is_read_again(page, tmp_path: Path) -> 
     choose_file(page, mine)
     wait_rendered(page, before)
     assert form_value(page, "process.transfer_time_s") == "2.5"
+@pytest.mark.slow  # the browser: the slow tier keeps the fast one under 5 minutes
 
 
 def test_d4_the_case_list_follows_an_upload(page, tmp_path: Path) -> None:
@@ -179,6 +181,7 @@ def test_d5_a_normal_session_leaves_the_console_empty(page, tmp_path: Path) -> N
     page.wait_for_function("document.querySelector('#cam-message').textContent !== ''", timeout=60_000)
     page.wait_for_timeout(300)
     assert page.console == []
+@pytest.mark.slow  # the browser: the slow tier keeps the fast one under 5 minutes
 
 
 def test_d6_the_badge_names_the_plan_shown_and_downloads_wait_for_a_good_value(page) -> None:
@@ -244,6 +247,7 @@ def test_d7_one_screen_at_every_size_with_nothing_overprinted(site, width: int, 
         assert console == []
     finally:
         context.close()
+@pytest.mark.slow  # the browser: the slow tier keeps the fast one under 5 minutes
 
 
 def test_the_chart_follows_a_resize_and_six_panels_overprint_nothing(site) -> None:
@@ -269,6 +273,7 @@ def test_the_chart_follows_a_resize_and_six_panels_overprint_nothing(site) -> No
         assert console == []
     finally:
         context.close()
+@pytest.mark.slow  # the browser: the slow tier keeps the fast one under 5 minutes
 
 
 def test_typing_back_to_the_solved_value_restores_the_status(page) -> None:
@@ -282,6 +287,7 @@ def test_typing_back_to_the_solved_value_restores_the_status(page) -> None:
     page.keyboard.press("Tab")
     page.wait_for_timeout(400)  # past the typing pause
     assert page.locator("#status").inner_text().startswith("improved-s-curve, free placement, verified")
+@pytest.mark.slow  # the browser: the slow tier keeps the fast one under 5 minutes
 
 
 def test_d8_one_quantity_per_axis_and_a_far_limit_written_not_drawn(page) -> None:
@@ -377,6 +383,7 @@ def test_d10_a_radians_typo_is_warned_beside_its_field(page) -> None:
     assert page.evaluate("document.body.dataset.state") == "ready"
     edit(page, "key_points.closing_deg", "66")
     assert page.locator('.warn[data-warn-for="key_points.closing_deg"]').inner_text() == ""
+@pytest.mark.slow  # the browser: the slow tier keeps the fast one under 5 minutes
 
 
 def test_each_limits_use_is_a_bar_in_the_cases_order_binding_ones_marked(page) -> None:
@@ -394,6 +401,7 @@ def test_each_limits_use_is_a_bar_in_the_cases_order_binding_ones_marked(page) -
     binding = {r[0] for r in rows if r[1]}
     assert binding == {c.name for c in solution.verification.checks if c.binds and c.kind in ("max", "min")}
     assert binding and all(r[2] == "100 %" for r in rows if r[1])
+@pytest.mark.slow  # the browser: the slow tier keeps the fast one under 5 minutes
 
 
 def test_undo_and_redo_walk_the_edits(page) -> None:
@@ -420,6 +428,7 @@ def test_undo_and_redo_walk_the_edits(page) -> None:
     page.keyboard.press("Control+KeyZ")
     wait_rendered(page, before)
     assert form_value(page, "process.transfer_time_s") == "2.5"
+@pytest.mark.slow  # the browser: the slow tier keeps the fast one under 5 minutes
 
 
 def test_a_decimal_comma_is_a_decimal_point(page) -> None:
@@ -437,6 +446,7 @@ def test_a_decimal_comma_is_a_decimal_point(page) -> None:
     assert page.evaluate("caseFromForm().process.transfer_time_s") == 2.5
     assert page.evaluate("document.body.dataset.state") == "ready"
     assert page.locator('.msg[data-for="process.transfer_time_s"]').inner_text() == ""
+@pytest.mark.slow  # the browser: the slow tier keeps the fast one under 5 minutes
 
 
 def test_a_recipe_is_saved_under_a_name_and_reopened(site, page) -> None:
