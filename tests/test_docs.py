@@ -33,6 +33,7 @@ SLOW_BLOCKS = ("pressplan line ",)  # commands of tens of seconds (a whole press
 
 def _slow(command: str) -> bool:
     return command.startswith(SLOW_BLOCKS)
+@pytest.mark.slow  # the slow tier keeps the fast one under 5 minutes
 
 
 def test_every_shown_output_is_what_the_command_prints_now():

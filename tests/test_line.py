@@ -44,6 +44,7 @@ def fast(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, Path]:
 def slow(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, Path]:
     out = tmp_path_factory.mktemp("slow")
     return _run(DATA / "slow.yaml", out), out
+@pytest.mark.slow  # the slow tier keeps the fast one under 5 minutes
 
 
 def test_fast_transfers_leave_the_line_at_its_slowest_press(fast: tuple[dict, Path]) -> None:
@@ -53,6 +54,7 @@ def test_fast_transfers_leave_the_line_at_its_slowest_press(fast: tuple[dict, Pa
     assert result["spm"] == pytest.approx(min(alone), rel=1e-9)
     assert result["bottleneck"]["kind"] == "press"
     assert result["bottleneck"]["name"] == result["stations"][int(np.argmin(alone))]["name"]
+@pytest.mark.slow  # the slow tier keeps the fast one under 5 minutes
 
 
 def test_a_slow_transfer_binds_the_line_and_the_summary_names_it(slow: tuple[dict, Path]) -> None:
@@ -69,6 +71,7 @@ def test_a_slow_transfer_binds_the_line_and_the_summary_names_it(slow: tuple[dic
     assert f"bottleneck: robot first->second's loop = {loop}" in summary
 
 
+@pytest.mark.slow  # the slow tier keeps the fast one under 5 minutes
 @pytest.mark.parametrize("name", ["fast", "slow"])
 def test_written_timings_replayed_hold_every_clearance(name: str, request: pytest.FixtureRequest) -> None:
     result, out = request.getfixturevalue(name)
@@ -76,6 +79,7 @@ def test_written_timings_replayed_hold_every_clearance(name: str, request: pytes
     assert clearance >= -REPLAY_TOL_MM
     assert gap >= -REPLAY_TOL_S
     assert not both
+@pytest.mark.slow  # the slow tier keeps the fast one under 5 minutes
 
 
 def test_the_replay_finds_a_loader_started_late(fast: tuple[dict, Path]) -> None:
@@ -85,6 +89,7 @@ def test_the_replay_finds_a_loader_started_late(fast: tuple[dict, Path]) -> None
     moved["stations"][0]["robot_starts_s"]["loader"] += 0.02
     clearance, _, _ = _replay(moved, out, DATA / "fast.yaml")
     assert clearance < -1.0
+@pytest.mark.slow  # the slow tier keeps the fast one under 5 minutes
 
 
 def test_the_replay_finds_a_press_shifted_on_the_master(slow: tuple[dict, Path]) -> None:
@@ -95,6 +100,7 @@ def test_the_replay_finds_a_press_shifted_on_the_master(slow: tuple[dict, Path])
         moved["stations"][1]["robot_starts_s"][role] += 0.05
     _, gap, _ = _replay(moved, out, DATA / "slow.yaml")
     assert gap < -0.01
+@pytest.mark.slow  # the slow tier keeps the fast one under 5 minutes
 
 
 def test_the_line_verification_fails_a_press_off_its_offset(
@@ -199,6 +205,7 @@ def test_a_line_slower_than_a_press_can_turn_is_infeasible_naming_it(
     assert main(["line", str(path), "--out", str(tmp_path / "out"), "--no-plots"]) == 3
     err = capsys.readouterr().err
     assert "robot first->second" in err and "station second" in err and "min_crank_speed_rpm" in err, err
+@pytest.mark.slow  # the slow tier keeps the fast one under 5 minutes
 
 
 def test_a_sweep_over_a_transfer_speed(tmp_path: Path) -> None:

@@ -40,7 +40,7 @@ def with_jerk(case, jerk: float, law: str = "optimal"):  # noqa: ANN001, ANN201 
 # constant slide speed not the laws' with halves (tests/test_slide_draw.py): neither compares the two
 WITHOUT_HOLD = [p for p in CASES if not read_case(p).free_draw]
 # the robots' case (about 30 s) and the linkages (about 6 s each) in the slow tier
-SLOW_BEATEN = ("robots", "link-drive", "knuckle-joint", "side-panel-servo-limits")
+SLOW_BEATEN = ("robots", "link-drive", "knuckle-joint", "side-panel-servo-limits", "small-fast-cup", "cup-2000kN")
 BEATEN = [
     pytest.param(p, marks=pytest.mark.slow) if p.stem.startswith(SLOW_BEATEN) or "robots" in p.stem else p
     for p in WITHOUT_HOLD

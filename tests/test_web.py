@@ -91,6 +91,7 @@ def screenshot(tab, name: str) -> None:  # noqa: ANN001
     tab.screenshot(path=str(ARTIFACTS / f"{name}.png"), full_page=True)
 
 
+@pytest.mark.slow  # the slow tier keeps the fast one under 5 minutes
 @browser
 def test_page_shows_what_the_cli_gives_and_follows_an_edit(page) -> None:
     assert page.locator("#case-label").inner_text() == LABEL
