@@ -29,6 +29,7 @@ import numpy as np
 from planning.model.case import RPM, Case
 from planning.model.cycle import HOLD_SEGMENT
 from planning.model.laws import get_law
+from planning.model.limits.base import trapezoid
 from planning.model.limits.grid import EXCESS_SMOOTHING, bus_power
 from planning.model.pendulum import TWO_PI, forming_on_path
 from planning.model.profile import advance_segment
@@ -183,18 +184,14 @@ def _grid_rows(case: Case, add: Any, drives: dict[str, DriveSamples], limits: di
     ``integral (P_bus - L)+ dt`` (a smooth max, trapezoids over the swing's samples), within what the storage can
     give, ``eta_s U``: each swing's draw is carried by the storage apart, which recharges between them (its exact
     periodic schedule over the cycle is the dense check's, ``planning.solver.peak_shaving``)."""
-    d = case.drive
-    copper = d.motor.copper_loss_at_rated_kW * 1e3 / d.motor.rated_torque_Nm**2
-    limit = d.grid.peak_power_kW * 1e3
+    limit = case.drive.grid.peak_power_kW * 1e3
     eps = EXCESS_SMOOTHING * limit
     for samples in drives.values():
-        power = bus_power(samples.tm, samples.speed, copper, d.converter_efficiency)
+        power = _bus_power(case, samples)
         add("grid peak power", power / limits["grid_cap"], -math.inf, 1.0, GRID)
         if "grid_allowance" in limits:
             excess = (power - limit + ca.sqrt((power - limit) ** 2 + eps**2)) / 2
-            n = samples.times.shape[0]
-            t = samples.times
-            energy = ca.sum1((t[1:n] - t[0 : n - 1]) * (excess[1:n] + excess[0 : n - 1]) / 2)
+            energy = trapezoid(excess, samples.times)
             add("storage energy above the grid limit", energy / limits["grid_allowance"], -math.inf, 1.0, GRID)
 
 
@@ -202,11 +199,15 @@ def bus_peak_rows(case: Case, add: Any, drives: dict[str, DriveSamples], peak: A
     """min-grid-peak (``planning.solver.pendulum_rate``): the bus power ``(T_m omega_m + k T_m^2) / eta_c`` at or
     below the epigraph variable ``peak`` [W] at every sample of both swings (``unit`` [W] scales the rows); the
     standstills' holding copper loss is far below any peak."""
+    for samples in drives.values():
+        add("bus power under its peak", (_bus_power(case, samples) - peak) / unit, -math.inf, 0.0, "planner.objective")
+
+
+def _bus_power(case: Case, samples: DriveSamples) -> Any:
+    """The bus power [W] at a swing's samples, ``(T_m omega_m + k T_m^2) / eta_c`` (``planning.model.limits.grid``)."""
     d = case.drive
     copper = d.motor.copper_loss_at_rated_kW * 1e3 / d.motor.rated_torque_Nm**2
-    for samples in drives.values():
-        power = bus_power(samples.tm, samples.speed, copper, d.converter_efficiency)
-        add("bus power under its peak", (power - peak) / unit, -math.inf, 0.0, "planner.objective")
+    return bus_power(samples.tm, samples.speed, copper, d.converter_efficiency)
 
 
 def draw_torque(case: Case, setup: Any, speed: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
