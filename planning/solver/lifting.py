@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import casadi as ca
+import numpy as np
 
 from press.jets import Jet
 
@@ -78,6 +79,17 @@ class Lift:
         return ca.vertcat(*coefficients, unused)
 
 
+# a Hessian is symmetric: CasADi colours its columns for a symmetric matrix (star colouring), which needs far
+# fewer directional sweeps than a general Jacobian's colouring where a row is dense (the period's, the motor's RMS
+# integral): the optimal law's Hessian on a layout of 624 segments builds in 0.06 s instead of 2.7 s and
+# evaluates in 13.5 ms instead of 92 ms (the same matrix)
+SYMMETRIC = {"symmetric": True}
+# a row of a constraint Jacobian that depends on more than this many variables is dense (the period's, the RMS
+# torque's integral): CasADi colours a Jacobian's columns (forward sweeps) or its rows (adjoint sweeps), and a dense
+# row with a dense column (a phase's step) needs as many sweeps as the smaller dimension; the dense rows apart (one
+# adjoint sweep each) and the rest by columns, the optimal law's constraint Jacobian on 624 segments builds in
+# 0.06 s instead of 1.5 s and evaluates in 7 ms instead of 32 ms
+DENSE_ROW = 64
 CAPACITY = 6  # lifted quantities per sample at most: the height and two derivatives, three link terms
 
 
@@ -86,6 +98,17 @@ def _column(value: Any, like: Any) -> Any:
     if isinstance(value, (ca.SX, ca.MX, ca.DM)) and value.shape[0] == like.shape[0]:
         return value
     return value * type(like).ones(like.shape[0])
+
+
+def row_split_jacobian(rows: Any, x: Any) -> Any:
+    """``d rows / d x``, its dense rows (:data:`DENSE_ROW`) differentiated apart from the others: the same matrix."""
+    counts = np.diff(np.array(ca.jacobian_sparsity(rows, x).T.colind()))  # the variables of each row
+    dense = np.flatnonzero(counts > DENSE_ROW)
+    if dense.size == 0 or dense.size == counts.size:
+        return ca.jacobian(rows, x)
+    sparse = np.flatnonzero(counts <= DENSE_ROW)
+    stacked = ca.vertcat(ca.jacobian(rows[sparse.tolist()], x), ca.jacobian(rows[dense.tolist()], x))
+    return stacked[np.argsort(np.concatenate([sparse, dense])).tolist(), :]
 
 
 def lifted_problem(problem: dict, lift: Lift) -> tuple[ca.Function, dict]:
@@ -103,16 +126,16 @@ def lifted_problem(problem: dict, lift: Lift) -> tuple[ca.Function, dict]:
     lam_f, lam_g = sym.sym("lam_f"), sym.sym("lam_g", g.shape[0])
 
     grad = ca.gradient(f, x) + ca.mtimes(J.T, ca.mtimes(E.T, ca.gradient(f, eta)))
-    jac = ca.jacobian(g, x) + ca.mtimes(ca.jacobian(g, eta), ca.mtimes(E, J))
+    jac = row_split_jacobian(g, x) + ca.mtimes(row_split_jacobian(g, eta), ca.mtimes(E, J))
     lagrangian = lam_f * f + ca.dot(lam_g, g)
     l_x, l_eta = ca.gradient(lagrangian, x), ca.gradient(lagrangian, eta)
     cross = ca.mtimes(ca.jacobian(l_eta, x).T, ca.mtimes(E, J))
     curvature = ca.sum2(ca.reshape(l_eta * e2, n, -1))  # sum over the quantities of each sample
-    inner = ca.mtimes(E.T, ca.mtimes(ca.jacobian(l_eta, eta), E)) + ca.diag(curvature)
+    inner = ca.mtimes(E.T, ca.mtimes(ca.jacobian(l_eta, eta, SYMMETRIC), E)) + ca.diag(curvature)
     weights = sym.sym("weights", n)
     angles_hessian = ca.hessian(ca.dot(weights, lift.angle_values), x)[0]
     angles_hessian = ca.substitute(angles_hessian, weights, ca.mtimes(E.T, l_eta))  # the law's part only
-    hessian = ca.jacobian(l_x, x) + cross + cross.T + ca.mtimes(J.T, ca.mtimes(inner, J)) + angles_hessian
+    hessian = ca.jacobian(l_x, x, SYMMETRIC) + cross + cross.T + ca.mtimes(J.T, ca.mtimes(inner, J)) + angles_hessian
 
     angles = ca.Function("lifted_angles", [x, p], [lift.angle_values])
     coefficients = [lift.columns(lift.values), lift.columns(lift.first), lift.columns(lift.second)]
