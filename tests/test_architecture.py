@@ -178,6 +178,7 @@ CASADI_MODULES = {  # the wrapper and the modules that build expressions for it
     "planning.solver.pendulum_robots",  # its rows (the dense checks beside them load no CasADi)
     "planning.solver.bound",
     "planning.solver.upper_bound",
+    "planning.solver.compiled",  # the derivatives compiled by CasADi's code generator
     "planning.solver.peak_shaving",  # the peak-shaving linear programme (HiGHS through casadi.conic)
 }
 

@@ -24,12 +24,14 @@ import signal
 import sys
 import threading
 import time
+import weakref
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
 
+from planning.solver.compiled import COMPILED_FUNCTIONS, cached_functions, compile_into_cache
 from planning.solver.lifting import Lift, lifted_problem, row_split_jacobian
 from planning.tolerances import IPOPT_MU_INIT, IPOPT_TOL, IPOPT_WARM_PUSH
 
@@ -53,6 +55,7 @@ WARM_START_OPTIONS = {  # a start from a nearby solution and its multipliers: a 
     "ipopt.warm_start_slack_bound_push": IPOPT_WARM_PUSH,
 }
 
+BUILT: weakref.WeakSet = weakref.WeakSet()  # the process's solvers of SX problems (``pressplan compile`` compiles them)
 # nlpsol's options that take a derivative function, and the name of that function in a built solver
 DERIVATIVE_FUNCTIONS = {"grad_f": "nlp_grad_f", "jac_g": "nlp_jac_g", "hess_lag": "nlp_hess_l"}
 
@@ -128,8 +131,35 @@ class NLPSolver:
             self.options.update(derivatives)
         self.problem = problem  # a dict of expressions, or (lifted) a function of x and p
         self.warm_options = {**WARM_START_OPTIONS, **(warm_options or {})}
+        # an SX problem's derivatives compiled to machine code where the cache holds them (``compiled``)
+        self.compilable = isinstance(problem, dict) and not isinstance(problem["x"], ca.MX)
+        found = cached_functions(problem) if self.compilable else None
+        self.options.update(found or {})
+        self.compiled = found is not None
         self._cold = _compiled(name, problem, self.options)
         self._warm: ca.Function | None = None
+        if self.compilable:
+            BUILT.add(self)
+
+    def compile(self) -> float | None:
+        """Compile this problem's derivative functions into the cache (``planning.solver.compiled``) and solve
+        with them from now on; the seconds the compiler took (0: they were there), or None where this problem
+        cannot be compiled (an MX or lifted problem) or there is no compiler or no cache (said once)."""
+        if not self.compilable:
+            return None
+        if self.compiled:
+            return 0.0
+        functions = {option: self._cold.get_function(name) for option, name in COMPILED_FUNCTIONS.items()}
+        seconds = compile_into_cache(self.problem, functions)
+        found = cached_functions(self.problem) if seconds is not None else None
+        if found is None:
+            return None
+        with _IPOPT_LOCK:  # a thread may be solving with the interpreted functions
+            self.options.update(found)
+            self._cold = _compiled(self.name, self.problem, self.options)
+            self._warm = None
+            self.compiled = True
+        return seconds
 
     def _warm_function(self) -> ca.Function:
         if self._warm is None:

@@ -1,0 +1,106 @@
+"""The NLPs' derivative functions compiled into the cache (``planning.solver.compiled``): the same functions (the
+same numbers, the same IPOPT iterations), loaded by a later solver of the same problem, and a clear fallback where
+there is no cache or no compiler."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from planning.solver import compiled
+from planning.solver.ipopt import NLPSolver
+from tests.conftest import PUBLISHED_CASE
+
+
+def _problem() -> dict:
+    """A small SX problem with curvature in its objective and rows (a Rosenbrock valley under a disc and a line)."""
+    x, p = ca.SX.sym("x", 3), ca.SX.sym("p", 1)
+    f = (1 - x[0]) ** 2 + p[0] * (x[1] - x[0] ** 2) ** 2 + (x[2] - x[1]) ** 2
+    g = ca.vertcat(ca.sumsqr(x) - 2.0, x[0] + ca.sin(x[1]) * x[2])
+    return {"x": x, "p": p, "f": f, "g": g}
+
+
+def _solve(solver: NLPSolver):
+    return solver.solve(np.array([-1.2, 1.0, 0.5]), [-5] * 3, [5] * 3, [-np.inf, -1.0], [0.0, 1.5], p=np.array([100.0]))
+
+
+@pytest.fixture
+def cache(tmp_path, monkeypatch):
+    monkeypatch.setenv(compiled.CACHE_ENV, str(tmp_path / "cache"))
+    return tmp_path / "cache"
+
+
+@pytest.mark.skipif(compiled.compiler() is None, reason="no C compiler on this machine")
+def test_compiled_derivatives_are_the_interpreted_ones_and_a_later_solver_loads_them(cache):
+    solver = NLPSolver("toy", _problem())
+    assert not solver.compiled
+    interpreted = _solve(solver)
+    assert solver.compile() > 0
+    assert solver.compiled and len(list(cache.glob("*.so"))) == 2
+    again = _solve(solver)
+    loaded = NLPSolver("toy", _problem())  # a later process's solver of the same problem: found in the cache
+    assert loaded.compiled and loaded.compile() == 0.0
+    for result in (again, _solve(loaded)):
+        assert np.array_equal(result.x, interpreted.x) and result.iterations == interpreted.iterations
+    # the compiled functions give the interpreted ones' numbers
+    x, p, lam = np.array([0.3, -0.7, 1.1]), np.array([100.0]), np.array([0.4, -2.0])
+    for name in compiled.COMPILED_FUNCTIONS.values():
+        fast, slow = loaded._cold.get_function(name), NLPSolver("toy", _problem())._cold.get_function(name)
+        args = [x, p, 1.0, lam] if name == "nlp_hess_l" else [x, p]
+        a, b = fast.call(args), slow.call(args)  # every output, as a list
+        assert len(a) == len(b) and all(np.array_equal(np.array(u), np.array(v)) for u, v in zip(a, b, strict=True))
+    other = _problem()
+    other["f"] = other["f"] + other["x"][2] ** 4  # another problem: another key, not found
+    assert not NLPSolver("toy", other).compiled
+
+
+def test_without_a_cache_or_a_compiler_the_functions_stay_interpreted_said_once(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(compiled, "_said", set())
+    monkeypatch.setenv(compiled.CACHE_ENV, "off")
+    solver = NLPSolver("toy", _problem())
+    assert solver.compile() is None and solver.compile() is None and not solver.compiled
+    assert capsys.readouterr().err.count("no cache (PRESSPLAN_CACHE=off)") == 1
+    monkeypatch.setenv(compiled.CACHE_ENV, str(tmp_path))
+    monkeypatch.setattr(compiled, "compiler", lambda: None)
+    assert solver.compile() is None
+    assert "no C compiler" in capsys.readouterr().err
+    assert _solve(solver).success  # interpreted, as before
+    mx = {k: v for k, v in zip("xpfg", (ca.MX.sym("x", 1), ca.MX.sym("p", 0), 0, 0), strict=True)}
+    mx["f"], mx["g"] = mx["x"] ** 2, mx["x"]
+    assert NLPSolver("mx", mx).compile() is None  # an MX problem is not compiled
+
+
+@pytest.mark.slow  # compiling the published case's NLP takes some 20 s
+@pytest.mark.skipif(compiled.compiler() is None, reason="no C compiler on this machine")
+def test_pressplan_compile_then_solve_gives_the_same_plan(tmp_path):
+    env = {"PRESSPLAN_CACHE": str(tmp_path / "cache"), "PATH": "/usr/bin:/bin"}
+    cli = [sys.executable, "-m", "planning.cli"]
+    done = subprocess.run([*cli, "compile", str(PUBLISHED_CASE)], env=env, capture_output=True, text=True)
+    assert done.returncode == 0 and "1 NLP(s) compiled" in done.stdout, done.stderr
+    plans = {}
+    for name, cache in (("compiled", env["PRESSPLAN_CACHE"]), ("interpreted", "off")):
+        out = tmp_path / name
+        args = [*cli, "solve", str(PUBLISHED_CASE), "--no-plots", "--out", str(out)]
+        subprocess.run(args, env={**env, "PRESSPLAN_CACHE": cache}, check=True, capture_output=True)
+        plans[name] = json.loads((out / "result.json").read_text())
+    a, b = plans["compiled"], plans["interpreted"]
+    assert a["spm"] == b["spm"] and a["solver"]["iterations"] == b["solver"]["iterations"]
+
+
+def test_a_damaged_library_or_an_unwritable_cache_leaves_the_functions_interpreted(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(compiled, "_said", set())
+    monkeypatch.setenv(compiled.CACHE_ENV, str(tmp_path))
+    key = compiled.problem_key(_problem())
+    for name in compiled.COMPILED_FUNCTIONS.values():
+        (tmp_path / f"{key}_{name}.so").write_bytes(b"not a library")
+    solver = NLPSolver("toy", _problem())
+    assert not solver.compiled and _solve(solver).success
+    assert "does not load" in capsys.readouterr().err
+    monkeypatch.setenv(compiled.CACHE_ENV, str(tmp_path / "file" / "cache"))
+    (tmp_path / "file").write_text("a file where the cache's folder would go")
+    assert solver.compile() is None and "not compiled" in capsys.readouterr().err
