@@ -222,11 +222,11 @@ def _other_commands(sub) -> None:  # noqa: ANN001 - argparse's sub-parsers
         cm.add_argument(option.flag, **option.kwargs)
     co = sub.add_parser(
         "compile",
-        help="compile the NLPs a case takes to machine code, kept for every later solve (a C compiler)",
+        help="compile the NLPs a case takes to machine code, kept for every later solve (needs a C compiler)",
         description="Solve the case, compile the derivative functions of the NLPs it took (their Jacobian and "
         "Hessian, evaluated at every iteration) with the C compiler into a cache ($PRESSPLAN_CACHE, default "
         "~/.cache/pressplan), and solve it again: every later solve of those NLPs (solve, sweep's workers, the web "
-        "page) loads them. Some 20 s a problem; the same numbers, faster.",
+        "page) loads them. 20-70 s a problem (a linkage's some minutes); the same numbers, 1.2-1.7x faster.",
     )
     _case_argument(co)
     pl = sub.add_parser("plot", help="redraw the figures of a finished output folder (no solve)")
@@ -856,7 +856,7 @@ def _compile(case, args) -> int:
         return EXIT_OK
     print(
         f"{case.name}: {report.compiled} NLP(s) compiled in {report.seconds:.1f} s, {report.present} found compiled, "
-        f"{report.interpreted} interpreted (MX or lifted) in {report.folder}; a solve took {report.solve_s:.2f} s "
+        f"{report.interpreted} left interpreted, in {report.folder}; a solve took {report.solve_s:.2f} s "
         f"before (its NLPs built), {report.compiled_solve_s:.2f} s after"
     )
     return EXIT_OK

@@ -19,7 +19,7 @@ from planning.solver.solution import Solution
 
 # the tests solve with the interpreted derivative functions, whatever a developer compiled on this machine
 # (``pressplan compile``; the same numbers either way): tests/test_compiled.py sets its own cache
-os.environ.setdefault("PRESSPLAN_CACHE", "off")
+os.environ["PRESSPLAN_CACHE"] = "off"
 ROOT = Path(__file__).resolve().parents[1]
 PUBLISHED_CASE = ROOT / "cases" / "wang2023-side-panel.yaml"
 SHIPPED_CASES = sorted((ROOT / "cases").glob("*.yaml"))

@@ -40,6 +40,7 @@ def test_compiled_derivatives_are_the_interpreted_ones_and_a_later_solver_loads_
     solver = NLPSolver("toy", _problem())
     assert not solver.compiled
     interpreted = _solve(solver)
+    slow_functions = {name: solver._cold.get_function(name) for name in compiled.COMPILED_FUNCTIONS.values()}
     assert solver.compile() > 0
     assert solver.compiled and len(list(cache.glob("*.so"))) == 2
     again = _solve(solver)
@@ -50,7 +51,8 @@ def test_compiled_derivatives_are_the_interpreted_ones_and_a_later_solver_loads_
     # the compiled functions give the interpreted ones' numbers
     x, p, lam = np.array([0.3, -0.7, 1.1]), np.array([100.0]), np.array([0.4, -2.0])
     for name in compiled.COMPILED_FUNCTIONS.values():
-        fast, slow = loaded._cold.get_function(name), NLPSolver("toy", _problem())._cold.get_function(name)
+        fast, slow = loaded._cold.get_function(name), slow_functions[name]
+        assert fast.class_name() != slow.class_name()  # a library against CasADi's interpreter
         args = [x, p, 1.0, lam] if name == "nlp_hess_l" else [x, p]
         a, b = fast.call(args), slow.call(args)  # every output, as a list
         assert len(a) == len(b) and all(np.array_equal(np.array(u), np.array(v)) for u, v in zip(a, b, strict=True))
@@ -100,7 +102,29 @@ def test_a_damaged_library_or_an_unwritable_cache_leaves_the_functions_interpret
         (tmp_path / f"{key}_{name}.so").write_bytes(b"not a library")
     solver = NLPSolver("toy", _problem())
     assert not solver.compiled and _solve(solver).success
-    assert "does not load" in capsys.readouterr().err
+    assert "compiled functions not loaded" in capsys.readouterr().err
+    assert not any(tmp_path.glob("*.so"))  # removed: `pressplan compile` makes them anew
     monkeypatch.setenv(compiled.CACHE_ENV, str(tmp_path / "file" / "cache"))
+    monkeypatch.setattr(compiled, "compiler", lambda: "cc")
     (tmp_path / "file").write_text("a file where the cache's folder would go")
     assert solver.compile() is None and "not compiled" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("kind", [ca.SX, ca.MX])
+def test_the_row_split_jacobian_is_casadis_own(kind):
+    """Dense rows (more than DENSE_ROW variables) apart from sparse ones, in any order, none or all of them dense."""
+    from planning.solver.lifting import DENSE_ROW, row_split_jacobian
+
+    n = DENSE_ROW + 6
+    x = kind.sym("x", n)
+    dense = ca.sum1(ca.sin(x)) * x[0]
+    rows = {
+        "mixed": ca.vertcat(x[1] * x[2], dense, ca.cos(x[3]), ca.sumsqr(x), x[n - 1] ** 3),
+        "sparse only": ca.vertcat(x[1] * x[2], ca.cos(x[3])),
+        "dense only": ca.vertcat(dense, ca.sumsqr(x)),
+    }
+    point = np.linspace(-1.0, 1.0, n)
+    for name, g in rows.items():
+        ours = ca.Function("a", [x], [row_split_jacobian(g, x)])(point)
+        theirs = ca.Function("b", [x], [ca.jacobian(g, x)])(point)
+        assert ours.sparsity() == theirs.sparsity() and np.array_equal(np.array(ours), np.array(theirs)), name

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from planning.model.case import Case
 from planning.solver.compiled import cache_dir
-from planning.solver.ipopt import BUILT
+from planning.solver.ipopt import kept_solvers
 from planning.solver.optimize import solve
 from planning.solver.outcomes import PlanningError
 from planning.solver.pendulum_rate import solve_swings
@@ -21,7 +21,7 @@ from planning.solver.pendulum_rate import solve_swings
 @dataclass(frozen=True)
 class CompileReport:
     """What :func:`compile_nlps` did: ``compiled`` problems compiled now, ``present`` ones found compiled in the
-    cache, ``interpreted`` ones left so (an MX or lifted problem, or no compiler or no cache), the compiler's
+    cache, ``interpreted`` ones left so (no compiler, no cache, or the compiler failed; said), the compiler's
     ``seconds``, the case's solve before and after [s] (``solve_s``, ``compiled_solve_s``) and the cache folder."""
 
     compiled: int
@@ -46,8 +46,9 @@ def compile_nlps(case: Case) -> CompileReport:
             pass  # its NLPs were built all the same
         return time.perf_counter() - t_start
 
-    before = timed()
-    results = [solver.compile() for solver in list(BUILT)]
+    with kept_solvers() as solvers:
+        before = timed()
+        results = [solver.compile() for solver in solvers]
     done = [s for s in results if s is not None]
     after = timed()
     return CompileReport(

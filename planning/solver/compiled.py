@@ -14,6 +14,7 @@ cache, the functions are interpreted as before: said once, never an error.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import platform
@@ -26,9 +27,14 @@ from pathlib import Path
 
 import casadi as ca
 
+from planning.solver import lifting
+from planning.solver.lifting import Lift
+
 CACHE_ENV = "PRESSPLAN_CACHE"
 OFF = "off"
-COMPILER_FLAGS = ("-O1", "-shared", "-fPIC")
+# IEEE arithmetic as written: no fused multiply-adds (an aarch64 compiler's default contracts a * b + c), no fast
+# math; so any conforming C compiler gives the interpreted functions' numbers
+COMPILER_FLAGS = ("-O1", "-ffp-contract=off", "-shared", "-fPIC")
 FORMAT = "1"  # the cache's layout: a change makes every key new
 # nlpsol's options that take a derivative function, and the name of that function in a built solver (the ones
 # evaluated at every iteration)
@@ -37,10 +43,11 @@ _said: set[str] = set()
 
 
 def cache_dir() -> Path | None:
-    """The cache directory (module docstring), or None where it is turned off."""
-    value = os.environ.get(CACHE_ENV)
-    if value is not None:
-        return None if value.strip().lower() == OFF else Path(value)
+    """The cache directory (module docstring; a relative ``PRESSPLAN_CACHE`` from the working directory, an empty
+    one as unset), or None where it is turned off."""
+    value = (os.environ.get(CACHE_ENV) or "").strip()
+    if value:
+        return None if value.lower() == OFF else Path(value).resolve()
     base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
     return Path(base) / "pressplan"
 
@@ -50,48 +57,64 @@ def compiler() -> str | None:
     return shutil.which("cc") or shutil.which("gcc")
 
 
-def problem_key(problem: dict) -> str:
-    """The cache key of an SX problem ``{"x", "p", "f", "g"}`` (module docstring)."""
+def problem_key(problem: dict, lift: Lift | None = None) -> str:
+    """The cache key of an SX problem ``{"x", "p", "f", "g"}`` (module docstring); of a lifted one (``lift``:
+    ``planning.solver.lifting``), the key of what its derivative functions are built from: its rows in ``x``, ``p``
+    and the lifted symbols, the sample angles, the mechanism's coefficients and the lifting's own source."""
     inputs = [problem["x"]] + ([problem["p"]] if "p" in problem else [])
-    serialized = ca.Function("nlp", inputs, [problem["f"], problem["g"]]).serialize()
+    parts = [ca.Function("nlp", inputs + ([lift.symbols] if lift else []), [problem["f"], problem["g"]])]
+    if lift is not None:
+        parts.append(ca.Function("angles", inputs, [lift.angle_values]))
+        parts.append(ca.Function("mechanism", [lift.angles, *inputs[1:]], [*lift.values, *lift.first, *lift.second]))
     salt = "|".join((FORMAT, ca.__version__, platform.machine(), sys.platform, *COMPILER_FLAGS))
-    return "k" + hashlib.sha256(salt.encode() + serialized.encode()).hexdigest()[:32]
+    digest = hashlib.sha256(salt.encode())
+    for part in parts:
+        digest.update(part.serialize().encode())
+    if lift is not None:
+        digest.update(Path(lifting.__file__).read_bytes())
+    return "k" + digest.hexdigest()[:32]
 
 
-def cached_functions(problem: dict) -> dict[str, ca.Function] | None:
-    """The compiled derivative functions of ``problem`` (nlpsol's options) where the cache holds them, else None."""
+def cached_functions(key: str) -> dict[str, ca.Function] | None:
+    """The compiled derivative functions of the problem of ``key`` (nlpsol's options) where the cache holds them,
+    else None: also where the cache cannot be read or a library does not load (said once; a damaged library is
+    removed, so that ``pressplan compile`` makes it anew)."""
     folder = cache_dir()
     if folder is None:
         return None
-    key = problem_key(problem)
     paths = {option: folder / f"{key}_{name}.so" for option, name in COMPILED_FUNCTIONS.items()}
-    if not all(path.is_file() for path in paths.values()):
-        return None
     try:
+        if not all(path.is_file() for path in paths.values()):
+            return None
         return {option: ca.external(COMPILED_FUNCTIONS[option], str(path)) for option, path in paths.items()}
-    except RuntimeError as exc:  # a damaged library: the interpreted functions, as without one
-        _say_once(f"{paths['hess_lag'].parent}: a compiled library does not load ({str(exc).splitlines()[0]})")
+    except (OSError, RuntimeError) as exc:  # unreadable, or a damaged library: interpreted, as without a cache
+        _say_once(f"{folder}: compiled functions not loaded ({str(exc).splitlines()[0]})")
+        for path in paths.values():
+            with contextlib.suppress(OSError):
+                path.unlink(missing_ok=True)
         return None
 
 
-def compile_into_cache(problem: dict, functions: dict[str, ca.Function]) -> float | None:
-    """Compile ``functions`` (nlpsol's options -> the interpreted derivative functions of ``problem``) into the
-    cache; the seconds it took, 0 where they were there already, None where there is no cache or no compiler (said
-    once). Each file is written under a temporary name and renamed: a reader never sees half a library."""
+def compile_into_cache(key: str, functions: dict[str, ca.Function]) -> float | None:
+    """Compile ``functions`` (nlpsol's options -> the interpreted derivative functions of the problem of ``key``)
+    into the cache; the seconds the compiler took (0.0 where every library was there already), None where there is
+    no cache, no compiler, or the compiler or the folder failed (said once). Each file is written under a temporary
+    name and renamed: a reader never sees half a library."""
     folder, cc = cache_dir(), compiler()
     if folder is None or cc is None:
         _say_once("no cache (PRESSPLAN_CACHE=off)" if folder is None else "no C compiler (cc, gcc) on the path")
         return None
-    key, t_start = problem_key(problem), time.perf_counter()
+    t_start, compiled = time.perf_counter(), False
     try:
         folder.mkdir(parents=True, exist_ok=True, mode=0o700)
         for option, name in COMPILED_FUNCTIONS.items():
             if not (folder / f"{key}_{name}.so").is_file():
                 _compile_one(cc, functions[option], folder, f"{key}_{name}")
-    except (OSError, subprocess.CalledProcessError) as exc:
-        _say_once(f"{folder}: not compiled ({exc})")
+                compiled = True
+    except (OSError, RuntimeError, subprocess.CalledProcessError) as exc:  # RuntimeError: CasADi's generator
+        _say_once(f"{folder}: not compiled ({str(exc).splitlines()[0] if str(exc) else type(exc).__name__})")
         return None
-    return time.perf_counter() - t_start
+    return time.perf_counter() - t_start if compiled else 0.0
 
 
 def _compile_one(cc: str, function: ca.Function, folder: Path, stem: str) -> None:

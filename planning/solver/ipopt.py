@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
-from planning.solver.compiled import COMPILED_FUNCTIONS, cached_functions, compile_into_cache
+from planning.solver.compiled import COMPILED_FUNCTIONS, cached_functions, compile_into_cache, problem_key
 from planning.solver.lifting import Lift, lifted_problem, row_split_jacobian
 from planning.tolerances import IPOPT_MU_INIT, IPOPT_TOL, IPOPT_WARM_PUSH
 
@@ -56,6 +56,7 @@ WARM_START_OPTIONS = {  # a start from a nearby solution and its multipliers: a 
 }
 
 BUILT: weakref.WeakSet = weakref.WeakSet()  # the process's solvers of SX problems (``pressplan compile`` compiles them)
+_KEPT: list[list] = []  # while :func:`kept_solvers` runs: the solvers built, held (a solve may drop its NLP)
 # nlpsol's options that take a derivative function, and the name of that function in a built solver
 DERIVATIVE_FUNCTIONS = {"grad_f": "nlp_grad_f", "jac_g": "nlp_jac_g", "hess_lag": "nlp_hess_l"}
 
@@ -126,32 +127,37 @@ class NLPSolver:
         self.fixed_scale = None if fixed_scale is None else np.asarray(fixed_scale, dtype=float)
         self.name = name
         self.options = {**BASE_OPTIONS, **(options or {})}
+        # an SX problem's derivatives (a lifted one's too) compiled to machine code where the cache holds them
+        # (``compiled``): found by the problem's key
+        self.compilable = isinstance(problem, dict) and not isinstance(problem["x"], ca.MX)
+        self.key = problem_key(problem, lift) if self.compilable else None
         if lift is not None:  # the mechanism's quantities lifted out of the derivatives (``lifting``)
             problem, derivatives = lifted_problem(problem, lift)
             self.options.update(derivatives)
         self.problem = problem  # a dict of expressions, or (lifted) a function of x and p
         self.warm_options = {**WARM_START_OPTIONS, **(warm_options or {})}
-        # an SX problem's derivatives compiled to machine code where the cache holds them (``compiled``)
-        self.compilable = isinstance(problem, dict) and not isinstance(problem["x"], ca.MX)
-        found = cached_functions(problem) if self.compilable else None
+        found = cached_functions(self.key) if self.key is not None else None
         self.options.update(found or {})
         self.compiled = found is not None
         self._cold = _compiled(name, problem, self.options)
         self._warm: ca.Function | None = None
         if self.compilable:
             BUILT.add(self)
+            for kept in _KEPT:
+                kept.append(self)
 
     def compile(self) -> float | None:
         """Compile this problem's derivative functions into the cache (``planning.solver.compiled``) and solve
         with them from now on; the seconds the compiler took (0: they were there), or None where this problem
-        cannot be compiled (an MX or lifted problem) or there is no compiler or no cache (said once)."""
+        cannot be compiled (an MX problem), there is no compiler or no cache, or the libraries made do not load
+        (said once)."""
         if not self.compilable:
             return None
         if self.compiled:
             return 0.0
         functions = {option: self._cold.get_function(name) for option, name in COMPILED_FUNCTIONS.items()}
-        seconds = compile_into_cache(self.problem, functions)
-        found = cached_functions(self.problem) if seconds is not None else None
+        seconds = compile_into_cache(self.key, functions)
+        found = cached_functions(self.key) if seconds is not None else None
         if found is None:
             return None
         with _IPOPT_LOCK:  # a thread may be solving with the interpreted functions
@@ -205,11 +211,10 @@ class NLPSolver:
         if p is not None or scale is not None:
             parts = [np.asarray(p, dtype=float)] if p is not None else []
             args["p"] = np.concatenate(parts + ([unit] if scale is not None else []))
-        solver = self._cold
         if warm_start is not None:
-            solver = self._warm_function()
             args.update(lam_x0=warm_start[0], lam_g0=warm_start[1])
-        with _IPOPT_LOCK:
+        with _IPOPT_LOCK:  # the solvers chosen under it too: ``compile`` replaces them under it
+            solver = self._cold if warm_start is None else self._warm_function()
             res = _call_passing_signals_on(solver, args)
             stats = solver.stats()
         x = np.array(res["x"]).ravel() * unit
@@ -224,6 +229,18 @@ class NLPSolver:
             iterations=int(stats["iter_count"]),
             wall_time_s=time.perf_counter() - t0,
         )
+
+
+@contextlib.contextmanager
+def kept_solvers() -> Iterator[list[NLPSolver]]:
+    """The solvers of SX problems built inside the block (held by the list yielded: a solve that builds an NLP for
+    one case only, a pendulum's, lets it go), and those built before that are still alive."""
+    kept: list[NLPSolver] = list(BUILT)
+    _KEPT.append(kept)
+    try:
+        yield kept
+    finally:
+        _KEPT.remove(kept)
 
 
 def _compiled(name: str, problem: dict | ca.Function, options: dict) -> ca.Function:
