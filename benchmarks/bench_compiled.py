@@ -1,12 +1,12 @@
 """The NLPs compiled (``pressplan compile``) against interpreted: the same solves, taking turns.
 
-Compiles the published case's and its drive case's NLPs into a fresh cache (timing the compiler), then measures
-each of these with the cache (``PRESSPLAN_CACHE`` at it) and without (``off``), the two taking turns so that a drift
-of the machine's speed falls on both: the warm in-process solve (a process builds the NLP, solves once, then
-``WARM_RUNS`` times: their median; ``PAIRS`` processes each way), a cold ``pressplan solve --no-plots`` process
-(``COLD_RUNS`` each way) and a 41-point transfer-time sweep on 2 workers (whole process). Every pair's plans are
-checked equal. Writes its section of benchmarks/RESULTS.md. Run: ``python benchmarks/bench_compiled.py`` (about 4
-minutes).
+Compiles the NLPs of the published case, its drive case and the link drive's (lifted) into a fresh cache (timing the
+compiler), then measures each of these with the cache (``PRESSPLAN_CACHE`` at it) and without (``off``), the two
+taking turns so that a drift of the machine's speed falls on both: the warm in-process solve (a process builds the
+NLP, solves once, then ``WARM_RUNS`` times: their median; ``PAIRS`` processes each way), a cold ``pressplan solve
+--no-plots`` process (``COLD_RUNS`` each way) of the published case and a 41-point transfer-time sweep of it on 2
+workers (one whole process each way, interpreted first). The warm solves' plans and iterations are checked equal.
+Writes its section of benchmarks/RESULTS.md. Run: ``python benchmarks/bench_compiled.py`` (about 10 minutes).
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from results_section import write_section  # benchmarks/ is the script's folder
 
 ROOT = Path(__file__).resolve().parents[1]
 BEGIN, END = "<!-- compiled:begin -->", "<!-- compiled:end -->"
-CASES = ("cases/wang2023-side-panel.yaml", "cases/wang2023-side-panel-drive.yaml")
+CASES = ("cases/wang2023-side-panel.yaml", "cases/wang2023-side-panel-drive.yaml", "cases/link-drive-side-panel.yaml")
 PAIRS, WARM_RUNS, COLD_RUNS = 3, 7, 5
 WARM = """
 import statistics, sys, time
