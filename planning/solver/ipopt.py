@@ -7,7 +7,9 @@ multipliers, the iteration count and the wall time. This module and the modules 
 expressions for it (``planning.solver.nlp``, ``planning.solver.halves_nlp``, ``planning.solver.free_nlp``,
 ``planning.solver.bound``, ``planning.solver.lifting``) are the only ones that import CasADi
 (``tests/test_architecture.py`` checks). A problem that samples a lifted mechanism comes with its
-:class:`~planning.solver.lifting.Lift`: its derivative functions are put together by the chain rule.
+:class:`~planning.solver.lifting.Lift`: its derivative functions are put together by the chain rule. An SX
+problem's (a lifted one's too) Jacobian and Hessian come compiled to machine code where the cache holds them
+(``planning.solver.compiled``; :meth:`NLPSolver.compile` puts them there): the same functions, faster.
 
 Scaling: a problem may read a per-solve scale vector from the end of its parameter vector
 (physical value = scale * decision variable). :meth:`NLPSolver.solve` then takes the physical start
