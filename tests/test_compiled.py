@@ -59,6 +59,14 @@ def test_compiled_derivatives_are_the_interpreted_ones_and_a_later_solver_loads_
     other = _problem()
     other["f"] = other["f"] + other["x"][2] ** 4  # another problem: another key, not found
     assert not NLPSolver("toy", other).compiled
+    # a library of another problem's shape under a key (copied there): discarded, the interpreted functions used
+    wider = _problem()
+    wider["g"] = ca.vertcat(wider["g"], wider["x"][0])  # a third row
+    wider_key = compiled.problem_key(wider)
+    for library in list(cache.glob("*.so")) + list(cache.glob("*.sha256")):
+        (cache / library.name.replace(compiled.problem_key(_problem()), wider_key)).write_bytes(library.read_bytes())
+    misfit = NLPSolver("wider", wider)
+    assert not misfit.compiled and not any(cache.glob(f"{wider_key}*"))
 
 
 def test_without_a_cache_or_a_compiler_the_functions_stay_interpreted_said_once(tmp_path, monkeypatch, capsys):
@@ -71,6 +79,9 @@ def test_without_a_cache_or_a_compiler_the_functions_stay_interpreted_said_once(
     monkeypatch.setattr(compiled, "compiler", lambda: None)
     assert solver.compile() is None
     assert "no C compiler" in capsys.readouterr().err
+    monkeypatch.setattr(compiled, "compiler", lambda: "false")  # a compiler that fails: said in one line
+    assert solver.compile() is None
+    assert "not compiled (false failed" in capsys.readouterr().err
     assert _solve(solver).success  # interpreted, as before
     mx = {k: v for k, v in zip("xpfg", (ca.MX.sym("x", 1), ca.MX.sym("p", 0), 0, 0), strict=True)}
     mx["f"], mx["g"] = mx["x"] ** 2, mx["x"]
@@ -98,12 +109,17 @@ def test_a_damaged_library_or_an_unwritable_cache_leaves_the_functions_interpret
     monkeypatch.setattr(compiled, "_said", set())
     monkeypatch.setenv(compiled.CACHE_ENV, str(tmp_path))
     key = compiled.problem_key(_problem())
-    for name in compiled.COMPILED_FUNCTIONS.values():
-        (tmp_path / f"{key}_{name}.so").write_bytes(b"not a library")
-    solver = NLPSolver("toy", _problem())
-    assert not solver.compiled and _solve(solver).success
-    assert "compiled functions not loaded" in capsys.readouterr().err
-    assert not any(tmp_path.glob("*.so"))  # removed: `pressplan compile` makes them anew
+    for digest_of_what_is_there in (False, True):  # a truncated library (its checksum), or one that does not load
+        for name in compiled.COMPILED_FUNCTIONS.values():
+            library = tmp_path / f"{key}_{name}.so"
+            library.write_bytes(b"not a library")
+            text = compiled._digest(library) if digest_of_what_is_there else "0" * 64
+            compiled._digest_path(library).write_text(text)
+        monkeypatch.setattr(compiled, "_said", set())
+        solver = NLPSolver("toy", _problem())
+        assert not solver.compiled and _solve(solver).success
+        assert "a compiled library not used" in capsys.readouterr().err
+        assert not any(tmp_path.iterdir())  # removed: `pressplan compile` makes them anew
     monkeypatch.setenv(compiled.CACHE_ENV, str(tmp_path / "file" / "cache"))
     monkeypatch.setattr(compiled, "compiler", lambda: "cc")
     (tmp_path / "file").write_text("a file where the cache's folder would go")

@@ -19,6 +19,7 @@ import hashlib
 import os
 import platform
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -77,56 +78,101 @@ def problem_key(problem: dict, lift: Lift | None = None) -> str:
 
 def cached_functions(key: str) -> dict[str, ca.Function] | None:
     """The compiled derivative functions of the problem of ``key`` (nlpsol's options) where the cache holds them,
-    else None: also where the cache cannot be read or a library does not load (said once; a damaged library is
-    removed, so that ``pressplan compile`` makes it anew)."""
+    else None: also where the cache cannot be read or a library is damaged (its SHA-256 is not the one written
+    beside it when it was made: a truncated file would crash the process that loads it) or does not load; such
+    libraries are removed, said once, so that ``pressplan compile`` makes them anew."""
     folder = cache_dir()
     if folder is None:
         return None
     paths = {option: folder / f"{key}_{name}.so" for option, name in COMPILED_FUNCTIONS.items()}
     try:
-        if not all(path.is_file() for path in paths.values()):
+        if not all(path.is_file() and _digest_path(path).is_file() for path in paths.values()):
             return None
+        if not all(_digest_path(path).read_text().strip() == _digest(path) for path in paths.values()):
+            raise OSError("its checksum does not match")
         return {option: ca.external(COMPILED_FUNCTIONS[option], str(path)) for option, path in paths.items()}
-    except (OSError, RuntimeError) as exc:  # unreadable, or a damaged library: interpreted, as without a cache
-        _say_once(f"{folder}: compiled functions not loaded ({str(exc).splitlines()[0]})")
-        for path in paths.values():
+    except (OSError, RuntimeError) as exc:  # unreadable or damaged: interpreted, as without a cache
+        discard(key, exc)
+        return None
+
+
+def discard(key: str, reason: Exception) -> None:
+    """Remove the libraries of ``key`` that did not load or did not fit their problem (``reason``), said once."""
+    folder = cache_dir()
+    if folder is None:
+        return
+    why = _first_line(reason)
+    _say_once(f"{folder}: a compiled library not used ({why}; removed: pressplan compile makes it anew)")
+    for name in COMPILED_FUNCTIONS.values():
+        for path in (folder / f"{key}_{name}.so", _digest_path(folder / f"{key}_{name}.so")):
             with contextlib.suppress(OSError):
                 path.unlink(missing_ok=True)
-        return None
 
 
 def compile_into_cache(key: str, functions: dict[str, ca.Function]) -> float | None:
     """Compile ``functions`` (nlpsol's options -> the interpreted derivative functions of the problem of ``key``)
     into the cache; the seconds the compiler took (0.0 where every library was there already), None where there is
     no cache, no compiler, or the compiler or the folder failed (said once). Each file is written under a temporary
-    name and renamed: a reader never sees half a library."""
+    name and renamed, its SHA-256 beside it last: a reader never takes half a library."""
     folder, cc = cache_dir(), compiler()
     if folder is None or cc is None:
         _say_once("no cache (PRESSPLAN_CACHE=off)" if folder is None else "no C compiler (cc, gcc) on the path")
+        return None
+    if folder.exists() and not folder.is_dir():
+        _say_once(f"{folder}: not a folder (PRESSPLAN_CACHE)")
         return None
     t_start, compiled = time.perf_counter(), False
     try:
         folder.mkdir(parents=True, exist_ok=True, mode=0o700)
         for option, name in COMPILED_FUNCTIONS.items():
-            if not (folder / f"{key}_{name}.so").is_file():
+            library = folder / f"{key}_{name}.so"
+            if not (library.is_file() and _digest_path(library).is_file()):
                 _compile_one(cc, functions[option], folder, f"{key}_{name}")
                 compiled = True
-    except (OSError, RuntimeError, subprocess.CalledProcessError) as exc:  # RuntimeError: CasADi's generator
-        _say_once(f"{folder}: not compiled ({str(exc).splitlines()[0] if str(exc) else type(exc).__name__})")
+    except (OSError, RuntimeError) as exc:  # RuntimeError: CasADi's generator, or the compiler's failure
+        _say_once(f"{folder}: not compiled ({_first_line(exc)})")
         return None
     return time.perf_counter() - t_start if compiled else 0.0
 
 
 def _compile_one(cc: str, function: ca.Function, folder: Path, stem: str) -> None:
-    """``function``'s generated C compiled by ``cc`` into ``folder/stem.so`` (written under a temporary name)."""
+    """``function``'s generated C compiled by ``cc`` into ``folder/stem.so``, its SHA-256 into ``stem.so.sha256``
+    (each written under a temporary name). The compiler runs in its own process group, killed with it when this
+    process is interrupted (a compiler left running would burn a core for a minute)."""
     with tempfile.TemporaryDirectory(dir=folder) as work:
         generator = ca.CodeGenerator(f"{stem}.c", {"with_header": False})
         generator.add(function)
         generator.generate(work + os.sep)
         library = Path(work) / f"{stem}.so"
         command = [cc, *COMPILER_FLAGS, str(Path(work) / f"{stem}.c"), "-o", str(library), "-lm"]
-        subprocess.run(command, check=True, capture_output=True)
+        with subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True) as run:
+            try:
+                _, errors = run.communicate()
+            except BaseException:
+                os.killpg(run.pid, signal.SIGKILL)
+                raise
+        if run.returncode != 0:
+            said = [ln for ln in errors.decode(errors="replace").splitlines() if "error" in ln] or ["no message"]
+            raise RuntimeError(f"{Path(cc).name} failed: {said[0].strip()}")
+        digest = Path(work) / f"{stem}.so.sha256"
+        digest.write_text(_digest(library))
         os.replace(library, folder / f"{stem}.so")
+        os.replace(digest, _digest_path(folder / f"{stem}.so"))
+
+
+def _digest(path: Path) -> str:
+    """The SHA-256 of the file ``path`` (hex)."""
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _digest_path(library: Path) -> Path:
+    """Where the SHA-256 of ``library`` is kept: beside it."""
+    return library.with_name(library.name + ".sha256")
+
+
+def _first_line(exc: Exception) -> str:
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else type(exc).__name__
 
 
 def _say_once(reason: str) -> None:

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
-from planning.solver.compiled import COMPILED_FUNCTIONS, cached_functions, compile_into_cache, problem_key
+from planning.solver.compiled import COMPILED_FUNCTIONS, cached_functions, compile_into_cache, discard, problem_key
 from planning.solver.lifting import Lift, lifted_problem, row_split_jacobian
 from planning.tolerances import IPOPT_MU_INIT, IPOPT_TOL, IPOPT_WARM_PUSH
 
@@ -138,10 +138,8 @@ class NLPSolver:
             self.options.update(derivatives)
         self.problem = problem  # a dict of expressions, or (lifted) a function of x and p
         self.warm_options = {**WARM_START_OPTIONS, **(warm_options or {})}
-        found = cached_functions(self.key) if self.key is not None else None
-        self.options.update(found or {})
-        self.compiled = found is not None
-        self._cold = _compiled(name, problem, self.options)
+        self.compiled = False
+        self._cold = self._solver_with(cached_functions(self.key) if self.key is not None else None)
         self._warm: ca.Function | None = None
         if self.compilable:
             BUILT.add(self)
@@ -163,11 +161,23 @@ class NLPSolver:
         if found is None:
             return None
         with _IPOPT_LOCK:  # a thread may be solving with the interpreted functions
-            self.options.update(found)
-            self._cold = _compiled(self.name, self.problem, self.options)
+            self._cold = self._solver_with(found)
             self._warm = None
-            self.compiled = True
-        return seconds
+        return seconds if self.compiled else None
+
+    def _solver_with(self, found: dict[str, ca.Function] | None) -> ca.Function:
+        """The cold solver, with the compiled derivative functions ``found`` where they fit the problem (else,
+        their libraries discarded, the interpreted ones); sets :attr:`compiled`."""
+        if found is not None:
+            try:
+                solver = _compiled(self.name, self.problem, {**self.options, **found})
+            except RuntimeError as exc:  # a library of another shape under this key: not this problem's
+                discard(self.key, exc)
+            else:
+                self.options.update(found)
+                self.compiled = True
+                return solver
+        return _compiled(self.name, self.problem, self.options)
 
     def _warm_function(self) -> ca.Function:
         if self._warm is None:
