@@ -84,6 +84,11 @@ class Lift:
 # integral): the optimal law's Hessian on a layout of 624 segments builds in 0.06 s instead of 2.7 s and
 # evaluates in 13.5 ms instead of 92 ms (the same matrix)
 SYMMETRIC = {"symmetric": True}
+# ... on a large problem (the optimal law's: hundreds of variables) only: a law with halves (14 variables) or a
+# pendulum's keeps CasADi's general colouring, which costs it nothing, and so its iterates: the multi-start of the
+# laws with halves was checked on them (a random link drive's cold solve found no plan at one sweep point with the
+# same derivatives evaluated in the other order: tests/test_best_of_law.py, link-drive-7)
+LARGE_PROBLEM = 200
 # a row of a constraint Jacobian that depends on more than this many variables is dense (the period's, the RMS
 # torque's integral): CasADi colours a Jacobian's columns (forward sweeps) or its rows (adjoint sweeps), and a dense
 # row with a dense column (a phase's step) needs as many sweeps as the smaller dimension; the dense rows apart (one
@@ -126,16 +131,18 @@ def lifted_problem(problem: dict, lift: Lift) -> tuple[ca.Function, dict]:
     lam_f, lam_g = sym.sym("lam_f"), sym.sym("lam_g", g.shape[0])
 
     grad = ca.gradient(f, x) + ca.mtimes(J.T, ca.mtimes(E.T, ca.gradient(f, eta)))
-    jac = row_split_jacobian(g, x) + ca.mtimes(row_split_jacobian(g, eta), ca.mtimes(E, J))
+    large = x.shape[0] > LARGE_PROBLEM
+    by_rows, symmetric = (row_split_jacobian, SYMMETRIC) if large else (ca.jacobian, {})
+    jac = by_rows(g, x) + ca.mtimes(by_rows(g, eta), ca.mtimes(E, J))
     lagrangian = lam_f * f + ca.dot(lam_g, g)
     l_x, l_eta = ca.gradient(lagrangian, x), ca.gradient(lagrangian, eta)
     cross = ca.mtimes(ca.jacobian(l_eta, x).T, ca.mtimes(E, J))
     curvature = ca.sum2(ca.reshape(l_eta * e2, n, -1))  # sum over the quantities of each sample
-    inner = ca.mtimes(E.T, ca.mtimes(ca.jacobian(l_eta, eta, SYMMETRIC), E)) + ca.diag(curvature)
+    inner = ca.mtimes(E.T, ca.mtimes(ca.jacobian(l_eta, eta, symmetric), E)) + ca.diag(curvature)
     weights = sym.sym("weights", n)
     angles_hessian = ca.hessian(ca.dot(weights, lift.angle_values), x)[0]
     angles_hessian = ca.substitute(angles_hessian, weights, ca.mtimes(E.T, l_eta))  # the law's part only
-    hessian = ca.jacobian(l_x, x, SYMMETRIC) + cross + cross.T + ca.mtimes(J.T, ca.mtimes(inner, J)) + angles_hessian
+    hessian = ca.jacobian(l_x, x, symmetric) + cross + cross.T + ca.mtimes(J.T, ca.mtimes(inner, J)) + angles_hessian
 
     angles = ca.Function("lifted_angles", [x, p], [lift.angle_values])
     coefficients = [lift.columns(lift.values), lift.columns(lift.first), lift.columns(lift.second)]
