@@ -84,9 +84,9 @@ def cached_functions(key: str) -> dict[str, ca.Function] | None:
     folder = cache_dir()
     if folder is None:
         return None
-    paths = {option: folder / f"{key}_{name}.so" for option, name in COMPILED_FUNCTIONS.items()}
+    paths = _libraries(folder, key)
     try:
-        if not all(path.is_file() and _digest_path(path).is_file() for path in paths.values()):
+        if not all(_present(path) for path in paths.values()):
             return None
         if not all(_digest_path(path).read_text().strip() == _digest(path) for path in paths.values()):
             raise OSError("its checksum does not match")
@@ -103,8 +103,8 @@ def discard(key: str, reason: Exception) -> None:
         return
     why = _first_line(reason)
     _say_once(f"{folder}: a compiled library not used ({why}; removed: pressplan compile makes it anew)")
-    for name in COMPILED_FUNCTIONS.values():
-        for path in (folder / f"{key}_{name}.so", _digest_path(folder / f"{key}_{name}.so")):
+    for library in _libraries(folder, key).values():
+        for path in (library, _digest_path(library)):
             with contextlib.suppress(OSError):
                 path.unlink(missing_ok=True)
 
@@ -124,10 +124,9 @@ def compile_into_cache(key: str, functions: dict[str, ca.Function]) -> float | N
     t_start, compiled = time.perf_counter(), False
     try:
         folder.mkdir(parents=True, exist_ok=True, mode=0o700)
-        for option, name in COMPILED_FUNCTIONS.items():
-            library = folder / f"{key}_{name}.so"
-            if not (library.is_file() and _digest_path(library).is_file()):
-                _compile_one(cc, functions[option], folder, f"{key}_{name}")
+        for option, library in _libraries(folder, key).items():
+            if not _present(library):
+                _compile_one(cc, functions[option], folder, library.stem)
                 compiled = True
     except (OSError, RuntimeError) as exc:  # RuntimeError: CasADi's generator, or the compiler's failure
         _say_once(f"{folder}: not compiled ({_first_line(exc)})")
@@ -158,6 +157,16 @@ def _compile_one(cc: str, function: ca.Function, folder: Path, stem: str) -> Non
         digest.write_text(_digest(library))
         os.replace(library, folder / f"{stem}.so")
         os.replace(digest, _digest_path(folder / f"{stem}.so"))
+
+
+def _libraries(folder: Path, key: str) -> dict[str, Path]:
+    """The library of each compiled function of the problem of ``key`` (nlpsol's option -> its path)."""
+    return {option: folder / f"{key}_{name}.so" for option, name in COMPILED_FUNCTIONS.items()}
+
+
+def _present(library: Path) -> bool:
+    """``library`` and its SHA-256 beside it are there (whether they match is checked when it is loaded)."""
+    return library.is_file() and _digest_path(library).is_file()
 
 
 def _digest(path: Path) -> str:
