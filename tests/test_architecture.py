@@ -174,6 +174,8 @@ CASADI_MODULES = {  # the wrapper and the modules that build expressions for it
     "planning.solver.halves_nlp",
     "planning.solver.free_nlp",
     "planning.solver.pendulum_nlp",
+    "planning.solver.pendulum_swing",  # a swing's symbols and the rows every law's swing shares
+    "planning.solver.pendulum_free",  # the optimal law's swings
     "planning.solver.pendulum_drive",
     "planning.solver.pendulum_robots",  # its rows (the dense checks beside them load no CasADi)
     "planning.solver.bound",

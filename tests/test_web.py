@@ -881,6 +881,30 @@ def test_a_pendulum_stroke_on_the_page(page) -> None:
     screenshot(page, "web-pendulum")
 
 
+@pytest.mark.slow  # the browser and two solves of the optimal swings: about 25 s
+@browser
+def test_optimal_swings_on_the_page(page) -> None:
+    """The side panel under servo limits set to pendulum strokes and to the optimal law with the mouse and the keys:
+    the page's strokes are the CLI's optimal swings' (``solve_pendulum``), its summary names the law, no error."""
+    from planning.solver.pendulum import solve_pendulum
+
+    errors = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    pick_case(page, "side-panel-servo-limits.yaml")
+    for field, value in (("planner.mode", "pendulum"), ("planner.motion_law", "optimal")):
+        before = int(page.evaluate("document.body.dataset.rendered"))
+        _choose_with_mouse_and_keys(page, f'[data-field="{field}"]', value)
+        wait_rendered(page, before)
+    data = load_yaml((CASES / "side-panel-servo-limits.yaml").read_text(encoding="utf-8"))
+    data["planner"].update(mode="pendulum", motion_law="optimal")
+    solution = solve_pendulum(case_from_data(data, "cases/side-panel-servo-limits.yaml"), compare=False)
+    assert page.locator("#spm").inner_text() == f"{solution.plan.spm:.3f}"
+    page.locator("#summary").locator("xpath=..").locator("summary").click()  # the summary unfolded
+    summary = page.locator("#summary").inner_text()
+    assert "in pendulum strokes" in summary and "(optimal, verified)" in summary and not errors
+    screenshot(page, "web-pendulum-optimal")
+
+
 @pytest.mark.slow
 @browser
 def test_a_pendulum_stroke_at_the_lines_rate_on_the_page(page) -> None:

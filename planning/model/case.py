@@ -948,9 +948,9 @@ def _hold_checks(case: Case) -> None:
 
 PENDULUM_NOT_WITH = (  # what a pendulum stroke does not plan with yet: (field, its value when set, why)
     (
-        "planner.motion_law",
-        lambda c: c.planner.motion_law if c.planner.motion_law == "optimal" else None,
-        "a law with halves plans the swings",
+        "process.hold_time_s",
+        lambda c: c.process.hold_time_s if c.planner.motion_law == "optimal" else None,
+        "the optimal law's swings have no hold yet: a law with halves plans a hold in a swing",
     ),
     (
         "planner.placement",
@@ -967,9 +967,9 @@ PENDULUM_NOT_WITH = (  # what a pendulum stroke does not plan with yet: (field, 
 
 
 def _pendulum_checks(case: Case) -> None:
-    """A pendulum stroke (``planner.mode: pendulum``) plans with a law with halves, at the most strokes or at a
-    line's rate (the motor's heat or energy), against the safety height and the transfer time or the robots on
-    their curves; what it does not plan with yet is refused naming the field."""
+    """A pendulum stroke (``planner.mode: pendulum``) plans with a law with halves or the optimal law, at the most
+    strokes or at a line's rate (the motor's heat or energy), against the safety height and the transfer time or the
+    robots on their curves; what it does not plan with yet is refused naming the field."""
     if not case.pendulum:
         return
     for name, value_of, why in PENDULUM_NOT_WITH:

@@ -28,10 +28,12 @@ from planning.model.units import RPM, rounded_down
 from planning.solver.outcomes import Infeasible, NoPlanFound, PlanningError, Unverified
 from planning.solver.pendulum_check import evaluate_pendulum
 from planning.solver.pendulum_drive import draw_torque
+from planning.solver.pendulum_free import SEED_LAW, seed_start
 from planning.solver.pendulum_nlp import (
     PendulumNLP,
     build,
     elapsed_info,
+    free,
     plan_of_values,
     refined,
     sampled_limit_values,
@@ -81,9 +83,10 @@ def solve_pendulum(case: Case, compare: bool = True) -> PendulumSolution:
     tried, iterations, previous = 0, 0, None
     failure = None
     compiled = build(case)  # once: the sampled limits are its parameters
+    seeded, (tried, iterations) = _seeded(case, compiled.names)
     for _ in range(REFINE_ROUNDS + 1):
         nlp = compiled.at(limits)
-        x0s = starts(case, nlp) + ([previous] if previous else [])
+        x0s = starts(case, nlp) + seeded + ([previous] if previous else [])
         solved, tried, iterations = solved_starts(case, nlp, x0s, (t0, tried, iterations))
         best, best_failed = None, None
         for passed in (True, False):  # the most strokes among the verified plans, and among the failed
@@ -104,6 +107,16 @@ def solve_pendulum(case: Case, compare: bool = True) -> PendulumSolution:
             break
     check = failure[0]
     raise Unverified(f"{check.name} = {check.value:.6g} {check.unit} (limit {check.limit:.6g})", check)
+
+
+def _seeded(case: Case, names: tuple[str, ...]) -> tuple[list[dict[str, float]], tuple[int, int]]:
+    """The optimal law's start (``planning.solver.pendulum_free``): the case's pendulum plan under
+    :data:`~planning.solver.pendulum_free.SEED_LAW` as the free swings' values, and the starts and iterations
+    that plan took; none for a law with halves (its NLP's own starts)."""
+    if not free(case):
+        return [], (0, 0)
+    seed = solve_pendulum(case.with_law(SEED_LAW), compare=False).plan
+    return [seed_start(seed, names)], (seed.solver.starts, seed.solver.iterations)
 
 
 def solved_starts(

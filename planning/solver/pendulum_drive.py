@@ -28,7 +28,7 @@ import numpy as np
 
 from planning.model.case import RPM, Case
 from planning.model.cycle import HOLD_SEGMENT
-from planning.model.laws import get_law
+from planning.model.free_swing import samples_per_segment
 from planning.model.limits.base import trapezoid
 from planning.model.limits.grid import EXCESS_SMOOTHING, bus_power
 from planning.model.pendulum import TWO_PI, forming_on_path
@@ -71,7 +71,7 @@ def swing_drive(case: Case, swing: Any) -> DriveSamples:
     """The drive at the samples of one swing (``swing``: the NLP's ``_Swing``)."""
     model = case.drive_model
     p = swing.params
-    fractions = ca.DM(np.linspace(0.0, 1.0, get_law(p.motion_law).samples + 1)[:-1])
+    fractions = ca.DM(np.linspace(0.0, 1.0, samples_per_segment(p.motion_law) + 1)[:-1])
     parts = []  # (u, omega, alpha, times from the swing's start, forming force) of each segment, in time order
     parts += _half_samples(*swing.feed, fractions, 0.0)
     parts.append(_draw_samples(swing))

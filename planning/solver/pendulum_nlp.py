@@ -39,6 +39,7 @@ import casadi as ca
 import numpy as np
 
 from planning.model.case import RPM, Case
+from planning.model.free_swing import FREE_LAW
 from planning.model.laws import get_law
 from planning.model.limits import limits_of
 from planning.model.limits.capacity import torque_capacity_kNm
@@ -60,12 +61,22 @@ from planning.model.pendulum import (
     swing_setups,
 )
 from planning.model.plan import SolverInfo
-from planning.model.profile import Profile, Segment, advance_segment, knot_states
+from planning.model.profile import Profile, Segment
 from planning.solver.halves_nlp import MIN_HALF_S, TOP_SPEED, VARIABLE_INDEX, angle_at, variable_scales
 from planning.solver.ipopt import NLPSolver
 from planning.solver.nlp import RATE_OPTIONS, Rows
 from planning.solver.parameters import time_limit
 from planning.solver.pendulum_drive import bus_peak_rows, drive_rows, rate_terms, swing_drive
+from planning.solver.pendulum_free import (
+    FREE_SWING_VARIABLES,
+    STEP_SCALE,
+    TOP_SPEED_PARAMETER,
+    free_parameters,
+    free_swing,
+    free_swing_rows,
+    jerk_tie_break,
+    variable_bound,
+)
 from planning.solver.pendulum_robots import (
     NEED_FACTOR,
     ROBOTS_CHECK,
@@ -76,6 +87,7 @@ from planning.solver.pendulum_robots import (
     robot_rows,
     start_variables,
 )
+from planning.solver.pendulum_swing import SwingSymbols, sampled_rows, segments_from
 from planning.tolerances import ACCEL_BACKOFF, DRIVE_BACKOFF, IPOPT_CONSTR_VIOL_TOL, REFINE_MARGIN
 
 SWING_VARIABLES = (  # per swing, prefixed ``forward_`` / ``backward_``: (name, scale kind of the halves NLP)
@@ -106,9 +118,16 @@ SAMPLED_LIMITS = (
     "motor_rms_torque",
     "crank_torque",
     "grid_peak_power",
+    "crank_speed",
+    "motor_speed",
 )
-SAMPLED_PARAMETER = {"grid_peak_power": "grid_cap"}  # a sampled limit's parameter where it is not the limit's id
-ACCEL, JERK, SLIDE_ACCEL = "limits.crank_accel_rad_s2", "limits.crank_jerk_rad_s3", "limits.slider_accel_mm_s2"
+# a sampled limit's parameter where it is not the limit's id (the top speed: held at an optimal swing's samples)
+SAMPLED_PARAMETER = {
+    "grid_peak_power": "grid_cap",
+    "crank_speed": TOP_SPEED_PARAMETER,
+    "motor_speed": TOP_SPEED_PARAMETER,
+}
+ACCEL, JERK = "limits.crank_accel_rad_s2", "limits.crank_jerk_rad_s3"
 OPTIONS = {"ipopt.constr_viol_tol": IPOPT_CONSTR_VIOL_TOL, "ipopt.max_iter": 600}
 # at a target rate: the cycle's time [s] and the weights of the heat [1/(N^2 m^2 s)], the energy [1/J] and the
 # bus power's peak [1/W] (min-grid-peak: its epigraph variable PEAK_VARIABLE)
@@ -117,31 +136,9 @@ PEAK_VARIABLE = "bus_peak"  # [W] min-grid-peak: at or above the bus power at ev
 TARGET = "planner.target_spm"
 
 
-@dataclass
-class _Swing:
-    """One swing's symbols: its parameters, the feed's and the return's segments (``(starts, states, segments)``
-    as :func:`~planning.solver.halves_nlp.angle_at` takes them) and the states at their ends."""
-
-    setup: SwingSetup
-    params: SwingParameters
-    v: dict[str, Any]
-    feed: tuple[list, list, list]
-    ret: tuple[list, list, list]
-    feed_end: tuple[Any, Any, Any]
-    return_end: tuple[Any, Any, Any]
-
-
-def _segments_from(segs: list, theta0: Any, omega0: Any) -> tuple[tuple[list, list, list], tuple[Any, Any, Any]]:
-    states = knot_states(theta0, omega0, 0.0, segs)
-    starts = [0.0]
-    for seg in segs[:-1]:
-        starts.append(starts[-1] + seg.duration)
-    return (starts, states[:-1], segs), states[-1]
-
-
 def _swing(
     setup: SwingSetup, v: dict[str, Any], ends: tuple[Any, Any], law: tuple[str, Any], hold_time: float
-) -> _Swing:
+) -> SwingSymbols:
     """One swing's symbols (``law``: the law's name and its shape parameter; ``hold_time`` [s] at the setup's
     hold, where it has one)."""
     law_name, law_parameter = law
@@ -162,12 +159,12 @@ def _swing(
         setup.hold,
         hold_time if setup.hold is not None else 0.0,
     )
-    feed, feed_end = _segments_from(p.feed_segments(), ends[0], 0.0)
-    ret, return_end = _segments_from(p.return_segments(), setup.keys[2], p.draw_speed)
-    return _Swing(setup, p, v, feed, ret, feed_end, return_end)
+    feed, feed_end = segments_from(p.feed_segments(), ends[0], 0.0)
+    ret, return_end = segments_from(p.return_segments(), setup.keys[2], p.draw_speed)
+    return SwingSymbols(setup, p, v, feed, ret, feed_end, return_end)
 
 
-def _swing_rows(rows: Rows, s: _Swing, case: Case, limits: dict[str, float], units: dict[str, float]) -> None:
+def _swing_rows(rows: Rows, s: SwingSymbols, case: Case, limits: dict[str, float], units: dict[str, float]) -> None:
     """One swing's rows (module docstring)."""
     p, v, keys = s.params, s.v, s.setup.keys
     law = get_law(p.motion_law)
@@ -201,28 +198,7 @@ def _swing_rows(rows: Rows, s: _Swing, case: Case, limits: dict[str, float], uni
         )
     if lim.crank_jerk_rad_s3 is not None:
         rows.add("crank jerk", ca.vertcat(*p.peak_jerks()) / lim.crank_jerk_rad_s3, -math.inf, 1.0, JERK)
-    _sampled_rows(rows, s, case, limits)
-
-
-def _sampled_rows(rows: Rows, s: _Swing, case: Case, limits: dict[str, float]) -> None:
-    """The slide's acceleration (and speed) at samples of every segment of the halves; the die zone at the
-    return's samples and its exit."""
-    law = get_law(s.params.motion_law)
-    fractions = ca.DM(np.linspace(0.0, 1.0, law.samples + 1)[:-1])
-    lim = case.limits
-    v_die = limits["die_speed"]
-    for _, states, segs in (s.feed, s.ret):
-        for seg, st in zip(segs, states, strict=True):
-            th, om, al, _ = advance_segment(seg, *st, fractions * seg.duration)
-            h, d1, d2, _ = s.setup.jets(th)
-            rows.add("slider acceleration", (d2 * om**2 + d1 * al) / limits["slider_accel"], -1.0, 1.0, SLIDE_ACCEL)
-            if lim.slider_speed_mm_s is not None:
-                rows.add("slider speed", d1 * om / limits["slider_speed"], -1.0, 1.0, "limits.slider_speed_mm_s")
-    for k, u in enumerate(s.setup.die_zone):  # the return in the die zone: at its fixed angles
-        th_x, om_x = angle_at(s.v[f"die_time_{k}"], *s.ret)
-        slope = abs(float(s.setup.jets(u)[1]))
-        rows.add("die zone angles", ca.vertcat(th_x - u), 0.0, 0.0, "limits.die_height_mm")
-        rows.add("die zone speed", slope * om_x / v_die, -math.inf, 1.0, "limits.die_speed_mm_s")
+    sampled_rows(rows, s, case, limits)
 
 
 @dataclass
@@ -261,11 +237,15 @@ class PendulumNLP:
 def _variables(case: Case) -> tuple[tuple[str, ...], np.ndarray]:
     """The variables' names and scales (the halves NLP's scales by kind; the swing's ends in radians)."""
     halves_scale = variable_scales(case)
+    own = {  # an optimal swing's jerks by the jerk limit, its steps a share of a half's
+        "jerk": case.limits.crank_jerk_rad_s3,
+        "step": halves_scale[VARIABLE_INDEX["feed_accel_duration"]] / STEP_SCALE,
+    }
     names, scales = [], []
     for swing in SWINGS:
-        for name, kind in SWING_VARIABLES:
+        for name, kind in swing_variables(case):
             names.append(f"{swing}_{name}")
-            scales.append(halves_scale[VARIABLE_INDEX[kind]])
+            scales.append(own[kind] if kind in own else halves_scale[VARIABLE_INDEX[kind]])
     for name, kind in SHARED_VARIABLES:
         names.append(name)
         scales.append(1.0 if kind is None else halves_scale[VARIABLE_INDEX[kind]])
@@ -276,6 +256,16 @@ def _variables(case: Case) -> tuple[tuple[str, ...], np.ndarray]:
         names.append(PEAK_VARIABLE)
         scales.append(case.drive.motor.rated_torque_Nm * case.drive.motor.base_speed_rpm * RPM)
     return tuple(names), np.array(scales)
+
+
+def free(case: Case) -> bool:
+    """Whether the optimal law plans the swings (``planning.solver.pendulum_free``), not a law with halves."""
+    return case.planner.motion_law == FREE_LAW
+
+
+def swing_variables(case: Case) -> tuple[tuple[str, str], ...]:
+    """A swing's variables (without its prefix) and their scale kinds under the case's law."""
+    return FREE_SWING_VARIABLES if free(case) else SWING_VARIABLES
 
 
 def build(case: Case) -> PendulumNLP:
@@ -293,10 +283,15 @@ def build(case: Case) -> PendulumNLP:
     ends = {"forward": (theta_s, theta_e), "backward": (TWO_PI - theta_e, TWO_PI - theta_s)}
     law = case.planner.motion_law
     rows = Rows()
-    units = {"speed": scales[0], "half": scales[3]}
+    half = variable_scales(case)[VARIABLE_INDEX["feed_accel_duration"]]
+    units = {"speed": scales[0], "half": half}
     swings = {}
     for setup in setups:
-        v = {name: phys[f"{setup.name}_{name}"] for name, _ in SWING_VARIABLES}
+        v = {name: phys[f"{setup.name}_{name}"] for name, _ in swing_variables(case)}
+        if free(case):
+            swings[setup.name] = free_swing(setup, v, ends[setup.name])
+            free_swing_rows(rows, swings[setup.name], case, limits, units)
+            continue
         hold = case.process.hold_time_s or 0.0
         swings[setup.name] = _swing(setup, v, ends[setup.name], (law, phys["law_parameter"]), hold)
         _swing_rows(rows, swings[setup.name], case, limits, units)
@@ -314,6 +309,8 @@ def build(case: Case) -> PendulumNLP:
         cycle = _cycle_times(case, f, b, turns)
         robot_rows(rows.add, case, cycle, starts, limits[NEED_FACTOR], units["half"])
     objective = period / transfer
+    if free(case):  # of the equally fast jerk profiles the smoothest (``planning.solver.pendulum_free``)
+        objective = objective + jerk_tie_break(case, phys)
     if case.drive is not None:  # the motor's torques at the swings' samples (``planning.solver.pendulum_drive``)
         drives = {name: swing_drive(case, swing) for name, swing in swings.items()}
         drive_rows(case, rows.add, drives, turns, period, limits)
@@ -331,7 +328,7 @@ def build(case: Case) -> PendulumNLP:
     return PendulumNLP(case, solver, *rows.bounds(), names, scales, limit_names)
 
 
-def _cycle_times(case: Case, f: _Swing, b: _Swing, turns: tuple[Any, Any]) -> CycleTimes:
+def _cycle_times(case: Case, f: SwingSymbols, b: SwingSymbols, turns: tuple[Any, Any]) -> CycleTimes:
     """The cycle as the robots' rows read it (``planning.solver.pendulum_robots.CycleTimes``): each window's
     segments in the crank's own angle (the backward swing's negated) from the draw before it to the draw after
     it, the slide's height at times from the window's theta3; before the first draw's start and after the last
@@ -354,7 +351,7 @@ def _cycle_times(case: Case, f: _Swing, b: _Swing, turns: tuple[Any, Any]) -> Cy
     jets = case.machine.jets
     heights = {}
     for w, (segs, theta2, omega2, before) in windows.items():
-        (starts, states, segs_w), _ = _segments_from(segs, theta2, omega2)
+        (starts, states, segs_w), _ = segments_from(segs, theta2, omega2)
         span = sum(seg.duration for seg in segs_w)
         heights[w] = (starts, states, segs_w, before.params.draw_time, span)
 
@@ -374,13 +371,15 @@ def _bounds(case: Case, names: tuple[str, ...], setups: tuple[SwingSetup, ...]) 
     """Variable bounds: speeds from the least crank speed (the draw) or 0 up to the top crank speed, the draw
     speed at most its swing's bound (the case's own when it gives one), durations above ``MIN_HALF_S``."""
     lo, hi = np.zeros(len(names)), np.full(len(names), np.inf)
-    tops = [t for limit in limits_of(case) if (t := limit.top_crank_speed(case)) is not None]
-    top = min(tops, default=TOP_SPEED)  # the crank's and the motor's top speed
+    top = _top_speed(case)
     given = case.process.draw_speed_rpm
     (s_lo, s_hi), (e_lo, e_hi) = swing_bounds(case)
     robots = start_variables(case)
     for i, name in enumerate(names):
-        if name.endswith("peak_speed"):
+        own = variable_bound(case, name) if free(case) else None
+        if own is not None:
+            lo[i], hi[i] = own
+        elif name.endswith("peak_speed"):
             hi[i] = top
         elif name.endswith("draw_speed"):
             bound = next(s.draw_speed_bound for s in setups if name.startswith(s.name))
@@ -401,6 +400,12 @@ def _bounds(case: Case, names: tuple[str, ...], setups: tuple[SwingSetup, ...]) 
     return lo, hi
 
 
+def _top_speed(case: Case) -> float:
+    """[rad/s] the crank's and the motor's top speed (:data:`TOP_SPEED` without either)."""
+    tops = [t for limit in limits_of(case) if (t := limit.top_crank_speed(case)) is not None]
+    return min(tops, default=TOP_SPEED)
+
+
 def _law_parameter_bounds(case: Case) -> tuple[float, float]:
     law = get_law(case.planner.motion_law)
     fixed = case.planner.law_parameter
@@ -415,6 +420,8 @@ def starts(case: Case, nlp: PendulumNLP) -> list[dict[str, float]]:
     """Starting points that meet the swings' own rows: the draw at its bound and at half of it, the peaks 1.5 and
     3 times the draw speed, each swing turning midway in its room; each S-curve with one jerk (Eq. 14) that sweeps
     its angle, the key points' times where that motion passes them."""
+    if free(case):  # the optimal law's swings start from a plan of another law (``planning.solver.pendulum``)
+        return []
     (s_lo, s_hi), (e_lo, e_hi) = swing_bounds(case)
     law = get_law(case.planner.motion_law)
     shape = 0.0 if law.parameter is None else (case.planner.law_parameter or law.parameter.start)
@@ -509,6 +516,9 @@ def plan_of_values(case: Case, values: dict[str, float], info: SolverInfo) -> Pe
     for setup in setups:
         n = setup.name
         a, e = ends[n]
+        if free(case):
+            swings[n] = free_parameters(values, n, setup, (a, e))
+            continue
         swings[n] = SwingParameters(
             *(float(values[f"{n}_{k}"]) for k, _ in SWING_VARIABLES[:7]),
             a,
@@ -560,6 +570,8 @@ def sampled_limit_values(case: Case) -> dict[str, float]:
             out["grid_cap"] = values["grid_cap"]
             if values["grid_allowance"] < NO_STORAGE_J:
                 out["grid_allowance"] = values["grid_allowance"]
+    if free(case):  # the optimal law's swings hold the crank's top speed at their samples
+        out[TOP_SPEED_PARAMETER] = _top_speed(case)
     if case.robots is not None:
         out[NEED_FACTOR] = 1.0  # the robots' needs at the samples as the curves say (raised on a dense failure)
     return out
@@ -576,8 +588,8 @@ def refined(limits: dict[str, float], failures: list) -> dict[str, float] | None
             out[name] = min(limits[name], ceiling) * factor
         elif check.id == ROBOTS_CHECK and raised:  # another clearance: the worst one's factor raises them all
             continue
-        elif check.id in SAMPLED_LIMITS:  # lowered by its overshoot, the most of two checks of one limit
-            name = SAMPLED_PARAMETER.get(check.id, check.id)
+        elif check.id in SAMPLED_LIMITS and SAMPLED_PARAMETER.get(check.id, check.id) in limits:
+            name = SAMPLED_PARAMETER.get(check.id, check.id)  # lowered by its overshoot, the most of two checks
             out[name] = min(out[name], limits[name] * min(check.limit / check.value, 1.0) * (1 - REFINE_MARGIN))
         else:
             return None
