@@ -37,7 +37,14 @@ from planning.model.limits import limits_of
 from planning.model.limits.base import DRAW_GRID, Draw
 from planning.model.limits.hold import least_rate
 from planning.model.profile import Profile, Segment
-from planning.tolerances import ANGLE_ROUND_OFF_RAD, ANGLE_TOL_RAD, HOLD_STILL_RAD_S, SAME_TIME_S, TINY
+from planning.tolerances import (
+    ANGLE_ROUND_OFF_RAD,
+    ANGLE_TOL_RAD,
+    HOLD_STILL_RAD_S,
+    SAME_HEIGHT_MM,
+    SAME_TIME_S,
+    TINY,
+)
 from press.dynamics import table_force
 
 TWO_PI = 2 * math.pi
@@ -48,6 +55,7 @@ SWING_HALVES = ("feed_accel", "feed_decel", "return_accel", "return_decel")
 DRAW_BOUND_LIMITS = ("crank_speed", "motor_speed", "slider_accel", "slider_speed", "draw_start_speed")  # their own
 BISECTIONS = 60  # halvings of a bracket to find where the draw crosses the die height
 DIE_ZONE_POINTS = 5  # angles of a swing's return in the die zone at which the NLP holds the die speed
+MIRROR_PROBES = 361  # angles over a turn at which a mechanism is compared with its mirror (mirror_symmetric)
 TIME_BISECTIONS = 200  # halvings of a swing's time to find when it passes an angle (stopped at SAME_TIME_S)
 
 
@@ -232,6 +240,15 @@ def other_side(machine: Any, theta: float) -> float:
         return bdc
     down, up = (float(a) for a in machine.angles_at_height(float(machine.height(theta))))
     return up if theta < bdc else down
+
+
+def mirror_symmetric(machine: Any) -> bool:
+    """Whether the slide's height is the same either side of BDC at 180 deg, ``h(2 pi - theta) = h(theta)`` (an
+    in-line crank-slider; not an offset crank, a link drive or a knuckle joint), to :data:`SAME_HEIGHT_MM` at
+    :data:`MIRROR_PROBES` angles: the backward swing on its u is then the forward swing's problem."""
+    theta = np.linspace(0.0, TWO_PI, MIRROR_PROBES)
+    gap = np.abs(np.asarray(machine.height(TWO_PI - theta)) - np.asarray(machine.height(theta)))
+    return bool(np.max(gap) <= SAME_HEIGHT_MM)
 
 
 def backward_key_angles(case: Any) -> tuple[float, float, float, float]:

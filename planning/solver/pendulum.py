@@ -23,7 +23,7 @@ import numpy as np
 from planning.model.case import Case
 from planning.model.limits.capacity import torque_capacity_kNm
 from planning.model.limits.grid import drive_chain
-from planning.model.pendulum import STROKES_PER_CYCLE, TWO_PI, PendulumPlan, swing_setups
+from planning.model.pendulum import STROKES_PER_CYCLE, TWO_PI, PendulumPlan, mirror_symmetric, swing_setups
 from planning.model.units import RPM, rounded_down
 from planning.solver.outcomes import Infeasible, NoPlanFound, PlanningError, Unverified
 from planning.solver.pendulum_check import evaluate_pendulum
@@ -76,14 +76,31 @@ def solve_pendulum(case: Case, compare: bool = True) -> PendulumSolution:
     """The verified pendulum plan of ``case`` with the most strokes (module docstring); ``compare``: solve the
     rotary stroke too. Raises :class:`~planning.solver.outcomes.PlanningError` without one."""
     t0 = time.perf_counter()
-    limits = sampled_limit_values(case)
     _precheck_draw_speed(case)
     if case.drive is not None:
         _precheck_draw_torque(case)
-    tried, iterations, previous = 0, 0, None
-    failure = None
     compiled = build(case)  # once: the sampled limits are its parameters
-    seeded, (tried, iterations) = _seeded(case, compiled.names)
+    seeded, counts = _seeded(case, compiled.names)
+    mirrored = free(case) and mirror_symmetric(case.machine)  # the optimal swings tied as mirror images too
+    best, errors = None, []
+    for nlp in ([build(case, mirror=True)] if mirrored else []) + [compiled]:
+        found, error, counts = _refined(case, nlp, seeded, (t0, *counts))
+        errors += [error] if error is not None else []
+        if found is not None and (best is None or found[0].spm > best[0].spm):
+            best = found
+    if best is None:
+        raise errors[0]
+    return _with_rotary(case, best, t0, counts[1], counts[0], compare)
+
+
+def _refined(
+    case: Case, compiled: PendulumNLP, seeded: list[dict[str, float]], counts: tuple[float, int, int]
+) -> tuple[tuple | None, PlanningError | None, tuple[int, int]]:
+    """The most strokes among the verified plans of ``compiled`` from its starts (and ``seeded``), the sampled
+    limits refined while none verifies (module docstring): ``(plan, evaluation)`` or None with the error that says
+    why, and the counts ``(starts tried, iterations)`` carried on from ``counts`` ``(t0, tried, iterations)``."""
+    t0, tried, iterations = counts
+    limits, previous, failure = sampled_limit_values(case), None, None
     for _ in range(REFINE_ROUNDS + 1):
         nlp = compiled.at(limits)
         x0s = starts(case, nlp) + seeded + ([previous] if previous else [])
@@ -95,18 +112,19 @@ def solve_pendulum(case: Case, compare: bool = True) -> PendulumSolution:
             best, best_failed = (top, best_failed) if passed else (best, top)
         if best is not None:
             best, more = _loosened(case, compiled, limits, best)
-            return _with_rotary(case, best, t0, iterations + more, tried + int(more > 0), compare)
+            return best, None, (tried + int(more > 0), iterations + more)
         if best_failed is None:
             if failure:  # an earlier round's plan failed its check; this round's found none
                 break
-            raise NoPlanFound(f"no start of the pendulum NLP converged ({tried} tried)")
+            return None, NoPlanFound(f"no start of the pendulum NLP converged ({tried} tried)"), (tried, iterations)
         failure = best_failed[1].verification.failures()
         limits = refined(limits, failure)
         previous = best_failed[0].nlp_values
         if limits is None:
             break
     check = failure[0]
-    raise Unverified(f"{check.name} = {check.value:.6g} {check.unit} (limit {check.limit:.6g})", check)
+    reason = f"{check.name} = {check.value:.6g} {check.unit} (limit {check.limit:.6g})"
+    return None, Unverified(reason, check), (tried, iterations)
 
 
 def _seeded(case: Case, names: tuple[str, ...]) -> tuple[list[dict[str, float]], tuple[int, int]]:

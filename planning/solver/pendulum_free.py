@@ -3,13 +3,15 @@
 Each swing is ``planning.model.free_swing``'s: the feed's and the return's steps and their segments' jerks are the
 swing's variables (the jerks bounded by the crank-jerk limit, :func:`variable_bounds`), with the draw speed, the
 times ``t1`` (from the swing's start to theta1), ``t4`` (from theta3 to theta4) and the return's die-zone times as
-a law with halves has them. Rows per swing: the feed arrives at theta2 with the draw speed and no acceleration,
-the return at the swing's end at rest with no acceleration; theta1 and theta4 at ``t1`` and ``t4`` (within the
-feed and the return); the crank's acceleration at every knot within its limit (it is linear between); the crank
-speed at ``law.samples`` points of every segment at or above 0 (the swing turns one way) and at or below the
-crank's and the motor's top speed; the slide's acceleration and speed and the die zone as every swing's
-(``planning.solver.pendulum_swing.sampled_rows``). The cycle's rows (the windows or the robots, the drive, the
-objective) are the pendulum NLP's.
+a law with halves has them. Rows per swing: the feed arrives at theta2 with the draw speed and no acceleration, the
+return at the swing's end at rest with no acceleration; theta1 and theta4 at ``t1`` and ``t4`` (within the feed and
+the return); the crank's acceleration at every knot within its limit (it is linear between); the crank speed at or
+above 0 (the swing turns one way) and at or below the crank's and the motor's top speed all through every segment
+(the speed is quadratic in a segment's time: its Bernstein control points ``w0``, ``w0 + a0 h / 2``, ``w1`` within
+the bounds hold it so, the convex hull; the top a parameter, lowered should the dense check find it passed); the
+slide's acceleration and speed and the die zone as every swing's, and the die speed at every sample at or below the
+die height (``planning.solver.pendulum_swing.sampled_rows``). The cycle's rows (the windows or the robots, the
+drive, the objective, to which :func:`jerk_tie_break` is added) are the pendulum NLP's.
 
 A start: a plan of the case under :data:`SEED_LAW` (a jerk-limited law with halves), each part's profile
 sampled on its uniform grid, a segment's jerk the change of acceleration across it, the jerks then closed onto
@@ -31,7 +33,6 @@ from planning.model.free_swing import (
     RETURN_SEGMENTS,
     FreeSwingParameters,
     closed_part_jerks,
-    samples_per_segment,
 )
 from planning.model.pendulum import DIE_ZONE_POINTS, SWINGS, PendulumPlan, SwingSetup
 from planning.model.profile import Profile
@@ -106,20 +107,17 @@ def free_swing_rows(rows: Rows, s: SwingSymbols, case: Case, limits: dict[str, f
     knots = ca.vertcat(*[st[2] for _, states, _ in (s.feed, s.ret) for st in states[1:]])
     if case.limits.crank_accel_rad_s2 is not None:  # (the parts' first knots: 0 by their starts)
         rows.add("crank acceleration", knots / case.limits.crank_accel_rad_s2, -1.0, 1.0, ACCEL)
-    fractions = ca.DM(np.linspace(0.0, 1.0, samples_per_segment(p.motion_law) + 1)[1:])
     for part, (_, states, segs) in enumerate((s.feed, s.ret)):
         for k, (seg, st) in enumerate(zip(segs, states, strict=True)):
-            omega = st[1] + st[2] * fractions * seg.duration + seg.j0 * (fractions * seg.duration) ** 2 / 2
-            rows.add("crank speed within the top", omega / top, -math.inf, 1.0, SPEED)
-            # one way all through the segment: its speed, a quadratic in time, in Bernstein form has the control
-            # points w0, w0 + a0 h / 2, w1; all >= 0 holds it >= 0 on the whole segment (the convex hull). The
-            # segments at rest's side (the feed's first, the return's last) move as j t^2 / 2 from rest: their
-            # far knot's speed holds them (the rest itself is a row of its own)
-            at_rest = (part, k) in ((0, 0), (1, len(segs) - 1))
-            one_way = [st[1] + st[2] * seg.duration / 2, omega[-1]] if not at_rest else []
-            one_way += [st[1]] if (part, k) == (1, len(segs) - 1) else []
-            rows.add("crank speed one way", ca.vertcat(*one_way) / w_unit, 0.0, math.inf, KEYS)
-    sampled_rows(rows, s, case, limits)
+            # its speed, a quadratic in the segment's time, has in Bernstein form the control points w0,
+            # w0 + a0 h / 2, w1, and lies in their convex hull: 0 <= each <= top holds it so all through the segment
+            # (w0 is the segment before's w1). The feed's first segment, j t^2 / 2 from rest, needs its w1 only; the
+            # return's last, the same arriving at rest, none (its w0 is the segment before's w1)
+            middle, end = st[1] + st[2] * seg.duration / 2, st[1] + st[2] * seg.duration + seg.j0 * seg.duration**2 / 2
+            points = {(0, 0): [end], (1, len(segs) - 1): []}.get((part, k), [middle, end])
+            if points:
+                rows.add("crank speed one way, within the top", ca.vertcat(*points) / top, 0.0, 1.0, SPEED)
+    sampled_rows(rows, s, case, limits, zone=True)
 
 
 def free_parameters(values: dict[str, float], swing: str, setup: SwingSetup, ends: tuple[float, float]) -> Any:

@@ -268,9 +268,12 @@ def swing_variables(case: Case) -> tuple[tuple[str, str], ...]:
     return FREE_SWING_VARIABLES if free(case) else SWING_VARIABLES
 
 
-def build(case: Case) -> PendulumNLP:
+def build(case: Case, mirror: bool = False) -> PendulumNLP:
     """The NLP of ``case``, its sampled limits (``sampled_limit_values``' keys) parameters: built once a case and
-    solved at each refinement's values (:meth:`PendulumNLP.at`)."""
+    solved at each refinement's values (:meth:`PendulumNLP.at`); ``mirror``: the backward swing's variables tied to
+    the forward's and the turns' standstills to each other (the optimal law's swings on a press whose two sides of
+    BDC are one, ``planning.model.pendulum.mirror_symmetric``: a mirror-image plan, a KKT point of the untied NLP
+    too)."""
     names, scales = _variables(case)
     x = ca.SX.sym("x", len(names))
     phys = {name: x[i] * scales[i] for i, name in enumerate(names)}
@@ -296,6 +299,10 @@ def build(case: Case) -> PendulumNLP:
         swings[setup.name] = _swing(setup, v, ends[setup.name], (law, phys["law_parameter"]), hold)
         _swing_rows(rows, swings[setup.name], case, limits, units)
     f, b = swings["forward"], swings["backward"]
+    if mirror:  # the swings as mirror images
+        tied = [(f"forward_{k}", f"backward_{k}") for k in f.v] + [("turn_end_s", "turn_start_s")]
+        mirror = ca.vertcat(*[x[names.index(back)] - x[names.index(fore)] for fore, back in tied])
+        rows.add("mirror swings", mirror, 0.0, 0.0, "planner.motion_law")
     transfer = case.transfer_time_s
     turns = (phys["turn_end_s"], phys["turn_start_s"])
     period = PendulumParameters(f.params, b.params, *turns).period

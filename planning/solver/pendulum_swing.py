@@ -44,9 +44,11 @@ def segments_from(segs: list, theta0: Any, omega0: Any) -> tuple[tuple[list, lis
     return (starts, states[:-1], segs), states[-1]
 
 
-def sampled_rows(rows: Rows, s: SwingSymbols, case: Case, limits: dict[str, float]) -> None:
-    """The slide's acceleration (and speed) at samples of every segment of the feed and the return; the die zone at the
-    return's samples and its exit."""
+def sampled_rows(rows: Rows, s: SwingSymbols, case: Case, limits: dict[str, float], zone: bool = False) -> None:
+    """The slide's acceleration (and speed) at samples of every segment of the feed and the return; the die speed at
+    the return's die-zone angles; with ``zone`` also at every sample at or below the die height
+    (``max(h - h_die, v_die - |v|) >= 0``, as the optimal law's rotary NLP: a free profile may speed up between
+    fixed angles)."""
     fractions = ca.DM(np.linspace(0.0, 1.0, samples_per_segment(s.params.motion_law) + 1)[:-1])
     lim = case.limits
     v_die = limits["die_speed"]
@@ -57,6 +59,10 @@ def sampled_rows(rows: Rows, s: SwingSymbols, case: Case, limits: dict[str, floa
             rows.add("slider acceleration", (d2 * om**2 + d1 * al) / limits["slider_accel"], -1.0, 1.0, SLIDE_ACCEL)
             if lim.slider_speed_mm_s is not None:
                 rows.add("slider speed", d1 * om / limits["slider_speed"], -1.0, 1.0, "limits.slider_speed_mm_s")
+            if zone:
+                below = (h - lim.die_height_mm) / case.machine.length_scale
+                inside = ca.fmax(below, (v_die - ca.fabs(d1 * om)) / v_die)
+                rows.add("die zone speed at the samples", inside, 0.0, math.inf, "limits.die_speed_mm_s")
     for k, u in enumerate(s.setup.die_zone):  # the return in the die zone: at its fixed angles
         th_x, om_x = angle_at(s.v[f"die_time_{k}"], *s.ret)
         slope = abs(float(s.setup.jets(u)[1]))
