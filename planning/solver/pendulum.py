@@ -8,8 +8,10 @@ and the failures are of limits the NLP holds at samples only (the slide's accele
 zone, the motor's torques, the grid's peak, the robots' clearances), those limits are lowered by their overshoot
 (the robots' needs raised by their shortfall) and the NLP (built once, the limits
 its parameters) solved again, at most :data:`REFINE_ROUNDS` times, each round also starting from the last
-round's best plan. For comparison the same case is solved as a rotary stroke: the gain of the swing is stated
-beside its plan.
+round's best plan. Under the optimal law (``planning.solver.pendulum_free``) the one start is the case's plan
+under the seven-segment law, and on a press whose two sides of BDC are one the NLP with the swings tied as mirror
+images is solved too: the faster verified plan of the two is the answer. For comparison the same case is solved as
+a rotary stroke: the gain of the swing is stated beside its plan.
 """
 
 from __future__ import annotations

@@ -1,4 +1,8 @@
-"""The NLP of a pendulum stroke (``planning.model.pendulum``) under a law with halves, built once a case.
+"""The NLP of a pendulum stroke (``planning.model.pendulum``), built once a case.
+
+Under a law with halves as below; under the optimal law each swing's variables and own rows are
+``planning.solver.pendulum_free``'s (a free jerk profile), the cycle's rows (the windows or the robots, the drive,
+the objective) as below.
 
 Both swings in one NLP, each on its own path coordinate u (the forward swing's u is the crank angle, the
 backward swing's ``2 pi - theta``, its mechanism ``h_b(u) = h(2 pi - u)``), each a forward motion with
@@ -301,8 +305,8 @@ def build(case: Case, mirror: bool = False) -> PendulumNLP:
     f, b = swings["forward"], swings["backward"]
     if mirror:  # the swings as mirror images
         tied = [(f"forward_{k}", f"backward_{k}") for k in f.v] + [("turn_end_s", "turn_start_s")]
-        mirror = ca.vertcat(*[x[names.index(back)] - x[names.index(fore)] for fore, back in tied])
-        rows.add("mirror swings", mirror, 0.0, 0.0, "planner.motion_law")
+        ties = ca.vertcat(*[x[names.index(back)] - x[names.index(fore)] for fore, back in tied])
+        rows.add("mirror swings", ties, 0.0, 0.0, "planner.motion_law")
     transfer = case.transfer_time_s
     turns = (phys["turn_end_s"], phys["turn_start_s"])
     period = PendulumParameters(f.params, b.params, *turns).period
