@@ -769,7 +769,7 @@ def _pendulum_bound(case, args) -> int:
     data["arc_times_s"] = dict(zip(("forward", "backward"), bound.arc_times_s, strict=True))
     data["set_by"] = bound.sets_it
     windows = (
-        f"two robot's windows of {case.process.transfer_time_s:g} s and "
+        f"the robot's two windows of {case.process.transfer_time_s:g} s and "
         if case.robots is None
         else f"set by {bound.sets_it}; "
     )

@@ -118,6 +118,5 @@ STORAGE_ROOM = 1e-3  # relative: a storage that holds the grid limit with this s
 PEAK_SLACK = 1e-9  # relative: the second peak-shaving programme keeps the grid peak within this share of the first's
 PEAK_FALLBACK_SLACK = 1e-7  # relative: its room when HiGHS finds the first's peak too tight
 PEAK_BISECTION_TOL = 1e-12  # relative: the least peak's bisection stops this close to it
-JERK_TIE_BREAK = 1e-5  # the optimal law's swings: the mean squared jerk (over its limit's) weighed this much beside
-# the cycle time, so that of the many equally fast jerk profiles the smoothest is the one answer (a symmetric press
-# then swings mirror images)
+JERK_TIE_BREAK = 1e-5  # the optimal law's swings: the mean squared jerk (over its scale's) weighed this much beside
+# the cycle time, so that of the many equally fast jerk profiles the smoothest is the one answer

@@ -946,23 +946,31 @@ def _hold_checks(case: Case) -> None:
         raise CaseError("key_points.opening_deg", reason, k.opening_deg)
 
 
-PENDULUM_NOT_WITH = (  # what a pendulum stroke does not plan with yet: (field, its value when set, why)
+PENDULUM_NOT_WITH = (  # what a pendulum stroke does not plan with yet: (field, its value when set, what with, why)
     (
         "process.hold_time_s",
         lambda c: c.process.hold_time_s if c.planner.motion_law == "optimal" else None,
+        "planner.motion_law: optimal in pendulum strokes",
         "the optimal law's swings have no hold yet: a law with halves plans a hold in a swing",
     ),
     (
         "planner.placement",
         lambda c: c.planner.placement if c.planner.placement == "published" else None,
+        "planner.mode: pendulum",
         "the paper's structure is a rotary cycle's",
     ),
     (
         "process.transfer_time_s",
         lambda c: t if (t := c.process.transfer_time_s) is not None and t > MAX_HOLD_S else None,
+        "planner.mode: pendulum",
         f"at most {MAX_HOLD_S:g} s: the swings stand at the turns, a cycle's times within the plan's precision",
     ),
-    ("process.draw_slide_speed_mm_s", lambda c: c.process.draw_slide_speed_mm_s, "a swing draws at a crank speed"),
+    (
+        "process.draw_slide_speed_mm_s",
+        lambda c: c.process.draw_slide_speed_mm_s,
+        "planner.mode: pendulum",
+        "a swing draws at a crank speed",
+    ),
 )
 
 
@@ -972,10 +980,10 @@ def _pendulum_checks(case: Case) -> None:
     robots on their curves; what it does not plan with yet is refused naming the field."""
     if not case.pendulum:
         return
-    for name, value_of, why in PENDULUM_NOT_WITH:
+    for name, value_of, what, why in PENDULUM_NOT_WITH:
         value = value_of(case)
         if value is not None:
-            raise CaseError(name, f"not with planner.mode: pendulum ({why})", value)
+            raise CaseError(name, f"not with {what} ({why})", value)
 
 
 def _slide_draw_checks(case: Case) -> None:

@@ -36,7 +36,7 @@ from planning.model.free_swing import (
 )
 from planning.model.pendulum import DIE_ZONE_POINTS, SWINGS, PendulumPlan, SwingSetup
 from planning.model.profile import Profile
-from planning.solver.halves_nlp import angle_at
+from planning.solver.halves_nlp import VARIABLE_INDEX, angle_at, variable_scales
 from planning.solver.nlp import Rows
 from planning.solver.pendulum_swing import SwingSymbols, sampled_rows, segments_from
 from planning.tolerances import JERK_TIE_BREAK
@@ -44,6 +44,7 @@ from planning.tolerances import JERK_TIE_BREAK
 SEED_LAW = "seven-segment"  # the law whose pendulum plan starts the optimal law's swings
 MIN_STEP_S = 1e-3  # [s] a segment's step at least (a part of 24 segments at least 24 ms)
 STEP_SCALE = 12.0  # a step's scale: the halves NLP's half duration over this (a part ~ two halves)
+JERK_SCALE_CAP = 100.0  # a jerk's scale: the jerk limit, at most this many of the press's own W* / T*^2
 FREE_SWING_VARIABLES = (  # per swing, prefixed ``forward_`` / ``backward_``: (name, scale kind)
     ("draw_speed", "draw_speed"),
     ("feed_step", "step"),
@@ -169,9 +170,19 @@ def variable_bound(case: Case, name: str) -> tuple[float, float] | None:
     return None
 
 
+def jerk_scale(case: Case) -> float:
+    """[rad/s^3] the jerk variables' scale: the jerk limit, but at most :data:`JERK_SCALE_CAP` times the press's own
+    jerk ``W* / T*^2`` (``planning.solver.halves_nlp.variable_scales``' speed over its half's duration squared), so
+    that the scaled jerks stay O(1) and the tie-break weighs them where the limit is far above any jerk the press
+    can use (1e9: the shipped cases' limits are below the cap, their scale the limit)."""
+    scales = variable_scales(case)
+    own = scales[VARIABLE_INDEX["draw_speed"]] / scales[VARIABLE_INDEX["feed_accel_duration"]] ** 2
+    return min(case.limits.crank_jerk_rad_s3, JERK_SCALE_CAP * own)
+
+
 def jerk_tie_break(case: Case, phys: dict[str, Any]) -> Any:
-    """:data:`~planning.tolerances.JERK_TIE_BREAK` times the mean of each jerk variable's square over the jerk
-    limit's: added to the objective, it picks the smoothest of the equally fast profiles (the cycle time alone
-    leaves a swing's jerks free wherever no limit binds), unique, so a symmetric press's swings are mirror images."""
+    """:data:`~planning.tolerances.JERK_TIE_BREAK` times the mean of each jerk variable's square over its scale's
+    (:func:`jerk_scale`): added to the objective, it picks the smoothest of the equally fast profiles (the cycle
+    time alone leaves a swing's jerks free wherever no limit binds), one answer."""
     jerks = [x for name, x in phys.items() if "_jerk_" in name]
-    return JERK_TIE_BREAK * ca.sumsqr(ca.vertcat(*jerks) / case.limits.crank_jerk_rad_s3) / len(jerks)
+    return JERK_TIE_BREAK * ca.sumsqr(ca.vertcat(*jerks) / jerk_scale(case)) / len(jerks)

@@ -78,6 +78,7 @@ from planning.solver.pendulum_free import (
     free_parameters,
     free_swing,
     free_swing_rows,
+    jerk_scale,
     jerk_tie_break,
     variable_bound,
 )
@@ -241,8 +242,8 @@ class PendulumNLP:
 def _variables(case: Case) -> tuple[tuple[str, ...], np.ndarray]:
     """The variables' names and scales (the halves NLP's scales by kind; the swing's ends in radians)."""
     halves_scale = variable_scales(case)
-    own = {  # an optimal swing's jerks by the jerk limit, its steps a share of a half's
-        "jerk": case.limits.crank_jerk_rad_s3,
+    own = {  # an optimal swing's jerks by the jerk limit (pendulum_free.jerk_scale), its steps a share of a half's
+        "jerk": jerk_scale(case) if free(case) else 1.0,
         "step": halves_scale[VARIABLE_INDEX["feed_accel_duration"]] / STEP_SCALE,
     }
     names, scales = [], []
