@@ -64,6 +64,8 @@ SAME_POSITION_MM = 1e-9  # [mm] a robot this close to a point of its interferenc
 # sums its move's pieces: about 1e-13 mm of round-off at the die centre)
 SAME_HEIGHT_MM = 1e-9  # [mm] a height this far outside the stroke still counts as its end; the die height
 # counts up to this
+MIRROR_HEIGHT_MM = 1e-9  # [mm] a mechanism is its own mirror about 180 deg where the slide's heights either side
+# agree this closely (planning.model.pendulum.mirror_symmetric)
 SAME_SCORE = 1e-9  # [s, or the objective's normalised score] a solution must beat the best by this to
 # replace it (two starts that agree to round-off keep the first)
 SAME_SPM = 1e-9  # [strokes/min] a neighbour's plan must beat a sweep point by this to replace it

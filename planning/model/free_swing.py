@@ -23,11 +23,12 @@ from typing import Any
 import numpy as np
 
 from planning.model.laws import get_law
+from planning.model.laws.optimal import OptimalLaw
 from planning.model.profile import Segment, knot_states
 
 FEED_SEGMENTS = 24  # the feed's segments of a swing (from rest to the draw)
 RETURN_SEGMENTS = 24  # the return's segments of a swing (from the draw to rest)
-FREE_LAW = "optimal"  # the law whose swings these are
+FREE_LAW = OptimalLaw.name  # the law whose swings these are
 FREE_SAMPLES = 5  # the points of each segment at which a swing's NLP holds the crank's and the slide's limits
 
 

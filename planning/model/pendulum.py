@@ -41,7 +41,7 @@ from planning.tolerances import (
     ANGLE_ROUND_OFF_RAD,
     ANGLE_TOL_RAD,
     HOLD_STILL_RAD_S,
-    SAME_HEIGHT_MM,
+    MIRROR_HEIGHT_MM,
     SAME_TIME_S,
     TINY,
 )
@@ -244,11 +244,11 @@ def other_side(machine: Any, theta: float) -> float:
 
 def mirror_symmetric(machine: Any) -> bool:
     """Whether the slide's height is the same either side of BDC at 180 deg, ``h(2 pi - theta) = h(theta)`` (an
-    in-line crank-slider; not an offset crank, a link drive or a knuckle joint), to :data:`SAME_HEIGHT_MM` at
+    in-line crank-slider; not an offset crank, a link drive or a knuckle joint), to :data:`MIRROR_HEIGHT_MM` at
     :data:`MIRROR_PROBES` angles: the backward swing on its u is then the forward swing's problem."""
     theta = np.linspace(0.0, TWO_PI, MIRROR_PROBES)
     gap = np.abs(np.asarray(machine.height(TWO_PI - theta)) - np.asarray(machine.height(theta)))
-    return bool(np.max(gap) <= SAME_HEIGHT_MM)
+    return bool(np.max(gap) <= MIRROR_HEIGHT_MM)
 
 
 def backward_key_angles(case: Any) -> tuple[float, float, float, float]:

@@ -90,8 +90,8 @@ def solve_pendulum(case: Case, compare: bool = True) -> PendulumSolution:
         errors += [error] if error is not None else []
         if found is not None and (best is None or found[0].spm > best[0].spm):
             best = found
-    if best is None:
-        raise errors[0]
+    if best is None:  # the untied NLP's reason (the more general problem)
+        raise errors[-1]
     return _with_rotary(case, best, t0, counts[1], counts[0], compare)
 
 

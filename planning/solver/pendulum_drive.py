@@ -68,7 +68,7 @@ def _links(case: Case, swing: str, u: Any) -> tuple[Any, Any, Any] | None:
 
 
 def swing_drive(case: Case, swing: Any) -> DriveSamples:
-    """The drive at the samples of one swing (``swing``: the NLP's ``_Swing``)."""
+    """The drive at the samples of one swing (``swing``: the NLP's ``SwingSymbols``)."""
     model = case.drive_model
     p = swing.params
     fractions = ca.DM(np.linspace(0.0, 1.0, samples_per_segment(p.motion_law) + 1)[:-1])
