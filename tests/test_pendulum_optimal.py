@@ -185,3 +185,27 @@ def test_random_optimal_swings_hold_every_limit_by_an_independent_check(tmp_path
             _check_written(read_case(path), tmp_path / f"out{k}")
             verified += 1
     assert verified >= 4
+
+
+def test_optimal_swings_start_from_another_law_where_the_seven_segment_finds_none(monkeypatch):
+    """Where the seven-segment law finds no swings the cycloidal law's start the optimal ones (the same verified
+    answer class: more strokes than the cycloidal's own); where no seed law finds any, the optimal law says so."""
+    import planning.solver.pendulum as pendulum
+    from planning.solver.outcomes import NoPlanFound
+
+    solve = pendulum.solve_pendulum
+    failing = {"seven-segment"}
+
+    def seeds_fail(case, compare=True):  # noqa: ANN001, ANN202 - the solver's own signature
+        if case.planner.motion_law in failing:
+            raise NoPlanFound("no start converged (a test)")
+        return solve(case, compare)
+
+    monkeypatch.setattr(pendulum, "solve_pendulum", seeds_fail)
+    case = read_case(SHALLOW, OPTIMAL)
+    solution = solve(case, compare=False)
+    assert solution.evaluation.verification.passed
+    assert solution.plan.spm > solve(case.with_law("cycloidal"), compare=False).plan.spm
+    failing.add("cycloidal")
+    with pytest.raises(NoPlanFound, match="optimal law's swings start from"):
+        solve(case, compare=False)

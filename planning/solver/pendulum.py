@@ -1,17 +1,16 @@
 """Solve a pendulum stroke: the NLP from several starts, the dense verification, the sampled limits refined.
 
-Before solving, a given draw speed above a swing's draw-speed bound, and a draw the motors cannot make on a
-swing at the least draw speed, are refused (``Infeasible``). Each start of
-:func:`~planning.solver.pendulum_nlp.starts` is solved; every converged plan is verified densely
-(``planning.solver.pendulum_check``); the answer is the verified plan with the most strokes. When none verifies
-and the failures are of limits the NLP holds at samples only (the slide's acceleration and speed, the die
-zone, the motor's torques, the grid's peak, the robots' clearances), those limits are lowered by their overshoot
-(the robots' needs raised by their shortfall) and the NLP (built once, the limits
-its parameters) solved again, at most :data:`REFINE_ROUNDS` times, each round also starting from the last
-round's best plan. Under the optimal law (``planning.solver.pendulum_free``) the one start is the case's plan
-under the seven-segment law, and on a press whose two sides of BDC are one the NLP with the swings tied as mirror
-images is solved too: the faster verified plan of the two is the answer. For comparison the same case is solved as
-a rotary stroke: the gain of the swing is stated beside its plan.
+Before solving, a given draw speed above a swing's draw-speed bound, and a draw the motors cannot make on a swing
+at the least draw speed, are refused (``Infeasible``). Each start of :func:`~planning.solver.pendulum_nlp.starts`
+is solved; every converged plan is verified densely (``planning.solver.pendulum_check``); the answer is the
+verified plan with the most strokes. When none verifies and the failures are of limits the NLP holds at samples
+only (the slide's acceleration and speed, the die zone, the motor's torques, the grid's peak, the robots'
+clearances), those limits are lowered by their overshoot (the robots' needs raised by their shortfall) and the NLP
+(built once, the limits its parameters) solved again, at most :data:`REFINE_ROUNDS` times, each round also starting
+from the last round's best plan. Under the optimal law (``planning.solver.pendulum_free``) the one start is the
+case's plan under the seven-segment law (the cycloidal where that finds none), and on a press whose two sides of
+BDC are one the NLP with the swings tied as mirror images is solved too: the faster verified plan of the two is the
+answer. For comparison the same case is solved as a rotary stroke: the gain of the swing is stated beside its plan.
 """
 
 from __future__ import annotations
@@ -30,7 +29,7 @@ from planning.model.units import RPM, rounded_down
 from planning.solver.outcomes import Infeasible, NoPlanFound, PlanningError, Unverified
 from planning.solver.pendulum_check import evaluate_pendulum
 from planning.solver.pendulum_drive import draw_torque
-from planning.solver.pendulum_free import SEED_LAW, seed_start
+from planning.solver.pendulum_free import SEED_LAWS, seed_start
 from planning.solver.pendulum_nlp import (
     PendulumNLP,
     build,
@@ -130,13 +129,22 @@ def _refined(
 
 
 def _seeded(case: Case, names: tuple[str, ...]) -> tuple[list[dict[str, float]], tuple[int, int]]:
-    """The optimal law's start (``planning.solver.pendulum_free``): the case's pendulum plan under
-    :data:`~planning.solver.pendulum_free.SEED_LAW` as the free swings' values, and the starts and iterations
-    that plan took; none for a law with halves (its NLP's own starts)."""
+    """The optimal law's start (``planning.solver.pendulum_free``): the case's pendulum plan under the first law of
+    :data:`~planning.solver.pendulum_free.SEED_LAWS` that finds one, as the free swings' values, and the starts and
+    iterations the seed took; none for a law with halves (its NLP's own starts). :class:`NoPlanFound` naming the
+    optimal law when no seed law finds swings."""
     if not free(case):
         return [], (0, 0)
-    seed = solve_pendulum(case.with_law(SEED_LAW), compare=False).plan
-    return [seed_start(seed, names)], (seed.solver.starts, seed.solver.iterations)
+    reasons = []
+    for law in SEED_LAWS:
+        try:
+            seed = solve_pendulum(case.with_law(law), compare=False).plan
+        except PlanningError as exc:  # (its starts and iterations are not carried by the error)
+            reasons.append(f"{law}: {exc.reason}")
+            continue
+        return [seed_start(seed, names)], (seed.solver.starts, seed.solver.iterations)
+    reason = "; ".join(reasons)
+    raise NoPlanFound(f"the optimal law's swings start from a law with halves' swings, and none was found ({reason})")
 
 
 def solved_starts(

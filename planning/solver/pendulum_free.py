@@ -13,10 +13,10 @@ slide's acceleration and speed and the die zone as every swing's, and the die sp
 die height (``planning.solver.pendulum_swing.sampled_rows``). The cycle's rows (the windows or the robots, the
 drive, the objective, to which :func:`jerk_tie_break` is added) are the pendulum NLP's.
 
-A start: a plan of the case under :data:`SEED_LAW` (a jerk-limited law with halves), each part's profile
-sampled on its uniform grid, a segment's jerk the change of acceleration across it, the jerks then closed onto
-the part's ends (:func:`~planning.model.free_swing.closed_part_jerks`); its key times, turns and robots' starts
-as they were.
+A start: a plan of the case under the first law of :data:`SEED_LAWS` that finds one (a jerk-limited law with
+halves; the cycloidal, smooth at any jerk, where it finds none), each part's profile sampled on its uniform grid, a
+segment's jerk the change of acceleration across it, the jerks then closed onto the part's ends
+(:func:`~planning.model.free_swing.closed_part_jerks`); its key times, turns and robots' starts as they were.
 """
 
 from __future__ import annotations
@@ -41,7 +41,7 @@ from planning.solver.nlp import Rows
 from planning.solver.pendulum_swing import SwingSymbols, sampled_rows, segments_from
 from planning.tolerances import JERK_TIE_BREAK
 
-SEED_LAW = "seven-segment"  # the law whose pendulum plan starts the optimal law's swings
+SEED_LAWS = ("seven-segment", "cycloidal")  # the laws whose pendulum plan starts the optimal swings, the first found
 MIN_STEP_S = 1e-3  # [s] a segment's step at least (a part of 24 segments at least 24 ms)
 STEP_SCALE = 12.0  # a step's scale: the halves NLP's half duration over this (a part ~ two halves)
 JERK_SCALE_CAP = 100.0  # a jerk's scale: the jerk limit, at most this many of the press's own W* / T*^2
