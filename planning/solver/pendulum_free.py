@@ -57,9 +57,7 @@ FREE_SWING_VARIABLES = (  # per swing, prefixed ``forward_`` / ``backward_``: (n
 )
 KEYS = "key_points"
 ACCEL, SPEED = "limits.crank_accel_rad_s2", "limits.crank_speed_rpm"
-TOP_SPEED_PARAMETER = (
-    "top_speed"  # [rad/s] the crank's top speed held at the samples (lowered where it is passed between)
-)
+TOP_SPEED_PARAMETER = "top_speed"  # [rad/s] the top crank speed of the rows (lowered should the dense check pass it)
 
 
 def jerk_names(part: str, count: int) -> tuple[str, ...]:
@@ -124,7 +122,9 @@ def free_swing_rows(rows: Rows, s: SwingSymbols, case: Case, limits: dict[str, f
     sampled_rows(rows, s, case, limits, zone=True)
 
 
-def free_parameters(values: dict[str, float], swing: str, setup: SwingSetup, ends: tuple[float, float]) -> Any:
+def free_parameters(
+    values: dict[str, float], swing: str, setup: SwingSetup, ends: tuple[float, float]
+) -> FreeSwingParameters:
     """A swing's :class:`FreeSwingParameters` of the NLP's ``values``, each part's jerks closed onto its ends."""
     n = swing
     w2 = float(values[f"{n}_draw_speed"])

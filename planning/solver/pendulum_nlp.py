@@ -126,7 +126,7 @@ SAMPLED_LIMITS = (
     "crank_speed",
     "motor_speed",
 )
-# a sampled limit's parameter where it is not the limit's id (the top speed: held at an optimal swing's samples)
+# a sampled limit's parameter where it is not the limit's id (the top speed: an optimal swing's rows' parameter)
 SAMPLED_PARAMETER = {
     "grid_peak_power": "grid_cap",
     "crank_speed": TOP_SPEED_PARAMETER,
