@@ -106,7 +106,16 @@ class FreeSwingParameters:
         draw = Segment("draw:constant", self.draw_time, 0.0, 0.0)
         return self.feed_segments() + [draw] + self.return_segments()
 
-    def _peak_speed(self, segments: list[Segment], start: tuple[float, float, float]) -> float:
+    def _parts(self) -> tuple[tuple[list[Segment], tuple[float, float, float]], ...]:
+        """The feed and the return of a numeric swing: each one's segments and its start state (angle, speed,
+        acceleration)."""
+        return (
+            (self.feed_segments(), (float(self.start), 0.0, 0.0)),
+            (self.return_segments(), (float(self.draw_end), float(self.draw_speed), 0.0)),
+        )
+
+    @staticmethod
+    def _peak_speed(segments: list[Segment], start: tuple[float, float, float]) -> float:
         """The highest speed [rad/s] of a numeric part: at its knots and where its (linear) acceleration is 0."""
         states = knot_states(*start, segments)
         best = max(float(om) for _, om, _ in states)
@@ -120,22 +129,16 @@ class FreeSwingParameters:
     @property
     def feed_peak_speed(self) -> float:
         """The highest speed of the feed [rad/s] (numeric plans)."""
-        return self._peak_speed(self.feed_segments(), (float(self.start), 0.0, 0.0))
+        return self._peak_speed(*self._parts()[0])
 
     @property
     def return_peak_speed(self) -> float:
         """The highest speed of the return [rad/s] (numeric plans)."""
-        return self._peak_speed(self.return_segments(), (float(self.draw_end), float(self.draw_speed), 0.0))
+        return self._peak_speed(*self._parts()[1])
 
     def peak_accelerations(self) -> list[float]:
         """Peak |crank acceleration| [rad/s^2] of the feed and of the return (at their knots: it is linear between)."""
-        out = []
-        for segs, start in (
-            (self.feed_segments(), (float(self.start), 0.0, 0.0)),
-            (self.return_segments(), (float(self.draw_end), float(self.draw_speed), 0.0)),
-        ):
-            out.append(max(abs(float(al)) for _, _, al in knot_states(*start, segs)))
-        return out
+        return [max(abs(float(al)) for _, _, al in knot_states(*start, segs)) for segs, start in self._parts()]
 
     def peak_jerks(self) -> list[float]:
         """Peak |crank jerk| [rad/s^3] of the feed and of the return."""
