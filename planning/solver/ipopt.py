@@ -61,6 +61,7 @@ BUILT: weakref.WeakSet = weakref.WeakSet()  # the process's solvers of SX proble
 _KEPT: list[list] = []  # while :func:`kept_solvers` runs: the solvers built, held (a solve may drop its NLP)
 # nlpsol's options that take a derivative function, and the name of that function in a built solver
 DERIVATIVE_FUNCTIONS = {"grad_f": "nlp_grad_f", "jac_g": "nlp_jac_g", "hess_lag": "nlp_hess_l"}
+GAMMA = {"gamma": ["f", "g"]}  # the Lagrangian's terms (objective and rows), as nlpsol weighs them in its Hessian
 
 
 class NLPStatus(enum.Enum):
@@ -263,9 +264,12 @@ def _compiled(name: str, problem: dict | ca.Function, options: dict) -> ca.Funct
     1-6 ms on the optimal law's NLP of 1046-2502 variables) and is built without the expansion (0.1-1.4 s)."""
     if isinstance(problem, ca.Function) or not isinstance(problem["x"], ca.MX):
         return ca.nlpsol(name, "ipopt", problem, options)
-    derived = ca.nlpsol(f"{name}_mx", "ipopt", problem, options)
-    supplied = {option: derived.get_function(DERIVATIVE_FUNCTIONS[option]) for option in ("grad_f", "hess_lag")}
     x, p, g = problem["x"], problem.get("p", ca.MX.sym("p", 0)), problem["g"]
+    oracle = ca.Function("nlp", [x, p], [problem["f"], g], ["x", "p"], ["f", "g"])
+    supplied = {  # as nlpsol derives them (the same functions), without the Jacobian it would derive too
+        "grad_f": oracle.factory("nlp_grad_f", ["x", "p"], ["f", "grad:f:x"]),
+        "hess_lag": oracle.factory("nlp_hess_l", ["x", "p", "lam:f", "lam:g"], ["triu:hess:gamma:x:x"], GAMMA),
+    }
     supplied["jac_g"] = ca.Function("nlp_jac_g", [x, p], [g, row_split_jacobian(g, x)], ["x", "p"], ["g", "jac_g_x"])
     return ca.nlpsol(name, "ipopt", problem, {**options, **supplied})
 
