@@ -204,6 +204,12 @@ def _other_commands(sub) -> None:  # noqa: ANN001 - argparse's sub-parsers
         "--cases", default="cases", help="folder whose *.yaml the page offers (default: cases, else the project's)"
     )
     sv.add_argument("--recipes", help="folder where the page saves cases under a name and reopens them (made)")
+    sv.add_argument(
+        "--no-compile",
+        action="store_true",
+        help="leave the NLPs interpreted (by default those the page builds are compiled in the background with the "
+        "C compiler into the cache, as `pressplan compile` does, where there is one)",
+    )
     cm = sub.add_parser(
         "cam",
         help="the plan as a controller's cam (CSV, CODESYS, TwinCAT, PLCopen XML), proved as the controller runs it",
@@ -974,7 +980,8 @@ def _serve(args) -> int:
         cases = Path(__file__).resolve().parents[1] / "cases"
     if case_path is None and (cases / SERVE_FIRST).is_file():  # the published case first, as in the README
         case_path = (cases / SERVE_FIRST).resolve()
-    serve(case_path, args.host, args.port, cases if cases.is_dir() else None, _recipes_folder(args.recipes))
+    folder = cases if cases.is_dir() else None
+    serve(case_path, args.host, args.port, folder, _recipes_folder(args.recipes), not args.no_compile)
     return EXIT_OK
 
 

@@ -1,18 +1,21 @@
 """The NLPs' derivative functions compiled into the cache (``planning.solver.compiled``): the same functions (the
 same numbers, the same IPOPT iterations), loaded by a later solver of the same problem, and a clear fallback where
-there is no cache or no compiler."""
+there is no cache or no compiler; compiled in the background as a long-lived process builds them
+(``planning.solver.background``), a compiler under way killed when it stops."""
 
 from __future__ import annotations
 
 import json
 import subprocess
 import sys
+import time
 
 import casadi as ca
 import numpy as np
 import pytest
 
 from planning.solver import compiled
+from planning.solver.background import BackgroundCompiler
 from planning.solver.ipopt import NLPSolver
 from tests.conftest import PUBLISHED_CASE
 
@@ -144,3 +147,46 @@ def test_the_row_split_jacobian_is_casadis_own(kind):
         ours = ca.Function("a", [x], [row_split_jacobian(g, x)])(point)
         theirs = ca.Function("b", [x], [ca.jacobian(g, x)])(point)
         assert ours.sparsity() == theirs.sparsity() and np.array_equal(np.array(ours), np.array(theirs)), name
+
+
+@pytest.mark.skipif(compiled.compiler() is None, reason="no C compiler on this machine")
+def test_the_background_compiler_compiles_what_the_process_builds_and_the_solves_stay_the_same(cache):
+    solver = NLPSolver("toy", _problem())  # built by "the page": interpreted at first
+    interpreted = _solve(solver)
+    said = []
+    compiler = BackgroundCompiler(say=said.append, poll_s=0.05).start()
+    try:
+        deadline = time.monotonic() + 60
+        while not solver.compiled and time.monotonic() < deadline:
+            time.sleep(0.05)
+    finally:
+        compiler.close()
+    assert solver.compiled and compiler.compiled == ["toy"] and len(said) == 1 and "toy compiled" in said[0]
+    again = _solve(solver)  # the same solver object, its functions swapped
+    assert np.array_equal(again.x, interpreted.x) and again.iterations == interpreted.iterations
+
+
+def test_closing_the_background_compiler_kills_its_compiler_and_leaves_the_solver_interpreted(
+    cache, tmp_path, monkeypatch, capsys
+):
+    slow = tmp_path / "bin" / "cc"  # a compiler that would take a minute
+    slow.parent.mkdir()
+    marker = tmp_path / "started"
+    slow.write_text(f"#!/bin/sh\necho $$ > {marker}.tmp\nmv {marker}.tmp {marker}\nexec sleep 60\n")
+    slow.chmod(0o755)
+    monkeypatch.setattr(compiled, "compiler", lambda: str(slow))
+    solver = NLPSolver("toy", _problem())
+    compiler = BackgroundCompiler(poll_s=0.05).start()
+    deadline = time.monotonic() + 30
+    while not marker.exists() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert marker.exists()
+    pid = marker.read_text().strip()  # the compiler's process under way (sleeping its minute)
+    assert subprocess.run(["kill", "-0", pid], capture_output=True).returncode == 0
+    t_close = time.monotonic()
+    compiler.close()
+    assert time.monotonic() - t_close < 5 and not compiler._thread.is_alive()
+    time.sleep(0.2)  # (reaped by the thread's Popen before close returned; the signal is immediate)
+    assert subprocess.run(["kill", "-0", pid], capture_output=True).returncode != 0  # killed, not left to run
+    assert not solver.compiled and not list(cache.glob("*.so"))
+    assert "not compiled" not in capsys.readouterr().err  # stopped on purpose: nothing to say

@@ -4,8 +4,9 @@ An SX problem's constraint Jacobian and Lagrangian Hessian are evaluated at ever
 them (the published case's Hessian is 132 000 operations: 0.7 ms a call, half an iteration). Compiled by a C
 compiler from CasADi's generated code they evaluate three times faster and are the same functions (the same
 operations in the same order: the same numbers; ``tests/test_compiled.py``). Compiling takes some 20 s a problem
-(``gcc -O1``; 60 s for a drive NLP's), so it is done once, on request (``pressplan compile``), and kept for every
-later solve of the problem (any command, a sweep's workers, the web page): ``$PRESSPLAN_CACHE`` (default
+(``gcc -O1``; 60 s for a drive NLP's), so it is done once, on request (``pressplan compile``) or in the background
+by a long-lived process (``pressplan serve``: ``planning.solver.background``), and kept for every later solve of the
+problem (any command, a sweep's workers, the web page): ``$PRESSPLAN_CACHE`` (default
 ``$XDG_CACHE_HOME/pressplan`` or ``~/.cache/pressplan``; ``off`` turns the cache off). A problem is found there by a
 key: the SHA-256 of the problem's own functions (serialized by CasADi), CasADi's version, the machine and the
 compiler's flags; another problem, another CasADi, another machine: another key. Without a compiler, or without the
@@ -23,6 +24,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -109,11 +111,14 @@ def discard(key: str, reason: Exception) -> None:
                 path.unlink(missing_ok=True)
 
 
-def compile_into_cache(key: str, functions: dict[str, ca.Function]) -> float | None:
+def compile_into_cache(
+    key: str, functions: dict[str, ca.Function], niceness: int = 0, cancel: Cancel | None = None
+) -> float | None:
     """Compile ``functions`` (nlpsol's options -> the interpreted derivative functions of the problem of ``key``)
     into the cache; the seconds the compiler took (0.0 where every library was there already), None where there is
-    no cache, no compiler, or the compiler or the folder failed (said once). Each file is written under a temporary
-    name and renamed, its SHA-256 beside it last: a reader never takes half a library."""
+    no cache, no compiler, or the compiler or the folder failed (said once; not when ``cancel`` stopped it). Each
+    file is written under a temporary name and renamed, its SHA-256 beside it last: a reader never takes half a
+    library. ``niceness``: the compiler's (a background compile yields the cores to the solves)."""
     folder, cc = cache_dir(), compiler()
     if folder is None or cc is None:
         _say_once("no cache (PRESSPLAN_CACHE=off)" if folder is None else "no C compiler (cc, gcc) on the path")
@@ -126,30 +131,43 @@ def compile_into_cache(key: str, functions: dict[str, ca.Function]) -> float | N
         folder.mkdir(parents=True, exist_ok=True, mode=0o700)
         for option, library in _libraries(folder, key).items():
             if not _present(library):
-                _compile_one(cc, functions[option], folder, library.stem)
+                _compile_one(cc, functions[option], folder, library.stem, niceness, cancel)
                 compiled = True
     except (OSError, RuntimeError) as exc:  # RuntimeError: CasADi's generator, or the compiler's failure
-        _say_once(f"{folder}: not compiled ({_first_line(exc)})")
+        if cancel is None or not cancel.stopped:  # (a compile stopped on purpose: nothing to say)
+            _say_once(f"{folder}: not compiled ({_first_line(exc)})")
         return None
     return time.perf_counter() - t_start if compiled else 0.0
 
 
-def _compile_one(cc: str, function: ca.Function, folder: Path, stem: str) -> None:
+def _compile_one(
+    cc: str, function: ca.Function, folder: Path, stem: str, niceness: int = 0, cancel: Cancel | None = None
+) -> None:
     """``function``'s generated C compiled by ``cc`` into ``folder/stem.so``, its SHA-256 into ``stem.so.sha256``
-    (each written under a temporary name). The compiler runs in its own process group, killed with it when this
-    process is interrupted (a compiler left running would burn a core for a minute)."""
+    (each written under a temporary name). The compiler runs in its own process group (at ``niceness``), killed
+    with it when this process is interrupted or ``cancel`` is stopped (a compiler left running would burn a core
+    for a minute)."""
     with tempfile.TemporaryDirectory(dir=folder) as work:
         generator = ca.CodeGenerator(f"{stem}.c", {"with_header": False})
         generator.add(function)
         generator.generate(work + os.sep)
         library = Path(work) / f"{stem}.so"
         command = [cc, *COMPILER_FLAGS, str(Path(work) / f"{stem}.c"), "-o", str(library), "-lm"]
+        nice = shutil.which("nice") if niceness else None
+        command = [nice, "-n", str(niceness), *command] if nice else command
+        if cancel is not None and cancel.stopped:
+            raise RuntimeError("stopped")
         with subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True) as run:
+            if cancel is not None:
+                cancel.started(run.pid)  # (its own session: its process group is its pid)
             try:
                 _, errors = run.communicate()
             except BaseException:
                 os.killpg(run.pid, signal.SIGKILL)
                 raise
+            finally:
+                if cancel is not None:
+                    cancel.ended(run.pid)
         if run.returncode != 0:
             said = [ln for ln in errors.decode(errors="replace").splitlines() if "error" in ln] or ["no message"]
             raise RuntimeError(f"{Path(cc).name} failed: {said[0].strip()}")
@@ -157,6 +175,38 @@ def _compile_one(cc: str, function: ca.Function, folder: Path, stem: str) -> Non
         digest.write_text(_digest(library))
         os.replace(library, folder / f"{stem}.so")
         os.replace(digest, _digest_path(folder / f"{stem}.so"))
+
+
+class Cancel:
+    """The stop of a background compile (another thread's, ``planning.solver.background``): :meth:`stop` kills its
+    compiler under way (its process group) and starts none after it; the compile ends as failed, unsaid."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._stopped = threading.Event()
+        self._groups: set[int] = set()
+
+    @property
+    def stopped(self) -> bool:
+        return self._stopped.is_set()
+
+    def stop(self) -> None:
+        with self._lock:
+            self._stopped.set()
+            for group in self._groups:
+                with contextlib.suppress(ProcessLookupError, PermissionError):
+                    os.killpg(group, signal.SIGKILL)
+
+    def started(self, group: int) -> None:
+        """A compiler started (its process group): killed at once when stopped meanwhile."""
+        with self._lock:
+            self._groups.add(group)
+            if self._stopped.is_set():
+                os.killpg(group, signal.SIGKILL)
+
+    def ended(self, group: int) -> None:
+        with self._lock:
+            self._groups.discard(group)
 
 
 def _libraries(folder: Path, key: str) -> dict[str, Path]:

@@ -33,7 +33,14 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
-from planning.solver.compiled import COMPILED_FUNCTIONS, cached_functions, compile_into_cache, discard, problem_key
+from planning.solver.compiled import (
+    COMPILED_FUNCTIONS,
+    Cancel,
+    cached_functions,
+    compile_into_cache,
+    discard,
+    problem_key,
+)
 from planning.solver.lifting import Lift, lifted_problem, row_split_jacobian
 from planning.tolerances import IPOPT_MU_INIT, IPOPT_TOL, IPOPT_WARM_PUSH
 
@@ -147,17 +154,18 @@ class NLPSolver:
             for kept in _KEPT:
                 kept.append(self)
 
-    def compile(self) -> float | None:
-        """Compile this problem's derivative functions into the cache (``planning.solver.compiled``) and solve
-        with them from now on; the seconds the compiler took (0: they were there), or None where this problem
-        cannot be compiled (an MX problem), there is no compiler or no cache, or the libraries made do not load
-        (said once)."""
+    def compile(self, niceness: int = 0, cancel: Cancel | None = None) -> float | None:
+        """Compile this problem's derivative functions into the cache (``planning.solver.compiled``; the
+        compiler at ``niceness``, stopped by ``cancel``) and solve with them from now on; the seconds the
+        compiler took (0: they were there), or None where this problem cannot be compiled (an MX problem),
+        there is no compiler or no cache, the compile was stopped, or the libraries made do not load (said
+        once)."""
         if not self.compilable:
             return None
         if self.compiled:
             return 0.0
         functions = {option: self._cold.get_function(name) for option, name in COMPILED_FUNCTIONS.items()}
-        seconds = compile_into_cache(self.key, functions)
+        seconds = compile_into_cache(self.key, functions, niceness, cancel)
         found = cached_functions(self.key) if seconds is not None else None
         if found is None:
             return None
