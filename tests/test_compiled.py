@@ -154,7 +154,7 @@ def test_the_background_compiler_compiles_what_the_process_builds_and_the_solves
     solver = NLPSolver("toy", _problem())  # built by "the page": interpreted at first
     interpreted = _solve(solver)
     said = []
-    compiler = BackgroundCompiler(say=said.append, poll_s=0.05).start()
+    compiler = BackgroundCompiler(say=said.append, poll_s=0.05, source=lambda: [solver]).start()
     try:
         deadline = time.monotonic() + 60
         while not solver.compiled and time.monotonic() < deadline:
@@ -176,7 +176,7 @@ def test_closing_the_background_compiler_kills_its_compiler_and_leaves_the_solve
     slow.chmod(0o755)
     monkeypatch.setattr(compiled, "compiler", lambda: str(slow))
     solver = NLPSolver("toy", _problem())
-    compiler = BackgroundCompiler(poll_s=0.05).start()
+    compiler = BackgroundCompiler(poll_s=0.05, source=lambda: [solver]).start()
     deadline = time.monotonic() + 30
     while not marker.exists() and time.monotonic() < deadline:
         time.sleep(0.05)

@@ -14,7 +14,7 @@ from __future__ import annotations
 import sys
 import threading
 import weakref
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 
 from planning.solver.compiled import Cancel, cache_dir, compiler
 from planning.solver.ipopt import BUILT, NLPSolver
@@ -25,10 +25,17 @@ POLL_S = 1.0  # [s] how often the thread looks for a newly built problem
 
 class BackgroundCompiler:
     """Compiles every SX problem this process builds, in a daemon thread (module docstring). ``say``: where the
-    lines about it go (one when a problem is compiled)."""
+    lines about it go (one when a problem is compiled); ``source``: the solvers it looks at (by default every one
+    the process has built, ``BUILT``)."""
 
-    def __init__(self, say: Callable[[str], None] | None = None, poll_s: float = POLL_S) -> None:
+    def __init__(
+        self,
+        say: Callable[[str], None] | None = None,
+        poll_s: float = POLL_S,
+        source: Callable[[], Iterable[NLPSolver]] = lambda: BUILT,
+    ) -> None:
         self._say = say or (lambda text: print(f"pressplan: {text}", file=sys.stderr, flush=True))
+        self._source = source
         self._poll_s = poll_s
         self._stop = threading.Event()
         self._cancel = Cancel()
@@ -71,7 +78,7 @@ class BackgroundCompiler:
     def _waiting(self) -> list[NLPSolver]:
         """The built SX problems not compiled nor tried yet (a problem whose compile failed is not tried again)."""
         try:
-            built = list(BUILT)
+            built = list(self._source())
         except RuntimeError:  # a solver built while the set was read: next time
             return []
         fresh = [s for s in built if s.compilable and not s.compiled and s not in self._handled]
