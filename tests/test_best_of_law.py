@@ -20,8 +20,6 @@ import pytest
 from planning.model.case_file import CaseFileError, case_from_data, read_case
 from planning.solver.optimize import solve
 from planning.solver.outcomes import PlanningError
-from planning.solver.precheck import precheck
-from planning.solver.starts import DIE_EXIT_MIN_SHARE, die_exit
 
 from .random_cases import build_case, seeded_linkage_case
 
@@ -119,17 +117,3 @@ def test_a_crank_jerk_limit_near_zero_still_plans_under_the_improved_s_curve():
     assert solution.plan.motion_law == "improved-s-curve"
     assert solution.plan.spm == pytest.approx(6.7, rel=1e-9)
     assert solution.verification.check("crank_jerk").value <= 0.01
-
-
-def test_the_die_exit_start_is_left_out_where_the_slide_leaves_the_die_right_after_theta3():
-    """The die exit's start (the return's halves ending where the slide rises through the die height) is a
-    structure of its own where that crossing lies well after theta3 (the trial's link drive: 17 % of the
-    return's angle), and a degenerate one where it follows theta3 at once (the published case: 0.3 %, halves
-    of milliseconds): it is left out there (``starts.DIE_EXIT_MIN_SHARE``)."""
-    for path, kept in ((LINK2500, True), (ROOT / "cases" / "wang2023-side-panel.yaml", False)):
-        case = read_case(path)
-        _, _, th3, th4 = case.key_angles
-        up = float(case.machine.angles_at_height(case.limits.die_height_mm)[1])
-        share = (up - th3) / (th4 - th3)
-        assert (share > DIE_EXIT_MIN_SHARE) == kept and share > 0  # both draws end below the die height
-        assert (die_exit(case, precheck(case)[1]) is not None) == kept

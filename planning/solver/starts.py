@@ -161,27 +161,20 @@ def free_starts(
     return starts
 
 
-DIE_EXIT_MIN_SHARE = 0.01  # of the return's angle (theta3 .. theta4): a die exit closer to theta3 starts nothing new
-
-
 def die_exit(case: Case, w2: float) -> dict[str, float] | None:
     """Where the draw ends with the slide still below the die height (the check warns of it), the die speed
     caps the crank at the crossing the slide rises through after theta3: ``v_die / |h'|`` there. A start of
     that structure: the return's halves sweep theta3 to that crossing only, and the transfer runs at the cap
     (or the speed the transfer time needs, the lower) from the crossing through the robot's window, theta4
-    in the transfer. None where the draw ends above the die height, with a hold (its return starts at rest), or
-    where the slide rises through the die height within :data:`DIE_EXIT_MIN_SHARE` of the return's angle after
-    theta3: there the crossing's |h'| is near zero (the cap far above any speed) and halves ending at it last
-    milliseconds, a degenerate start of the guesses' structure (it reached their optimum in every press measured,
-    in 30-120 IPOPT iterations against their 20)."""
+    in the transfer. None where the draw ends above the die height, or with a hold (its return starts at rest)."""
     m = case.machine
     th1, _, th3, th4 = case.key_angles
     die = case.limits.die_height_mm
     if float(m.height(th3)) >= die or case.hold_angle is not None:
         return None
     up = float(m.angles_at_height(min(die, m.stroke))[1])
-    if not th3 + DIE_EXIT_MIN_SHARE * (th4 - th3) < up < th4:
-        return None  # (a crossing this close to theta3: a return that ends there lasts milliseconds, no structure)
+    if not th3 < up < th4:
+        return None
     cap = case.limits.die_speed_mm_s / abs(float(m.derivatives(up)[0]))
     w_transfer, w_min = transfer_speeds(case)
     w1 = max(min(w_transfer, cap), w_min)
