@@ -190,3 +190,29 @@ def test_closing_the_background_compiler_kills_its_compiler_and_leaves_the_solve
     assert subprocess.run(["kill", "-0", pid], capture_output=True).returncode != 0  # killed, not left to run
     assert not solver.compiled and not list(cache.glob("*.so"))
     assert "not compiled" not in capsys.readouterr().err  # stopped on purpose: nothing to say
+
+
+def test_a_compile_that_raises_is_said_in_one_line_and_the_thread_goes_on():
+    class Failing:  # a built problem whose compile raises (CasADi's code generator, say)
+        compilable, compiled, key, name = True, False, "k-failing", "failing"
+
+        def compile(self, niceness, cancel):  # noqa: ANN001, ANN202
+            raise ValueError("no code for this function")
+
+    class Fine(Failing):
+        key, name = "k-fine", "fine"
+
+        def compile(self, niceness, cancel):  # noqa: ANN001, ANN202
+            self.compiled = True
+            return 1.0
+
+    failing, fine = Failing(), Fine()
+    said = []
+    compiler = BackgroundCompiler(say=said.append, poll_s=0.02, source=lambda: [failing, fine]).start()
+    deadline = time.monotonic() + 10
+    while not fine.compiled and time.monotonic() < deadline:
+        time.sleep(0.02)
+    compiler.close()
+    assert fine.compiled and compiler.compiled == ["fine"] and not failing.compiled
+    assert said[0] == "failing not compiled (ValueError: no code for this function); it stays interpreted"
+    assert len(said) == 2 and "fine compiled" in said[1]  # tried once, not again at every poll

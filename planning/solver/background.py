@@ -66,7 +66,11 @@ class BackgroundCompiler:
                 if self._stop.is_set():
                     return
                 self._handled.add(solver)
-                seconds = solver.compile(NICENESS, self._cancel)  # 0.0: compiled before (another solver of the problem)
+                try:
+                    seconds = solver.compile(NICENESS, self._cancel)  # 0.0: compiled before (another solver of it)
+                except Exception as exc:  # noqa: BLE001 - a thread of a server: said in one line, never a traceback
+                    self._say(f"{solver.name} not compiled ({type(exc).__name__}: {exc}); it stays interpreted")
+                    seconds = None
                 if self._stop.is_set():
                     return
                 if seconds is None:

@@ -202,7 +202,8 @@ class Cancel:
         with self._lock:
             self._groups.add(group)
             if self._stopped.is_set():
-                os.killpg(group, signal.SIGKILL)
+                with contextlib.suppress(ProcessLookupError, PermissionError):
+                    os.killpg(group, signal.SIGKILL)
 
     def ended(self, group: int) -> None:
         with self._lock:
