@@ -9,6 +9,7 @@ import json
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import casadi as ca
 import numpy as np
@@ -172,7 +173,11 @@ def test_closing_the_background_compiler_kills_its_compiler_and_leaves_the_solve
     slow = tmp_path / "bin" / "cc"  # a compiler that would take a minute
     slow.parent.mkdir()
     marker = tmp_path / "started"
-    slow.write_text(f"#!/bin/sh\necho $$ > {marker}.tmp\nmv {marker}.tmp {marker}\nexec sleep 60\n")
+    scratch = tmp_path / "scratch"  # where the compiler says its own temporary files go (gcc: $TMPDIR)
+    slow.write_text(
+        f'#!/bin/sh\necho "$TMPDIR" > {scratch}\ntouch "$TMPDIR/cc-own.s"\n'
+        f"echo $$ > {marker}.tmp\nmv {marker}.tmp {marker}\nexec sleep 60\n"
+    )
     slow.chmod(0o755)
     monkeypatch.setattr(compiled, "compiler", lambda: str(slow))
     solver = NLPSolver("toy", _problem())
@@ -189,6 +194,8 @@ def test_closing_the_background_compiler_kills_its_compiler_and_leaves_the_solve
     time.sleep(0.2)  # (reaped by the thread's Popen before close returned; the signal is immediate)
     assert subprocess.run(["kill", "-0", pid], capture_output=True).returncode != 0  # killed, not left to run
     assert not solver.compiled and not list(cache.glob("*.so"))
+    own = Path(scratch.read_text().strip())  # its temporary files: in the cache's temporary folder, gone with it
+    assert own.parent == cache and not own.exists()
     assert "not compiled" not in capsys.readouterr().err  # stopped on purpose: nothing to say
 
 

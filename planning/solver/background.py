@@ -5,8 +5,9 @@ page's solves build them as cases come) and compiles each, one at a time in a da
 (``planning.solver.compiled``: the same functions, the same plans, about 0.6 times the solve time); the compiler runs
 at a lower priority (:data:`NICENESS`) so that the solves keep the cores. A solver swaps to its compiled functions
 when they are made (under the IPOPT lock: a solve under way finishes with the interpreted ones). Without a compiler
-or a cache nothing is compiled (said once, never an error). :meth:`BackgroundCompiler.close` stops the thread and
-kills a compiler under way (none outlives the process).
+or a cache (:meth:`BackgroundCompiler.available`) ``pressplan serve`` starts none and its solves stay interpreted, as
+with ``--no-compile``. :meth:`BackgroundCompiler.close` stops the thread and kills a compiler under way (none
+outlives the process; the compiler's temporary files are in the cache's temporary folder, removed with it).
 """
 
 from __future__ import annotations

@@ -157,7 +157,10 @@ def _compile_one(
         command = [nice, "-n", str(niceness), *command] if nice else command
         if cancel is not None and cancel.stopped:
             raise RuntimeError("stopped")
-        with subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True) as run:
+        temporary = {**os.environ, "TMPDIR": work}  # the compiler's own files too: gone with the folder, killed or not
+        with subprocess.Popen(
+            command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True, env=temporary
+        ) as run:
             if cancel is not None:
                 cancel.started(run.pid)  # (its own session: its process group is its pid)
             try:

@@ -167,26 +167,33 @@ class NLPSolver:
         functions = {option: self._cold.get_function(name) for option, name in COMPILED_FUNCTIONS.items()}
         seconds = compile_into_cache(self.key, functions, niceness, cancel)
         found = cached_functions(self.key) if seconds is not None else None
-        if found is None:
+        solver = self._fitted(found) if found is not None else None  # built outside the lock: solves go on
+        if solver is None:
             return None
-        with _IPOPT_LOCK:  # a thread may be solving with the interpreted functions
-            self._cold = self._solver_with(found)
-            self._warm = None
-        return seconds if self.compiled else None
+        with _IPOPT_LOCK:  # a thread may be solving with the interpreted functions: swapped between its solves
+            self.options.update(found)
+            self.compiled = True
+            self._cold, self._warm = solver, None
+        return seconds
 
     def _solver_with(self, found: dict[str, ca.Function] | None) -> ca.Function:
         """The cold solver, with the compiled derivative functions ``found`` where they fit the problem (else,
         their libraries discarded, the interpreted ones); sets :attr:`compiled`."""
-        if found is not None:
-            try:
-                solver = _compiled(self.name, self.problem, {**self.options, **found})
-            except RuntimeError as exc:  # a library of another shape under this key: not this problem's
-                discard(self.key, exc)
-            else:
-                self.options.update(found)
-                self.compiled = True
-                return solver
-        return _compiled(self.name, self.problem, self.options)
+        solver = self._fitted(found) if found is not None else None
+        if solver is None:
+            return _compiled(self.name, self.problem, self.options)
+        self.options.update(found)
+        self.compiled = True
+        return solver
+
+    def _fitted(self, found: dict[str, ca.Function]) -> ca.Function | None:
+        """The cold solver with the compiled derivative functions ``found``; None where they do not fit the
+        problem (a library of another shape under this key: not this problem's; discarded)."""
+        try:
+            return _compiled(self.name, self.problem, {**self.options, **found})
+        except RuntimeError as exc:
+            discard(self.key, exc)
+            return None
 
     def _warm_function(self) -> ca.Function:
         if self._warm is None:
