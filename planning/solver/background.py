@@ -42,6 +42,7 @@ class BackgroundCompiler:
         self._cancel = Cancel()
         self._handled: weakref.WeakSet = weakref.WeakSet()  # the solvers compiled or tried
         self._failed: set[str] = set()  # the keys whose compile failed (not tried again)
+        self._busy = False  # a compile under way
         self._thread = threading.Thread(target=self._run, name="pressplan-compiler", daemon=True)
         self.compiled: list[str] = []  # the solvers' names, as they were compiled
 
@@ -53,6 +54,10 @@ class BackgroundCompiler:
     def start(self) -> BackgroundCompiler:
         self._thread.start()
         return self
+
+    def pending(self) -> bool:
+        """A built problem waits for its compile, or one is under way."""
+        return self._busy or bool(self._waiting())
 
     def close(self) -> None:
         """Stop the thread; kill a compiler under way (its problem stays interpreted)."""
@@ -66,12 +71,15 @@ class BackgroundCompiler:
             for solver in self._waiting():
                 if self._stop.is_set():
                     return
+                self._busy = True
                 self._handled.add(solver)
                 try:
                     seconds = solver.compile(NICENESS, self._cancel)  # 0.0: compiled before (another solver of it)
                 except Exception as exc:  # noqa: BLE001 - a thread of a server: said in one line, never a traceback
                     self._say(f"{solver.name} not compiled ({type(exc).__name__}: {exc}); it stays interpreted")
                     seconds = None
+                finally:
+                    self._busy = False
                 if self._stop.is_set():
                     return
                 if seconds is None:

@@ -171,9 +171,7 @@ class NLPSolver:
         if solver is None:
             return None
         with _IPOPT_LOCK:  # a thread may be solving with the interpreted functions: swapped between its solves
-            self.options.update(found)
-            self.compiled = True
-            self._cold, self._warm = solver, None
+            self._cold, self._warm = self._adopted(found, solver), None
         return seconds
 
     def _solver_with(self, found: dict[str, ca.Function] | None) -> ca.Function:
@@ -182,6 +180,11 @@ class NLPSolver:
         solver = self._fitted(found) if found is not None else None
         if solver is None:
             return _compiled(self.name, self.problem, self.options)
+        return self._adopted(found, solver)
+
+    def _adopted(self, found: dict[str, ca.Function], solver: ca.Function) -> ca.Function:
+        """``solver`` (built with the compiled functions ``found``), this problem's from now on: the options (the
+        warm solver is built from them) and :attr:`compiled` say so."""
         self.options.update(found)
         self.compiled = True
         return solver
