@@ -108,9 +108,9 @@ SEQUENCES = 5  # in the default run; ``pytest -m slow`` runs SLOW_SEQUENCES
 SLOW_SEQUENCES = 50
 
 
-def _page_answer(client, data: dict, seq: int) -> dict:  # noqa: ANN001 - a Flask test client
+def _page_answer(client, data: dict, seq: int, session: str = "tab") -> dict:  # noqa: ANN001 - a Flask test client
     """What the page shows at rest after an edit: the fast answer, then the confirmed one."""
-    body = {"session": "tab", "seq": seq, "label": "case", "case": data}
+    body = {"session": session, "seq": seq, "label": "case", "case": data}
     answer = client.post("/api/solve", json={**body, "confirm": False}).get_json()
     if answer["status"] == Outcome.VERIFIED and not answer["confirmed"]:
         answer = client.post("/api/solve", json={**body, "confirm": True}).get_json()
@@ -124,42 +124,56 @@ def _edit_sequences(count: int, seed: int) -> list[list[tuple[tuple[str, str], o
     return [[rng.choice(EDITS) for _ in range(rng.randint(3, 8))] for _ in range(count)]
 
 
-def _run_sequences(count: int, seed: int) -> None:
+def _run_sequences(count: int, seed: int, cold_worker: bool = False) -> None:
+    """``count`` random edit sequences, each in a new tab (with ``cold_worker``: the tabs of one server whose
+    edits' cold solves run in its worker process, as ``pressplan serve`` runs them)."""
+    import contextlib
     import random
 
     pytest.importorskip("flask")
-    from planning.web.server import create_app
+    from planning.web.server import close_app, create_app
 
     rng = random.Random(seed + 1)
     base = read_case(PUBLISHED).model_dump(exclude_none=True)
     base.pop("published", None)
-    for n, sequence in enumerate(_edit_sequences(count, seed)):
-        client = create_app(ROOT / "cases").test_client()
-        data = json.loads(json.dumps(base))
-        answer = _page_answer(client, data, 1)
-        for k, ((section, field), values) in enumerate(sequence, start=2):
-            data[section][field] = rng.choice(values)
-            answer = _page_answer(client, data, k)
-        try:
-            cold = solve(case_from_data(data))
-        except CaseFileError:
-            assert answer["status"] == Outcome.BAD_INPUT, (n, data)
-            continue
-        except PlanningError:
-            assert answer["status"] != "verified", (n, data)
-            continue
-        assert answer["status"] == Outcome.VERIFIED, (n, answer.get("message"))
-        shown = answer["result"]["spm"]
-        assert shown >= cold.plan.spm * (1 - SAME), (n, sequence, shown, cold.plan.spm)
+    served = create_app(ROOT / "cases", cold_worker=True) if cold_worker else None
+    with contextlib.ExitStack() as stack:
+        if served is not None:
+            stack.callback(close_app, served)
+        for n, sequence in enumerate(_edit_sequences(count, seed)):
+            app = served or create_app(ROOT / "cases")
+            _check_sequence(app, f"tab-{n}", sequence, json.loads(json.dumps(base)), rng)
 
 
-def test_the_page_shows_the_cold_plan_or_better_whatever_the_order_of_edits():
-    _run_sequences(SEQUENCES, seed=2026)
+def _check_sequence(app, session: str, sequence: list, data: dict, rng) -> None:  # noqa: ANN001 - a Flask app, a Random
+    """The page's answer after the edits of ``sequence`` is the cold solve's plan or better."""
+    client = app.test_client()
+    answer = _page_answer(client, data, 1, session)
+    for k, ((section, field), values) in enumerate(sequence, start=2):
+        data[section][field] = rng.choice(values)
+        answer = _page_answer(client, data, k, session)
+    try:
+        cold = solve(case_from_data(data))
+    except CaseFileError:
+        assert answer["status"] == Outcome.BAD_INPUT, (session, data)
+        return
+    except PlanningError:
+        assert answer["status"] != "verified", (session, data)
+        return
+    assert answer["status"] == Outcome.VERIFIED, (session, answer.get("message"))
+    shown = answer["result"]["spm"]
+    assert shown >= cold.plan.spm * (1 - SAME), (session, sequence, shown, cold.plan.spm)
+
+
+@pytest.mark.parametrize("cold_worker", (False, True), ids=("cold solves here", "cold solves in the worker"))
+def test_the_page_shows_the_cold_plan_or_better_whatever_the_order_of_edits(cold_worker):
+    _run_sequences(SEQUENCES, seed=2026, cold_worker=cold_worker)
 
 
 @pytest.mark.slow
-def test_fifty_edit_sequences_show_the_cold_plan_or_better():
-    _run_sequences(SLOW_SEQUENCES, seed=1123)
+@pytest.mark.parametrize("cold_worker", (False, True), ids=("cold solves here", "cold solves in the worker"))
+def test_fifty_edit_sequences_show_the_cold_plan_or_better(cold_worker):
+    _run_sequences(SLOW_SEQUENCES, seed=1123 + cold_worker, cold_worker=cold_worker)
 
 
 def _counting_solves(monkeypatch) -> list[int]:  # noqa: ANN001 - pytest's monkeypatch

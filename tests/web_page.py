@@ -54,9 +54,10 @@ def running_server(initial: Path | None = None, recipes: Path | None = None) -> 
     """The app on a free port of 127.0.0.1 in a thread (with a recipes folder when given); yields its address."""
     from werkzeug.serving import make_server
 
-    from planning.web.server import create_app
+    from planning.web.server import close_app, create_app
 
-    server = make_server("127.0.0.1", 0, create_app(CASES, initial, recipes_dir=recipes), threaded=True)
+    app = create_app(CASES, initial, recipes_dir=recipes, cold_worker=True)  # as ``pressplan serve`` runs it
+    server = make_server("127.0.0.1", 0, app, threaded=True)
     thread = threading.Thread(target=server.serve_forever, daemon=True)
     thread.start()
     try:
@@ -64,6 +65,7 @@ def running_server(initial: Path | None = None, recipes: Path | None = None) -> 
     finally:
         server.shutdown()
         thread.join(timeout=10)
+        close_app(app)
 
 
 @contextmanager

@@ -166,13 +166,21 @@ class NLPSolver:
             return 0.0
         functions = {option: self._cold.get_function(name) for option, name in COMPILED_FUNCTIONS.items()}
         seconds = compile_into_cache(self.key, functions, niceness, cancel)
-        found = cached_functions(self.key) if seconds is not None else None
+        return seconds if seconds is not None and self.adopt() else None
+
+    def adopt(self) -> bool:
+        """Solve with the compiled derivative functions from now on where the cache holds them (compiled by this
+        process or by another: the page's cold-solve worker takes those of the server's background compiler);
+        whether this problem is compiled now. A cache without them costs two file lookups."""
+        if self.compiled or not self.compilable:
+            return self.compiled
+        found = cached_functions(self.key)
         solver = self._fitted(found) if found is not None else None  # built outside the lock: solves go on
         if solver is None:
-            return None
+            return False
         with _IPOPT_LOCK:  # a thread may be solving with the interpreted functions: swapped between its solves
             self._cold, self._warm = self._adopted(found, solver), None
-        return seconds
+        return True
 
     def _solver_with(self, found: dict[str, ca.Function] | None) -> ca.Function:
         """The cold solver, with the compiled derivative functions ``found`` where they fit the problem (else,
@@ -260,6 +268,12 @@ class NLPSolver:
             iterations=int(stats["iter_count"]),
             wall_time_s=time.perf_counter() - t0,
         )
+
+
+def adopt_compiled() -> int:
+    """Every problem this process built and solves interpreted: compiled from now on where the cache holds its
+    functions now (:meth:`NLPSolver.adopt`); how many were adopted."""
+    return sum(solver.adopt() for solver in list(BUILT) if not solver.compiled)
 
 
 @contextlib.contextmanager

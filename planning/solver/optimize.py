@@ -24,7 +24,7 @@ from planning.solver.outcomes import PlanningError
 from planning.solver.solution import Solution
 from planning.tolerances import BETTER_SHARE
 
-__all__ = ["Solution", "solve", "solve_from"]
+__all__ = ["Solution", "better", "solve", "solve_from"]
 
 
 def solve(
@@ -60,7 +60,7 @@ def solve(
         if warm is None:
             raise
         return warm
-    return _better(cold, _from_neighbour(case, placement, neighbour, optima))
+    return better(cold, _from_neighbour(case, placement, neighbour, optima))
 
 
 def solve_from(case: Case, neighbour: Plan | Solution, placement: Placement | None = None) -> Solution | None:
@@ -97,7 +97,7 @@ TRANSCRIPTIONS = {
 }
 
 
-def _better(cold: Solution, warm: Solution | None) -> Solution:
+def better(cold: Solution, warm: Solution | None) -> Solution:
     """The cold solve's answer unless the neighbour's is shorter; either way with both searches' totals."""
     if warm is None:
         return cold

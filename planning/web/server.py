@@ -16,7 +16,9 @@ solves of all sessions share two fair queues (:class:`FairQueue`), one for the f
 start from the session's plan) and one for the cold solves that confirm them: in each at most
 :data:`SOLVES_AT_ONCE` run, and the waiting session served least recently goes first. So one tab's burst
 of edits, or many tabs' cold solves, delay another tab's fast answer to an edit by the fast answers
-already running at most (``benchmarks/bench_web.py`` measures it under a 20-session burst). A confirmed
+already running at most (``benchmarks/bench_web.py`` measures it under a 20-session burst). With a cold-solve
+worker (``serve``), an edit's cold solve starts in a worker process when its fast request comes, and the confirm
+request takes it (``planning.web.workers``): the two solves side by side. A confirmed
 answer is kept by its case (:data:`ANSWER_CACHE` of them): the same case again, from any tab, is
 answered without a solve. The number of sessions kept is bounded (:data:`MAX_SESSIONS`, the least
 recently used is dropped).
@@ -24,6 +26,7 @@ recently used is dropped).
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import itertools
 import json
@@ -60,6 +63,7 @@ from planning.web.cams import (
     proved,
     refused,
 )
+from planning.web.workers import PendingCold, WorkerProcess, cold_solution
 
 STATIC = Path(__file__).resolve().parent / "static"
 PENDULUM_BOUND_LEAVES_OUT = (  # what the pendulum's bound leaves out (``planning.solver.pendulum_bound``)
@@ -86,6 +90,7 @@ class Session:
     newest: int = -1
     plan: Any = None
     shown: tuple[str, Any, Any] | None = None  # the last confirmed plan: (its case's key, case, solution)
+    pending: PendingCold | None = None  # the cold solve started in the worker for the last edit's fast request
     cam: CamCache = field(default_factory=CamCache)  # the last cam proved of it (planning.web.cams)
 
 
@@ -180,6 +185,7 @@ class _Shared:
     bounds: OrderedDict = field(default_factory=OrderedDict)
     bounds_lock: threading.Lock = field(default_factory=threading.Lock)
     bound_pool: Any = None
+    cold_worker: WorkerProcess | None = None
     recipes: Path | None = None
 
 
@@ -188,10 +194,14 @@ def create_app(
     initial: Path | None = None,
     allowed_hosts: tuple[str, ...] = (),
     recipes_dir: Path | None = None,
+    cold_worker: bool = False,
 ) -> Flask:
     """The application: the page, its static files and the JSON endpoints. Requests are answered for the
     host names of this machine and ``allowed_hosts`` (the address ``serve`` binds) only. With
-    ``recipes_dir`` the page saves cases under a name there and reopens them (``planning.web.recipes``)."""
+    ``recipes_dir`` the page saves cases under a name there and reopens them (``planning.web.recipes``).
+    ``cold_worker``: an edit's confirming cold solve runs in a worker process beside its fast answer
+    (``planning.web.workers``; ``serve`` and the browser tests); without, after it in this process. Either way
+    the same answers; ``close_app`` stops the worker processes."""
     import logging
 
     logging.getLogger("werkzeug").setLevel(logging.WARNING)  # no line per request
@@ -201,7 +211,8 @@ def create_app(
     if initial is not None:
         offered = {initial.name: initial, **{k: v for k, v in offered.items() if k != initial.name}}
     shared = _Shared(offered, bound_pool=_BoundPool(), recipes=recipes_dir)
-    app.extensions["pressplan_bound_pool"] = shared.bound_pool  # serve() stops its worker on the way out
+    shared.cold_worker = WorkerProcess() if cold_worker else None
+    app.extensions["pressplan_workers"] = [shared.bound_pool.worker, shared.cold_worker]  # stopped by close_app
     app.extensions["pressplan_sessions"] = shared.sessions  # the tests hold a session's lock to see superseding
     app.extensions["pressplan_queues"] = shared.queues  # the edits' fast answers never wait behind cold solves
     _guard(app, allowed_hosts)
@@ -448,7 +459,7 @@ def _answer(shared: _Shared, session: Session, body: dict[str, Any], seq: int) -
             with session.guard:
                 session.shown = (case_key(data), case, solution)
             return dict(answer)
-        answer = solve_case(data, label, session, body.get("confirm") is True)
+        answer = solve_case(data, label, session, body.get("confirm") is True, shared.cold_worker)
         if answer.get("confirmed") and answer["status"] is Outcome.VERIFIED and session.shown is not None:
             with shared.answers_lock:  # (a pendulum's answer is not kept: no plan of it is shown for downloads)
                 shared.answers[known] = (answer, *session.shown[1:])
@@ -590,12 +601,15 @@ def _model_at(dotted: str) -> tuple[type, str]:
     return model, leaf
 
 
-def solve_case(data: Any, label: str, session: Session, confirm: bool = True) -> dict[str, Any]:
+def solve_case(
+    data: Any, label: str, session: Session, confirm: bool = True, worker: WorkerProcess | None = None
+) -> dict[str, Any]:
     """Validate and solve ``data`` from the session's last plan; the page's answer. ``confirm`` False: the
     fast answer from the last plan alone when it verifies (``confirmed`` False in the answer: the page
-    then asks again with ``confirm``); else the cold solve's answer or better (``confirmed`` True)."""
+    then asks again with ``confirm``); else the cold solve's answer or better (``confirmed`` True). With a
+    ``worker``, the fast request starts the cold solve there at once (``planning.web.workers``)."""
     from planning.reports.report import columns_at, result_dict, summary_text
-    from planning.solver.optimize import solve, solve_from
+    from planning.solver.optimize import solve_from
     from planning.solver.outcomes import Infeasible, PlanningError
 
     try:
@@ -607,10 +621,13 @@ def solve_case(data: Any, label: str, session: Session, confirm: bool = True) ->
     try:
         solution = None
         if not confirm and session.plan is not None:
+            pending = _cold_started(worker, case, (data, label), session)
             solution = solve_from(case, session.plan)  # fast; another local optimum is possible
+            if pending is not None:
+                pending.fast = solution
         confirmed = solution is None
         if solution is None:
-            solution = solve(case, neighbour=session.plan)  # the cold solve's answer or better
+            solution = _cold_or_better(case, (data, label), session, worker)
     except PlanningError as exc:
         limit = exc.limit if isinstance(exc, Infeasible) else None
         return {"status": exc.outcome, "message": f"{label}: {exc}", "field": limit, "confirmed": True, **_warned(case)}
@@ -632,6 +649,44 @@ def solve_case(data: Any, label: str, session: Session, confirm: bool = True) ->
         "utilisation": utilisation(solution.verification, case),
         **_warned(case),
     }
+
+
+def _cold_started(worker: WorkerProcess | None, case: Case, sent: tuple, session: Session) -> PendingCold | None:
+    """The cold solve of ``case`` (``sent``: the page's data and label it was read from) started in ``worker`` for
+    the session's fast request (the session's older one dropped), or None: no worker, or an objective at the
+    line's rate (its neighbour starts the search there and is not compared with a cold solve: solved here)."""
+    if session.pending is not None:
+        session.pending.future.cancel()  # an older edit's, not started yet: dropped (one under way runs out)
+        session.pending = None
+    if worker is None or case.planner.objective != "max-spm":
+        return None
+    try:
+        session.pending = PendingCold(_sent_key(sent), worker.submit(cold_solution, *sent))
+    except RuntimeError:  # the worker does not start (BrokenProcessPool): solved here
+        return None
+    return session.pending
+
+
+def _cold_or_better(case: Case, sent: tuple, session: Session, worker: WorkerProcess | None) -> Any:
+    """The cold solve's answer or better: the better of the worker's cold solve of this case (started by its fast
+    request) and the fast answer, as ``solve`` with the neighbour gives; where there is none (no worker, another
+    case, the worker found no plan or is gone) ``solve`` here, the session's plan the neighbour. A case solved here
+    before the worker ever ran starts the worker (its imports and NLPs made while the user looks at the plan)."""
+    from planning.solver.optimize import better, solve
+
+    pending, session.pending = session.pending, None
+    cold = pending.cold() if pending is not None and pending.key == _sent_key(sent) else None
+    if cold is not None:
+        return better(cold, pending.fast)
+    if worker is not None and not worker.started and case.planner.objective == "max-spm":
+        with contextlib.suppress(RuntimeError):  # a worker that does not start: the edits are solved here
+            worker.submit(cold_solution, *sent)
+    return solve(case, neighbour=session.plan)
+
+
+def _sent_key(sent: tuple) -> str:
+    """The key of the case the page sent (its data and label)."""
+    return case_key({"label": sent[1], "case": sent[0]})
 
 
 def _pendulum_answer(case: Case, label: str, session: Session) -> dict[str, Any]:
@@ -731,37 +786,24 @@ def mechanism_drawing(case: Case) -> dict[str, Any]:
 
 
 class _BoundPool:
-    """The bounds are computed in one separate process: a bound takes about half a second, and in the
-    server's process it would hold IPOPT (one call at a time) while the next edit's solve waits."""
+    """The bounds are computed in a worker process (``planning.web.workers``): a bound takes about half a second,
+    and in the server's process it would hold IPOPT (one call at a time) while the next edit's solve waits."""
 
     def __init__(self) -> None:
-        self._pool = None
-        self._lock = threading.Lock()
+        self.worker = WorkerProcess()
 
     def run(self, data: Any, label: str) -> dict[str, Any]:
-        import multiprocessing
-        from concurrent.futures import ProcessPoolExecutor
-
-        with self._lock:
-            if self._pool is None:
-                self._pool = ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("spawn"))
         try:
-            return self._pool.submit(bound_of, data, label).result()
+            return self.worker.submit(bound_of, data, label).result()
         except Exception as exc:  # noqa: BLE001 - the bound is extra information: say why it is missing
             return {"message": f"no bound ({type(exc).__name__})"}
 
-    def close(self) -> None:
-        """Stop the worker process now (a bound under way is dropped)."""
-        with self._lock:
-            pool, self._pool = self._pool, None
-        if pool is None:
-            return
-        processes = list(getattr(pool, "_processes", {}).values())  # the executor keeps no public handle
-        for process in processes:
-            process.terminate()
-        for process in processes:
-            process.join(timeout=5)
-        pool.shutdown(wait=True, cancel_futures=True)  # its queues closed: no semaphore left to the tracker
+
+def close_app(app: Flask) -> None:
+    """Stop the application's worker processes now (work under way is dropped)."""
+    for worker in app.extensions["pressplan_workers"]:
+        if worker is not None:
+            worker.close()
 
 
 def bound_of(data: Any, label: str) -> dict[str, Any]:
@@ -847,7 +889,7 @@ def serve(
     build, in the background (``planning.solver.background``), where a C compiler and the cache are there."""
     from planning.solver.background import BackgroundCompiler
 
-    app = create_app(cases_dir, case_path, (host,), recipes_dir)
+    app = create_app(cases_dir, case_path, (host,), recipes_dir, cold_worker=True)
     compiler = BackgroundCompiler().start() if compile_nlps and BackgroundCompiler.available() else None
     print(f"pressplan: serving on http://{host}:{port}/ (Ctrl-C stops)", flush=True)
     if compiler is not None:
@@ -855,7 +897,7 @@ def serve(
     try:
         app.run(host=host, port=port, threaded=True, use_reloader=False)
     finally:  # Ctrl-C or SIGTERM (raised in this thread by the CLI): no worker process outlives the server
-        app.extensions["pressplan_bound_pool"].close()
+        close_app(app)
         if compiler is not None:
             compiler.close()
 
