@@ -505,8 +505,10 @@ def execute(
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
+    from planning.solver.ahead import worker_signals
+
     ctx = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_signals)
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=worker_signals)
     try:
         futures = [pool.submit(task, *args) for args in work]
         if meanwhile is not None:
@@ -521,9 +523,3 @@ def execute(
     pool.shutdown()
 
 
-def _worker_signals() -> None:
-    """In a worker process: Ctrl-C is the parent's to handle; SIGTERM (from the parent) just ends it."""
-    import signal
-
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)

@@ -29,6 +29,7 @@ from planning.model.case import Case
 from planning.model.free_profile import finer, first_layout
 from planning.model.laws.optimal import OptimalLaw
 from planning.model.profile import max_abs_jerk
+from planning.solver.ahead import Ahead
 from planning.solver.optimal import on_layout, solve_optimal
 from planning.solver.outcomes import NoPlanFound, PlanningError
 from planning.solver.solution import Solution
@@ -110,34 +111,11 @@ def bracket(case: Case, tolerance_pct: float = BRACKET_TOL_PCT) -> Bracket:
         planned = planned.model_copy(update={"limits": limits})
     planned = planned.with_law(OptimalLaw.name)
     fastest = case.with_objective("max-spm")  # the bracket is about the most strokes, whatever the objective
-    verified = _checked(fastest, solve_optimal(planned))
-    upper = upper_bound(fastest, UPPER_MESHES[0], 1)
-    rounds = [BracketRound(verified.plan.spm, upper.spm, gap_pct(verified.plan.spm, upper.spm))]
-    # with robots the verified motion stays on the first layout: their rows tie every segment of the profile
-    # (the slide's height at a robot's time sums them all), so a finer layout's NLP grows with its square
-    first = first_layout(case.free_draw, case.hold_angle is not None)
-    layouts = [finer(first, f) for f in LAYOUT_FACTORS] if case.robots is None else []
-    meshes = list(UPPER_MESHES[1:])
-    turn = 0
-    while rounds[-1].gap_pct > tolerance_pct and (layouts or meshes):
-        before = rounds[-1]
-        room = STALL_SHARE * (before.upper_spm - before.verified_spm)
-        if layouts and (turn % 2 == 0 or not meshes):  # the two sides in turn, the verified motion first
-            try:
-                verified = _checked(fastest, on_layout(planned, verified, layouts.pop(0)), verified)
-            except PlanningError:  # no plan on the finer layout: the side stalls, the motion found stays
-                pass
-            if verified.plan.spm - before.verified_spm < room:
-                layouts.clear()  # the layout does not hold the motion back (or failed): finer ones will not help
-        else:
-            try:  # the meshes are not nested: the lowest upper bound is kept
-                upper = min(upper, upper_bound(fastest, meshes.pop(0), 1), key=lambda u: u.spm)
-            except PlanningError:
-                pass
-            if before.upper_spm - upper.spm < room:
-                meshes.clear()  # the relaxation, not its mesh, leaves the gap
-        turn += 1
-        rounds.append(BracketRound(verified.plan.spm, upper.spm, gap_pct(verified.plan.spm, upper.spm)))
+    ahead = Ahead()  # each upper bound computed in a worker while the motion is planned (``planning.solver.ahead``)
+    try:
+        verified, upper, rounds = _refined(case, planned, fastest, tolerance_pct, ahead)
+    finally:
+        ahead.close()
     gap = rounds[-1].gap_pct
     if gap < -CROSSED_PCT:
         raise NoPlanFound(
@@ -154,6 +132,49 @@ def bracket(case: Case, tolerance_pct: float = BRACKET_TOL_PCT) -> Bracket:
         allowance,
         time.perf_counter() - t_start,
     )
+
+
+def _refined(
+    case: Case, planned: Case, fastest: Case, tolerance_pct: float, ahead: Ahead
+) -> tuple[Solution, UpperBound, list[BracketRound]]:
+    """The first verified motion and upper bound, then the rounds that refine them (module docstring): the verified
+    motion of ``planned`` checked against ``fastest``, the upper bound of ``fastest``. Each upper bound is started
+    ``ahead`` as soon as the rounds may need it, and taken when its turn comes: the same numbers, in the time of
+    the longer side on two cores."""
+    following = ahead.start(upper_bound, fastest, UPPER_MESHES[0], 1)
+    verified = _checked(fastest, solve_optimal(planned))
+    upper = following.take()
+    rounds = [BracketRound(verified.plan.spm, upper.spm, gap_pct(verified.plan.spm, upper.spm))]
+    # with robots the verified motion stays on the first layout: their rows tie every segment of the profile
+    # (the slide's height at a robot's time sums them all), so a finer layout's NLP grows with its square
+    first = first_layout(case.free_draw, case.hold_angle is not None)
+    layouts = [finer(first, f) for f in LAYOUT_FACTORS] if case.robots is None else []
+    meshes = list(UPPER_MESHES[1:])
+    following, turn = None, 0  # following: the bound of meshes[0], once started
+    while rounds[-1].gap_pct > tolerance_pct and (layouts or meshes):
+        if following is None and meshes:
+            following = ahead.start(upper_bound, fastest, meshes[0], 1)
+        before = rounds[-1]
+        room = STALL_SHARE * (before.upper_spm - before.verified_spm)
+        if layouts and (turn % 2 == 0 or not meshes):  # the two sides in turn, the verified motion first
+            try:
+                verified = _checked(fastest, on_layout(planned, verified, layouts.pop(0)), verified)
+            except PlanningError:  # no plan on the finer layout: the side stalls, the motion found stays
+                pass
+            if verified.plan.spm - before.verified_spm < room:
+                layouts.clear()  # the layout does not hold the motion back (or failed): finer ones will not help
+        else:
+            meshes.pop(0)
+            try:  # the meshes are not nested: the lowest upper bound is kept
+                upper = min(upper, following.take(), key=lambda u: u.spm)
+            except PlanningError:
+                pass
+            following = None
+            if before.upper_spm - upper.spm < room:
+                meshes.clear()  # the relaxation, not its mesh, leaves the gap
+        turn += 1
+        rounds.append(BracketRound(verified.plan.spm, upper.spm, gap_pct(verified.plan.spm, upper.spm)))
+    return verified, upper, rounds
 
 
 def _checked(case: Case, solution: Solution, previous: Solution | None = None) -> Solution:

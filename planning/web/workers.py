@@ -17,7 +17,6 @@ The worker solves with the NLPs the server's background compiler compiled once t
 from __future__ import annotations
 
 import multiprocessing
-import signal
 import threading
 from collections.abc import Callable
 from concurrent.futures import Future, ProcessPoolExecutor
@@ -26,6 +25,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from planning.model.case_file import CaseFileError, case_from_data
+from planning.solver.ahead import stop_pool, worker_signals
 from planning.solver.outcomes import PlanningError
 
 
@@ -46,7 +46,7 @@ class WorkerProcess:
             for _ in range(2):
                 if self._pool is None:
                     context = multiprocessing.get_context("spawn")
-                    self._pool = ProcessPoolExecutor(max_workers=1, mp_context=context, initializer=_ignore_interrupts)
+                    self._pool = ProcessPoolExecutor(max_workers=1, mp_context=context, initializer=worker_signals)
                 try:
                     return self._pool.submit(function, *args)
                 except BrokenProcessPool:  # the worker died (killed, out of memory): a new one
@@ -58,19 +58,8 @@ class WorkerProcess:
         """Stop the worker process now (work under way is dropped)."""
         with self._lock:
             pool, self._pool = self._pool, None
-        if pool is None:
-            return
-        processes = list(getattr(pool, "_processes", {}).values())  # the executor keeps no public handle
-        for process in processes:
-            process.terminate()
-        for process in processes:
-            process.join(timeout=5)
-        pool.shutdown(wait=True, cancel_futures=True)  # its queues closed: no semaphore left to the tracker
-
-
-def _ignore_interrupts() -> None:
-    """The worker's start: Ctrl-C at the terminal stops the server, which stops the worker (no traceback of it)."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+        if pool is not None:
+            stop_pool(pool)
 
 
 @dataclass

@@ -1,0 +1,106 @@
+"""Calls made ahead in a worker process while this process goes on: the bracket's next upper bound while its
+verified motion is refined (``planning.solver.bracket``), so that its time is the longer side's, not their sum.
+
+:meth:`Ahead.start` hands a call to one forked worker (calls run one after another, in the order started) and
+returns at once; :meth:`Ahead.take` returns its value. A call computed there is the same computation as here (the
+same code and inputs: the same numbers); where it raised, or the worker failed, the call is made again here when
+taken, so the caller sees the value or the exception it would have seen without the worker. Where the machine has
+one core, the process cannot fork (no ``fork``, threads running, a daemon process such as a sweep's worker), calls
+are made here when taken. The worker ignores Ctrl-C (the caller's to handle) and is stopped by :meth:`Ahead.close`.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import signal
+import threading
+from collections.abc import Callable
+from concurrent.futures import Future, ProcessPoolExecutor
+from typing import Any
+
+
+def worker_signals() -> None:
+    """In a worker process: Ctrl-C is the parent's to handle; SIGTERM (from the parent) just ends it."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+def stop_pool(pool: ProcessPoolExecutor) -> None:
+    """Stop ``pool``'s worker processes now (work under way is dropped) and close its queues (no semaphore left to
+    the resource tracker)."""
+    processes = list(getattr(pool, "_processes", {}).values())  # the executor keeps no public handle
+    for process in processes:
+        process.terminate()
+    for process in processes:
+        process.join(timeout=5)
+    pool.shutdown(wait=True, cancel_futures=True)
+
+
+class Ahead:
+    """One forked worker making calls ahead (module docstring)."""
+
+    def __init__(self) -> None:
+        self._pool: ProcessPoolExecutor | None = None
+        self._usable = _can_fork()
+
+    def start(self, function: Callable[..., Any], *args: Any) -> Call:
+        """``function(*args)`` started in the worker (or, where there is none, made when taken)."""
+        future = None
+        if self._usable:
+            try:
+                if self._pool is None:
+                    context = multiprocessing.get_context("fork")
+                    self._pool = ProcessPoolExecutor(max_workers=1, mp_context=context, initializer=worker_signals)
+                future = self._pool.submit(_guarded, function, args)
+            except (OSError, RuntimeError):  # no process to be had: made here
+                self._usable = False
+        return Call(function, args, future)
+
+    def close(self) -> None:
+        """Stop the worker now (a call under way is dropped)."""
+        pool, self._pool = self._pool, None
+        if pool is not None:
+            stop_pool(pool)
+
+
+class Call:
+    """A call started by :meth:`Ahead.start`."""
+
+    def __init__(self, function: Callable[..., Any], args: tuple, future: Future | None) -> None:
+        self.function, self.args, self.future = function, args, future
+
+    def take(self) -> Any:
+        """The call's value (waiting for the worker), or, where it raised there or the worker failed, the call made
+        here: its value or its exception."""
+        if self.future is not None:
+            try:
+                done, value = self.future.result()
+            except Exception:  # noqa: BLE001 - the worker died or was stopped: made here
+                done = False
+            if done:
+                return value
+        return self.function(*self.args)
+
+
+_FAILED = (False, None)
+
+
+def _guarded(function: Callable[..., Any], args: tuple) -> tuple[bool, Any]:
+    """In the worker: ``(True, function(*args))``, or :data:`_FAILED` where it raised (made again by the caller,
+    whose exception is then its own)."""
+    try:
+        return True, function(*args)
+    except Exception:  # noqa: BLE001 - raised again where it is taken
+        return _FAILED
+
+
+def _can_fork() -> bool:
+    """A second core, ``fork``, no other thread running, not a daemon process (which may have no children)."""
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    return (
+        cores >= 2
+        and "fork" in multiprocessing.get_all_start_methods()
+        and threading.active_count() == 1
+        and not multiprocessing.current_process().daemon
+    )

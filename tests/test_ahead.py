@@ -1,0 +1,110 @@
+"""Calls made ahead in a worker process (``planning.solver.ahead``), and the bracket that uses them: the same
+numbers as made here, the caller's own exception where the call raises."""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+
+import pytest
+
+from planning.solver import ahead as ahead_module
+from planning.solver.ahead import Ahead
+
+forking = pytest.mark.skipif(not ahead_module._can_fork(), reason="no second core or no fork here")
+
+
+def _pid_after(seconds: float) -> int:
+    time.sleep(seconds)
+    return os.getpid()
+
+
+def _raises(text: str) -> None:
+    raise ValueError(f"{text} in {os.getpid()}")
+
+
+@forking
+def test_a_call_runs_in_the_worker_while_this_process_goes_on_and_in_order():
+    ahead = Ahead()
+    try:
+        t0 = time.perf_counter()
+        calls = [ahead.start(_pid_after, 0.3), ahead.start(_pid_after, 0.0)]
+        started = time.perf_counter() - t0
+        values = [call.take() for call in calls]
+    finally:
+        ahead.close()
+    assert started < 0.25  # start returned before the call was done
+    assert values[0] == values[1] != os.getpid()  # both in the one worker
+
+
+@forking
+def test_a_call_that_raises_there_raises_here_as_it_would_without_the_worker():
+    ahead = Ahead()
+    try:
+        call = ahead.start(_raises, "wrong")
+        with pytest.raises(ValueError, match=f"wrong in {os.getpid()}$"):  # this process's own exception
+            call.take()
+    finally:
+        ahead.close()
+
+
+@forking
+def test_a_worker_stopped_before_the_take_leaves_the_call_to_this_process():
+    ahead = Ahead()
+    call = ahead.start(_pid_after, 30.0)
+    t0 = time.perf_counter()
+    ahead.close()
+    assert time.perf_counter() - t0 < 5.0  # the worker killed, not waited for
+    ahead.close()
+    assert ahead_module.Call(_pid_after, (0.0,), call.future).take() == os.getpid()
+
+
+def test_without_a_worker_the_call_is_made_when_taken(monkeypatch):
+    monkeypatch.setattr(ahead_module, "_can_fork", lambda: False)
+    ahead = Ahead()
+    call = ahead.start(_pid_after, 0.0)
+    assert call.future is None and call.take() == os.getpid()
+    ahead.close()
+
+
+def _bracket_both_ways(case, tolerance_pct: float, monkeypatch):  # noqa: ANN001, ANN202 - a Case; two Brackets
+    """The bracket with its upper bounds made ahead in the worker (each one taken was made there), and made here."""
+    from planning.solver.bracket import bracket
+
+    made_there: list[bool] = []
+    take = ahead_module.Call.take
+
+    def taken(call):  # noqa: ANN001, ANN202
+        made_there.append(call.future is not None and call.future.result()[0])
+        return take(call)
+
+    with monkeypatch.context() as m:
+        m.setattr(ahead_module.Call, "take", taken)
+        parallel = bracket(case, tolerance_pct)
+    assert made_there and all(made_there), made_there
+    with monkeypatch.context() as m:
+        m.setattr(ahead_module, "_can_fork", lambda: False)
+        alone = bracket(case, tolerance_pct)
+    return parallel, alone
+
+
+@forking
+def test_the_brackets_first_round_with_its_bound_made_ahead_is_the_one_made_here(monkeypatch):
+    from planning.model.case_file import read_case
+    from tests.conftest import PUBLISHED_CASE
+
+    parallel, alone = _bracket_both_ways(read_case(PUBLISHED_CASE), math.inf, monkeypatch)
+    assert parallel.rounds == alone.rounds and parallel.upper.spm == alone.upper.spm
+
+
+@pytest.mark.slow  # 15 s: three rounds, two meshes
+@forking
+def test_the_cup_presss_bracket_with_its_bounds_made_ahead_is_the_one_made_here(monkeypatch):
+    from planning.model.case_file import read_case
+    from tests.conftest import ROOT
+
+    parallel, alone = _bracket_both_ways(read_case(ROOT / "cases" / "cup-2000kN-drive.yaml"), 0.05, monkeypatch)
+    assert len(alone.rounds) == 3 and alone.upper.points == 2880  # the bound on the second mesh was taken
+    assert parallel.rounds == alone.rounds and parallel.upper.spm == alone.upper.spm
+    assert parallel.verified.plan.spm == alone.verified.plan.spm
