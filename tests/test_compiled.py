@@ -160,7 +160,7 @@ def test_the_background_compiler_compiles_what_the_process_builds_and_the_solves
     compiler = BackgroundCompiler(say=said.append, poll_s=0.05, source=lambda: [solver]).start()
     try:
         deadline = time.monotonic() + 60
-        while not solver.compiled and time.monotonic() < deadline:
+        while not compiler.compiled and time.monotonic() < deadline:  # its record: the solver swaps just before
             time.sleep(0.05)
     finally:
         compiler.close()
