@@ -505,12 +505,13 @@ def execute(
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
-    from planning.solver.ahead import worker_signals
+    from planning.solver.ahead import signals_held, worker_signals
 
     ctx = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=worker_signals)
     try:
-        futures = [pool.submit(task, *args) for args in work]
+        with signals_held():  # the workers start here: no Ctrl-C before they ignore it
+            futures = [pool.submit(task, *args) for args in work]
         if meanwhile is not None:
             meanwhile()
         for fut in as_completed(futures):
@@ -521,5 +522,3 @@ def execute(
         pool.shutdown(wait=False, cancel_futures=True)
         raise
     pool.shutdown()
-
-

@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 import os
 import time
+from types import SimpleNamespace
 
 import pytest
 
@@ -87,6 +88,36 @@ def _bracket_both_ways(case, tolerance_pct: float, monkeypatch):  # noqa: ANN001
         m.setattr(ahead_module, "_can_fork", lambda: False)
         alone = bracket(case, tolerance_pct)
     return parallel, alone
+
+
+FAKE_UPPER_SPM = {1440: 10.1, 2880: 10.08, 5760: 10.06}  # a bound that falls with each finer mesh
+
+
+def _fake_upper(case, points: int, pieces: int) -> SimpleNamespace:  # noqa: ANN001 - a Case
+    return SimpleNamespace(spm=FAKE_UPPER_SPM[points], points=points)
+
+
+def _fake_motion(spm: float) -> SimpleNamespace:
+    return SimpleNamespace(plan=SimpleNamespace(spm=spm))
+
+
+@forking
+def test_the_brackets_rounds_with_their_bounds_made_ahead_take_each_mesh_in_its_turn(monkeypatch):
+    """The bracket's rounds on stand-ins (a motion 0.02 SPM faster on each finer layout, a bound lower on each finer
+    mesh): four rounds, both meshes taken in their turns, each bound made in the worker; the same rounds as made
+    here."""
+    from planning.model.case_file import read_case
+    from planning.solver import bracket as bracket_module
+    from tests.conftest import PUBLISHED_CASE
+
+    monkeypatch.setattr(bracket_module, "upper_bound", _fake_upper)
+    monkeypatch.setattr(bracket_module, "solve_optimal", lambda case: _fake_motion(10.0))
+    monkeypatch.setattr(bracket_module, "on_layout", lambda case, answer, layout: _fake_motion(answer.plan.spm + 0.02))
+    monkeypatch.setattr(bracket_module, "_checked", lambda case, solution, previous=None: solution)
+    parallel, alone = _bracket_both_ways(read_case(PUBLISHED_CASE), 0.05, monkeypatch)
+    upper_spm = [r.upper_spm for r in alone.rounds]
+    assert upper_spm == [10.1, 10.1, 10.08, 10.08, 10.06], alone.rounds
+    assert parallel.rounds == alone.rounds
 
 
 @forking

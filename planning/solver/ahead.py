@@ -5,25 +5,57 @@ verified motion is refined (``planning.solver.bracket``), so that its time is th
 returns at once; :meth:`Ahead.take` returns its value. A call computed there is the same computation as here (the
 same code and inputs: the same numbers); where it raised, or the worker failed, the call is made again here when
 taken, so the caller sees the value or the exception it would have seen without the worker. Where the machine has
-one core, the process cannot fork (no ``fork``, threads running, a daemon process such as a sweep's worker), calls
-are made here when taken. The worker ignores Ctrl-C (the caller's to handle) and is stopped by :meth:`Ahead.close`.
+one core, the process cannot fork (no ``fork``, threads running, a daemon process, which may have no children), calls
+are made here when taken. The worker ignores Ctrl-C (the caller's to handle), is stopped by :meth:`Ahead.close` and
+ends itself when this process is gone (:func:`worker_signals`, which every worker process of pressplan starts with).
 """
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing
 import os
 import signal
 import threading
-from collections.abc import Callable
+import time
+from collections.abc import Callable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor
 from typing import Any
 
+HELD = {signal.SIGINT, signal.SIGTERM}  # held while a worker process starts (``signals_held``)
+PARENT_WATCH_S = 1.0  # [s] how often a worker looks whether its parent is still there
+
+
+@contextlib.contextmanager
+def signals_held() -> Iterator[None]:
+    """Ctrl-C and SIGTERM held in this thread while a worker process starts inside the block: the worker inherits
+    them held and sees none before :func:`worker_signals` (no traceback of a worker still importing); this
+    process gets them when the block ends."""
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, HELD)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
+
 
 def worker_signals() -> None:
-    """In a worker process: Ctrl-C is the parent's to handle; SIGTERM (from the parent) just ends it."""
+    """In a worker process: Ctrl-C is the parent's to handle; SIGTERM (from the parent) just ends it; signals held
+    while it started are let through now; and it ends itself once its parent is gone (killed without a word)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, HELD)
+    parent = os.getppid()
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(PARENT_WATCH_S)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="pressplan-parent-watch", daemon=True).start()
 
 
 def stop_pool(pool: ProcessPoolExecutor) -> None:
@@ -52,7 +84,8 @@ class Ahead:
                 if self._pool is None:
                     context = multiprocessing.get_context("fork")
                     self._pool = ProcessPoolExecutor(max_workers=1, mp_context=context, initializer=worker_signals)
-                future = self._pool.submit(_guarded, function, args)
+                with signals_held():  # the worker forks here: no Ctrl-C before it ignores it
+                    future = self._pool.submit(_guarded, function, args)
             except (OSError, RuntimeError):  # no process to be had: made here
                 self._usable = False
         return Call(function, args, future)

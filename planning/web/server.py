@@ -26,7 +26,6 @@ recently used is dropped).
 
 from __future__ import annotations
 
-import contextlib
 import hashlib
 import itertools
 import json
@@ -63,7 +62,7 @@ from planning.web.cams import (
     proved,
     refused,
 )
-from planning.web.workers import PendingCold, WorkerProcess, cold_solution
+from planning.web.workers import ColdSolves, PendingCold, WorkerProcess
 
 STATIC = Path(__file__).resolve().parent / "static"
 PENDULUM_BOUND_LEAVES_OUT = (  # what the pendulum's bound leaves out (``planning.solver.pendulum_bound``)
@@ -185,7 +184,7 @@ class _Shared:
     bounds: OrderedDict = field(default_factory=OrderedDict)
     bounds_lock: threading.Lock = field(default_factory=threading.Lock)
     bound_pool: Any = None
-    cold_worker: WorkerProcess | None = None
+    cold_worker: ColdSolves | None = None
     recipes: Path | None = None
 
 
@@ -201,7 +200,7 @@ def create_app(
     ``recipes_dir`` the page saves cases under a name there and reopens them (``planning.web.recipes``).
     ``cold_worker``: an edit's confirming cold solve runs in a worker process beside its fast answer
     (``planning.web.workers``; ``serve`` and the browser tests); without, after it in this process. Either way
-    the same answers; ``close_app`` stops the worker processes."""
+    the cold solve's plan or better; ``close_app`` stops the worker processes."""
     import logging
 
     logging.getLogger("werkzeug").setLevel(logging.WARNING)  # no line per request
@@ -211,7 +210,7 @@ def create_app(
     if initial is not None:
         offered = {initial.name: initial, **{k: v for k, v in offered.items() if k != initial.name}}
     shared = _Shared(offered, bound_pool=_BoundPool(), recipes=recipes_dir)
-    shared.cold_worker = WorkerProcess() if cold_worker else None
+    shared.cold_worker = ColdSolves() if cold_worker else None
     app.extensions["pressplan_workers"] = [shared.bound_pool.worker, shared.cold_worker]  # stopped by close_app
     app.extensions["pressplan_sessions"] = shared.sessions  # the tests hold a session's lock to see superseding
     app.extensions["pressplan_queues"] = shared.queues  # the edits' fast answers never wait behind cold solves
@@ -602,7 +601,7 @@ def _model_at(dotted: str) -> tuple[type, str]:
 
 
 def solve_case(
-    data: Any, label: str, session: Session, confirm: bool = True, worker: WorkerProcess | None = None
+    data: Any, label: str, session: Session, confirm: bool = True, worker: ColdSolves | None = None
 ) -> dict[str, Any]:
     """Validate and solve ``data`` from the session's last plan; the page's answer. ``confirm`` False: the
     fast answer from the last plan alone when it verifies (``confirmed`` False in the answer: the page
@@ -651,36 +650,45 @@ def solve_case(
     }
 
 
-def _cold_started(worker: WorkerProcess | None, case: Case, sent: tuple, session: Session) -> PendingCold | None:
+def _cold_started(worker: ColdSolves | None, case: Case, sent: tuple, session: Session) -> PendingCold | None:
     """The cold solve of ``case`` (``sent``: the page's data and label it was read from) started in ``worker`` for
-    the session's fast request (the session's older one dropped), or None: no worker, or an objective at the
-    line's rate (its neighbour starts the search there and is not compared with a cold solve: solved here)."""
-    if session.pending is not None:
-        session.pending.future.cancel()  # an older edit's, not started yet: dropped (one under way runs out)
-        session.pending = None
-    if worker is None or case.planner.objective != "max-spm":
+    the session's fast request (the session's older one withdrawn where it still waits), or None: no worker, an
+    objective at the line's rate (its neighbour starts the search there and is not compared with a cold solve:
+    solved here), or a case the prechecks refuse (the fast request says why; nothing to confirm)."""
+    from planning.solver.precheck import precheck
+
+    older, session.pending = session.pending, None
+    if worker is None:
+        return None
+    if older is not None:
+        worker.drop(older)
+    if case.planner.objective != "max-spm":
         return None
     try:
-        session.pending = PendingCold(_sent_key(sent), worker.submit(cold_solution, *sent))
-    except RuntimeError:  # the worker does not start (BrokenProcessPool): solved here
+        precheck(case)
+    except PlanningError:
         return None
+    session.pending = worker.start(str(id(session)), _sent_key(sent), sent)
     return session.pending
 
 
-def _cold_or_better(case: Case, sent: tuple, session: Session, worker: WorkerProcess | None) -> Any:
+def _cold_or_better(case: Case, sent: tuple, session: Session, worker: ColdSolves | None) -> Any:
     """The cold solve's answer or better: the better of the worker's cold solve of this case (started by its fast
     request) and the fast answer, as ``solve`` with the neighbour gives; where there is none (no worker, another
-    case, the worker found no plan or is gone) ``solve`` here, the session's plan the neighbour. A case solved here
-    before the worker ever ran starts the worker (its imports and NLPs made while the user looks at the plan)."""
+    case, not started yet, the worker found no plan or is gone) ``solve`` here, the session's plan the neighbour. A
+    case solved here before the worker ever ran starts the worker (its imports and NLPs made while the user looks
+    at the plan)."""
     from planning.solver.optimize import better, solve
 
     pending, session.pending = session.pending, None
-    cold = pending.cold() if pending is not None and pending.key == _sent_key(sent) else None
-    if cold is not None:
-        return better(cold, pending.fast)
-    if worker is not None and not worker.started and case.planner.objective == "max-spm":
-        with contextlib.suppress(RuntimeError):  # a worker that does not start: the edits are solved here
-            worker.submit(cold_solution, *sent)
+    if worker is not None and pending is not None and pending.key != _sent_key(sent):
+        worker.drop(pending)  # another case's
+    elif worker is not None and pending is not None:
+        cold = worker.take(pending)
+        if cold is not None:
+            return better(cold, pending.fast)
+    if worker is not None and case.planner.objective == "max-spm":
+        worker.warm_up(sent)
     return solve(case, neighbour=session.plan)
 
 
