@@ -1,5 +1,8 @@
-"""Calls made ahead in a worker process while this process goes on: the bracket's next upper bound while its
-verified motion is refined (``planning.solver.bracket``), so that its time is the longer side's, not their sum.
+"""Worker processes, and calls made ahead in one while this process goes on: the bracket's next upper bound while
+its verified motion is refined (``planning.solver.bracket``), so that its time is the longer side's, not their sum.
+
+A :class:`WorkerProcess` is one worker (spawned or forked) running one function at a time: the bracket's, and the
+web page's (``planning.web.workers``: its bounds and its edits' cold solves).
 
 :meth:`Ahead.start` hands a call to one forked worker (calls run one after another, in the order started) and
 returns at once; :meth:`Ahead.take` returns its value. A call computed there is the same computation as here (the
@@ -20,6 +23,7 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
 HELD = {signal.SIGINT, signal.SIGTERM}  # held while a worker process starts (``signals_held``)
@@ -58,7 +62,7 @@ def worker_signals() -> None:
     threading.Thread(target=watch, name="pressplan-parent-watch", daemon=True).start()
 
 
-def stop_pool(pool: ProcessPoolExecutor) -> None:
+def _stop(pool: ProcessPoolExecutor) -> None:
     """Stop ``pool``'s worker processes now (work under way is dropped) and close its queues (no semaphore left to
     the resource tracker)."""
     processes = list(getattr(pool, "_processes", {}).values())  # the executor keeps no public handle
@@ -69,32 +73,68 @@ def stop_pool(pool: ProcessPoolExecutor) -> None:
     pool.shutdown(wait=True, cancel_futures=True)
 
 
+class WorkerProcess:
+    """One worker process running one function at a time, started on first use (with :func:`signals_held`, under
+    :func:`worker_signals`) and by ``method``: ``"spawn"`` (a fresh interpreter: for a process running threads, such
+    as the web server) or ``"fork"`` (a copy of this one, its imports done)."""
+
+    def __init__(self, method: str = "spawn") -> None:
+        self.method = method
+        self._pool: ProcessPoolExecutor | None = None
+        self._lock = threading.Lock()
+        self._closed = False
+
+    @property
+    def started(self) -> bool:
+        return self._pool is not None
+
+    def submit(self, function: Callable[..., Any], *args: Any) -> Future:
+        """``function(*args)`` in the worker, queued behind what it runs; a worker that died is started anew. Raises
+        ``RuntimeError`` once closed (or where no worker starts) or ``OSError`` (no process to be had)."""
+        with self._lock:
+            for _ in range(2):
+                if self._closed:
+                    raise RuntimeError("the worker process is closed")
+                if self._pool is None:
+                    context = multiprocessing.get_context(self.method)
+                    self._pool = ProcessPoolExecutor(max_workers=1, mp_context=context, initializer=worker_signals)
+                try:
+                    with signals_held():  # the process starts here: no Ctrl-C before it ignores it
+                        return self._pool.submit(function, *args)
+                except BrokenProcessPool:  # the worker died (killed, out of memory): a new one
+                    self._pool.shutdown(wait=False, cancel_futures=True)
+                    self._pool = None
+            raise BrokenProcessPool("the worker process does not start")
+
+    def close(self) -> None:
+        """Stop the worker process now (work under way is dropped); no other starts."""
+        with self._lock:
+            pool, self._pool, self._closed = self._pool, None, True
+        if pool is not None:
+            _stop(pool)
+
+
 class Ahead:
     """One forked worker making calls ahead (module docstring)."""
 
     def __init__(self) -> None:
-        self._pool: ProcessPoolExecutor | None = None
-        self._usable = _can_fork()
+        self._worker = WorkerProcess("fork") if _can_fork() else None
 
     def start(self, function: Callable[..., Any], *args: Any) -> Call:
         """``function(*args)`` started in the worker (or, where there is none, made when taken)."""
         future = None
-        if self._usable:
+        if self._worker is not None:
             try:
-                if self._pool is None:
-                    context = multiprocessing.get_context("fork")
-                    self._pool = ProcessPoolExecutor(max_workers=1, mp_context=context, initializer=worker_signals)
-                with signals_held():  # the worker forks here: no Ctrl-C before it ignores it
-                    future = self._pool.submit(_guarded, function, args)
+                future = self._worker.submit(_guarded, function, args)
             except (OSError, RuntimeError):  # no process to be had: made here
-                self._usable = False
+                self.close()
         return Call(function, args, future)
 
     def close(self) -> None:
         """Stop the worker now (a call under way is dropped)."""
-        pool, self._pool = self._pool, None
-        if pool is not None:
-            stop_pool(pool)
+        worker, self._worker = self._worker, None
+        if worker is not None:
+            worker.close()
 
 
 class Call:

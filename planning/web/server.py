@@ -49,6 +49,7 @@ from planning.model.outcome import Outcome
 from planning.reports.new_case import MECHANISMS, drive_template, robots_template
 from planning.reports.outputs import downloads
 from planning.reports.outputs._cam import CamOptionError
+from planning.solver.ahead import WorkerProcess
 from planning.solver.outcomes import PlanningError
 from planning.web.cams import (
     CAM_FILES,
@@ -62,7 +63,7 @@ from planning.web.cams import (
     proved,
     refused,
 )
-from planning.web.workers import ColdSolves, PendingCold, WorkerProcess
+from planning.web.workers import ColdSolves, PendingCold
 
 STATIC = Path(__file__).resolve().parent / "static"
 PENDULUM_BOUND_LEAVES_OUT = (  # what the pendulum's bound leaves out (``planning.solver.pendulum_bound``)

@@ -1,10 +1,10 @@
 """The page's work done in worker processes beside the server's: the bounds, and the cold solves that confirm an
 edit's fast answer.
 
-IPOPT takes one call at a time per process, so what runs in the server's process waits for the solves there. A
-:class:`WorkerProcess` is one spawned process (started on first use with Ctrl-C and SIGTERM held until it ignores
-Ctrl-C, which stops the server; the server's stop ends it, and it ends itself when the server is gone) that runs one
-function at a time.
+IPOPT takes one call at a time per process, so what runs in the server's process waits for the solves there. Each
+is a :class:`~planning.solver.ahead.WorkerProcess` (spawned: the server runs threads; started on first use, it
+ignores Ctrl-C, which stops the server; the server's stop ends it, and it ends itself when the server is gone) that
+runs one function at a time.
 
 The confirming cold solve (:class:`ColdSolves`): when an edit's fast request comes (the warm start from the
 session's plan, ``planning.web.server.solve_case``), the server starts the cold solve of the same case in the worker
@@ -19,56 +19,16 @@ compiled once they are in the cache (``planning.solver.ipopt.adopt_compiled``).
 
 from __future__ import annotations
 
-import multiprocessing
 import threading
 from collections import OrderedDict
 from collections.abc import Callable
-from concurrent.futures import Future, ProcessPoolExecutor
-from concurrent.futures.process import BrokenProcessPool
+from concurrent.futures import Future
 from dataclasses import dataclass, field
 from typing import Any
 
 from planning.model.case_file import CaseFileError, case_from_data
-from planning.solver.ahead import signals_held, stop_pool, worker_signals
+from planning.solver.ahead import WorkerProcess
 from planning.solver.outcomes import PlanningError
-
-
-class WorkerProcess:
-    """One spawned worker process running one function at a time (module docstring)."""
-
-    def __init__(self) -> None:
-        self._pool: ProcessPoolExecutor | None = None
-        self._lock = threading.Lock()
-        self._closed = False
-
-    @property
-    def started(self) -> bool:
-        return self._pool is not None
-
-    def submit(self, function: Callable[..., Any], *args: Any) -> Future:
-        """``function(*args)`` in the worker, queued behind what it runs; a worker that died is started anew. Raises
-        ``RuntimeError`` once closed (or where no worker starts) or ``OSError`` (no process to be had)."""
-        with self._lock:
-            for _ in range(2):
-                if self._closed:
-                    raise RuntimeError("the worker process is closed")
-                if self._pool is None:
-                    context = multiprocessing.get_context("spawn")
-                    self._pool = ProcessPoolExecutor(max_workers=1, mp_context=context, initializer=worker_signals)
-                try:
-                    with signals_held():  # the process starts here: no Ctrl-C before it ignores it
-                        return self._pool.submit(function, *args)
-                except BrokenProcessPool:  # the worker died (killed, out of memory): a new one
-                    self._pool.shutdown(wait=False, cancel_futures=True)
-                    self._pool = None
-            raise BrokenProcessPool("the worker process does not start")
-
-    def close(self) -> None:
-        """Stop the worker process now (work under way is dropped); no other starts."""
-        with self._lock:
-            pool, self._pool, self._closed = self._pool, None, True
-        if pool is not None:
-            stop_pool(pool)
 
 
 @dataclass(eq=False)
