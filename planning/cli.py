@@ -721,17 +721,19 @@ def _bound(case, args) -> int:
     if case.pendulum:
         return _pendulum_bound(case, args)
     from planning.solver.bound import time_optimal_bound
-    from planning.solver.bracket import BRACKET_TOL_PCT, bracket
+    from planning.solver.bracket import BRACKET_TOL_PCT
 
     tolerance = BRACKET_TOL_PCT if args.tolerance is None else args.tolerance
     if not (math.isfinite(tolerance) and tolerance > 0):
         raise CommandError(f"--tolerance {args.tolerance}: the gap must be a positive percentage", EXIT_INPUT)
-    bound = time_optimal_bound(case, args.points)
-    data = {"case": case.name, **bound.as_dict()}
     upper = result = None
     if args.bracket or args.tolerance is not None:
-        result = bracket(case, tolerance)
+        bound, result = _bound_and_bracket(case, args.points, tolerance)
         upper = result.upper
+    else:
+        bound = time_optimal_bound(case, args.points)
+    data = {"case": case.name, **bound.as_dict()}
+    if result is not None:
         data["bracket"] = result.as_dict()
     if upper is None and (args.certified or args.upper_points is not None):
         from planning.solver.upper_bound import UPPER_POINTS, upper_bound
@@ -763,6 +765,27 @@ def _bound(case, args) -> int:
     if result is not None:
         print(bracket_text(result))
     return EXIT_OK
+
+
+def _bound_and_bracket(case, points, tolerance):  # noqa: ANN001, ANN202 - a Case, ints; a Bound and a Bracket
+    """The time-optimal bound, made in the bracket's worker (``planning.solver.ahead``) while the bracket plans its
+    motion, and the bracket. Where both fail, the bound's error, as when it was computed first."""
+    from planning.solver.ahead import Ahead
+    from planning.solver.bound import time_optimal_bound
+    from planning.solver.bracket import bracket
+    from planning.solver.outcomes import PlanningError
+
+    ahead = Ahead()
+    try:
+        following = ahead.start(time_optimal_bound, case, points)
+        try:
+            result = bracket(case, tolerance, ahead)
+        except PlanningError:
+            following.take()  # its own error first
+            raise
+        return following.take(), result
+    finally:
+        ahead.close()
 
 
 def _pendulum_bound(case, args) -> int:

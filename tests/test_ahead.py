@@ -139,3 +139,41 @@ def test_the_cup_presss_bracket_with_its_bounds_made_ahead_is_the_one_made_here(
     assert len(alone.rounds) == 3 and alone.upper.points == 2880  # the bound on the second mesh was taken
     assert parallel.rounds == alone.rounds and parallel.upper.spm == alone.upper.spm
     assert parallel.verified.plan.spm == alone.verified.plan.spm
+
+
+def _fake_bound(case, points: int) -> SimpleNamespace:  # noqa: ANN001 - a Case
+    return SimpleNamespace(points=points, pid=os.getpid())
+
+
+def _failing_bound(case, points: int) -> None:  # noqa: ANN001 - a Case
+    from planning.solver.outcomes import Infeasible
+
+    raise Infeasible(f"the bound's own error in {os.getpid()}")
+
+
+def _failing_bracket(case, tolerance_pct: float, ahead: Ahead) -> None:  # noqa: ANN001 - a Case
+    from planning.solver.outcomes import NoPlanFound
+
+    raise NoPlanFound("the bracket's error")
+
+
+@forking
+def test_bound_makes_its_time_optimal_bound_in_the_brackets_worker_and_says_its_error_first(monkeypatch):
+    """``pressplan bound --bracket``: the time-optimal bound made in the worker while the bracket runs here; where
+    both fail, the bound's error (raised here, as when it was computed before the bracket); where the bracket alone
+    fails, the bracket's."""
+    from planning import cli
+    from planning.solver import bound as bound_module
+    from planning.solver import bracket as bracket_module
+    from planning.solver.outcomes import Infeasible, NoPlanFound
+
+    monkeypatch.setattr(bound_module, "time_optimal_bound", _fake_bound)
+    monkeypatch.setattr(bracket_module, "bracket", lambda case, tolerance_pct, ahead: ("bracket", os.getpid()))
+    bound, result = cli._bound_and_bracket(None, 720, 0.05)
+    assert bound.points == 720 and bound.pid != os.getpid() and result == ("bracket", os.getpid())
+    monkeypatch.setattr(bracket_module, "bracket", _failing_bracket)
+    with pytest.raises(NoPlanFound, match="the bracket's error"):
+        cli._bound_and_bracket(None, 720, 0.05)
+    monkeypatch.setattr(bound_module, "time_optimal_bound", _failing_bound)
+    with pytest.raises(Infeasible, match=f"the bound's own error in {os.getpid()}$"):
+        cli._bound_and_bracket(None, 720, 0.05)

@@ -1,5 +1,7 @@
 """Worker processes, and calls made ahead in one while this process goes on: the bracket's next upper bound while
-its verified motion is refined (``planning.solver.bracket``), so that its time is the longer side's, not their sum.
+its verified motion is refined (``planning.solver.bracket``; ``pressplan bound``'s time-optimal bound before them),
+a multi-start's next start (``planning.solver.search.StartsAhead``), so that their time is the longer side's, not
+their sum.
 
 A :class:`WorkerProcess` is one worker (spawned or forked) running one function at a time: the bracket's, and the
 web page's (``planning.web.workers``: its bounds and its edits' cold solves).

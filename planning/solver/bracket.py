@@ -100,9 +100,10 @@ def jerk_allowance(case: Case) -> float:
     return JERK_ALLOWANCE * math.sqrt(A / m.peak_curvature) / (m.length_scale / A)
 
 
-def bracket(case: Case, tolerance_pct: float = BRACKET_TOL_PCT) -> Bracket:
+def bracket(case: Case, tolerance_pct: float = BRACKET_TOL_PCT, ahead: Ahead | None = None) -> Bracket:
     """The bracket of ``case`` (module docstring); raises a :class:`PlanningError` when no verified motion
-    or no upper bound is found."""
+    or no upper bound is found. ``ahead``: the worker that makes the upper bounds (the caller's, which may have
+    other calls of its own there, and closes it), else one of the bracket's own."""
     t_start = time.perf_counter()
     allowance = None if case.limits.crank_jerk_rad_s3 is not None else jerk_allowance(case)
     planned = case.with_objective("max-spm")
@@ -111,11 +112,13 @@ def bracket(case: Case, tolerance_pct: float = BRACKET_TOL_PCT) -> Bracket:
         planned = planned.model_copy(update={"limits": limits})
     planned = planned.with_law(OptimalLaw.name)
     fastest = case.with_objective("max-spm")  # the bracket is about the most strokes, whatever the objective
-    ahead = Ahead()  # each upper bound computed in a worker while the motion is planned (``planning.solver.ahead``)
+    own = ahead is None  # each upper bound computed in a worker while the motion is planned (``planning.solver.ahead``)
+    ahead = ahead or Ahead()
     try:
         verified, upper, rounds = _refined(case, planned, fastest, tolerance_pct, ahead)
     finally:
-        ahead.close()
+        if own:
+            ahead.close()
     gap = rounds[-1].gap_pct
     if gap < -CROSSED_PCT:
         raise NoPlanFound(

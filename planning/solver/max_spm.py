@@ -95,10 +95,17 @@ def _multi_start(search: Search, neighbour: Plan | None, ran: tuple[Ran, ...] = 
     """The published placement's starts (but those ``ran`` before; in free placement until one verifies), then
     (free placement) the free starts from that plan."""
     w2 = search.draw_speed_range[1]
-    confirm = search.placement != "free"  # the free starts confirm their own optimum: one published plan seeds them
-    published = search.multi_start(published_starts(search.case, w2, neighbour), "published", confirm, ran=ran)
-    if search.placement == "free":
+    if search.placement != "free":
+        search.multi_start(published_starts(search.case, w2, neighbour), "published", ran=ran)
+        return
+    try:  # the free starts' second (after the published plan) is solved ahead while the published starts run
+        if neighbour is None:
+            search.begin_ahead(free_starts(search.case, w2, None, None)[0], "free")
+        # the free starts confirm their own optimum: one published plan seeds them
+        published = search.multi_start(published_starts(search.case, w2, neighbour), "published", False, ran=ran)
         search.multi_start(free_starts(search.case, w2, neighbour, published), "free")
+    finally:
+        search.stop_ahead()
 
 
 def _try_harder(search: Search, neighbour: Plan | None) -> None:

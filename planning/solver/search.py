@@ -9,7 +9,9 @@ warm; where an NLP row that can overstate its figure is active while the exact f
 is loosened once by the room. A start whose first optimum (before any refinement) an earlier start of the same
 problem reached takes that start's refined plan (:class:`Optimum`): the refinements from one optimum repeat
 themselves; the searches of one solve may share them (a neighbour's start and the cold solve's starts). Starts
-run until two agree on the optimum (:meth:`Search.multi_start`; with ``confirm`` False until one verifies).
+run until two agree on the optimum (:meth:`Search.multi_start`; with ``confirm`` False until one verifies); on two
+cores the next start's first solve is made ahead in a forked worker meanwhile (:class:`StartsAhead`: the same
+call, the same result to the last bit).
 Without a verified plan the answer is a typed outcome (``planning.solver.outcomes``). The max-SPM solve of
 the laws (``planning.solver.max_spm``), the optimal law (``planning.solver.optimal``) and the objectives at a
 rate (``planning.solver.objectives``) all run on it.
@@ -19,6 +21,7 @@ from __future__ import annotations
 
 import math
 import time
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
@@ -28,6 +31,7 @@ from planning.model.case import Case, Placement
 from planning.model.limits import BY_ID
 from planning.model.limits.base import Check, Dense
 from planning.model.plan import Plan, SolverInfo
+from planning.solver.ahead import Ahead, Call
 from planning.solver.halves_nlp import halves_nlp_for
 from planning.solver.ipopt import NLPResult, NLPStatus
 from planning.solver.nlp import CycleNLP
@@ -78,6 +82,7 @@ class Search:
     stop_on: frozenset[str] = frozenset()
     stopped: bool = False
     optima: list[Optimum] = field(default_factory=list)  # the attempts' first optima (shared by one solve's searches)
+    ahead: StartsAhead | None = None  # during a multi-start: the next start's first solve, made in a worker
 
     def parameter(self, name: str) -> int:
         """The position of the NLP parameter ``name`` in :attr:`parameters`."""
@@ -104,7 +109,7 @@ class Search:
         self.starts += 1
         first: tuple[tuple, np.ndarray] | None = None
         for _ in range(REFINEMENTS + 2):
-            res = self.nlp.solve(values, q, self.lbx, self.ubx, placement, self.scale, multipliers, self.fixed_period)
+            res = self._solve(values, q, placement, multipliers)
             self.iterations += res.iterations
             if self.fixed_period and res.status == NLPStatus.STOPPED_AT_LIMIT:
                 # at a target rate the optimum may sit where a half of the law degenerates (a monotone speed
@@ -166,6 +171,15 @@ class Search:
                 else:
                     q[refine.index] *= (c.limit / c.value) * (1 - REFINE_MARGIN)
         return self._remember(first, found, kept)
+
+    def _solve(
+        self, values: dict[str, float], q: np.ndarray, placement: Placement, multipliers: tuple | None
+    ) -> NLPResult:
+        """One IPOPT solve from ``values`` (``multipliers``: a warm re-solve's), taken from the solves made ahead
+        where one is this very call (:class:`StartsAhead`)."""
+        args = (values, q, self.lbx, self.ubx, placement, self.scale, multipliers, self.fixed_period)
+        made = self.ahead.take(self.nlp, args) if self.ahead is not None and multipliers is None else None
+        return made if made is not None else self.nlp.solve(*args)
 
     def _problem_key(self, q: np.ndarray, placement: Placement) -> tuple:
         """What makes one NLP problem and its search: the compiled NLP (the object: compared by identity), its
@@ -274,24 +288,48 @@ class Search:
         """Run the starts in order until the two best verified ones agree on the score (the optimum
         is confirmed; ``confirm`` False: until one verifies) or the starts run out; the values of the
         best verified start. ``ran``: starts of this placement already solved (the drive's probe): they
-        are not run again, and what they found counts."""
+        are not run again, and what they found counts. While a start runs whose result cannot end the
+        search (none found yet), the next one's first solve is begun ahead (:meth:`begin_ahead`)."""
         found = sorted((r.found for r in ran if r.found is not None), key=lambda item: item[1])
         tried = [self.key(r.start) for r in ran]
+        todo = []
         for x0 in x0s:
-            if self.stopped:
-                break
             key = self.key(x0)
-            if any(_same_start(key, other) for other in tried):
-                continue  # the same start again would only repeat its answer
-            tried.append(key)
-            out = self.attempt(x0, placement)
-            if out is None:
-                continue
-            found.append(out)
-            found.sort(key=lambda item: item[1])
-            if not confirm or (len(found) >= 2 and found[1][1] - found[0][1] <= AGREE_S):
-                break
+            if not any(_same_start(key, other) for other in tried):  # the same start again would repeat its answer
+                tried.append(key)
+                todo.append(x0)
+        own = self.ahead is None  # made ahead for this multi-start only, else for the solve that began it
+        self.ahead = self.ahead or StartsAhead()
+        try:
+            for i, x0 in enumerate(todo):
+                if self.stopped:
+                    break
+                if confirm and not found and i + 1 < len(todo):  # the next start runs whatever this one finds
+                    self.begin_ahead(todo[i + 1], placement)
+                out = self.attempt(x0, placement)
+                if out is None:
+                    continue
+                found.append(out)
+                found.sort(key=lambda item: item[1])
+                if not confirm or (len(found) >= 2 and found[1][1] - found[0][1] <= AGREE_S):
+                    break
+        finally:
+            if own:
+                self.stop_ahead()
         return found[0][0] if found else None
+
+    def begin_ahead(self, x0: dict[str, float], placement: Placement) -> None:
+        """The first solve of the start ``x0`` (as :meth:`attempt` will make it) begun in a worker
+        (:class:`StartsAhead`; until :meth:`stop_ahead`)."""
+        self.ahead = self.ahead or StartsAhead()
+        q = self.parameters.copy()
+        self.ahead.start(self.nlp, (x0, q, self.lbx, self.ubx, placement, self.scale, None, self.fixed_period))
+
+    def stop_ahead(self) -> None:
+        """Stop the worker of :meth:`begin_ahead` (what it has not handed over is dropped)."""
+        if self.ahead is not None:
+            self.ahead.close()
+        self.ahead = None
 
     def answer(self) -> Solution:
         """The best verified plan with the solver's totals; else the typed error: a converged plan
@@ -318,6 +356,69 @@ class Search:
             plan = replace(plan, placement="free")
         info = SolverInfo(self.iterations, time.perf_counter() - self.t_start, self.starts, plan.solver.status)
         return replace(self.best, plan=replace(plan, solver=info))
+
+
+# the NLPs whose solves a worker may make (by id: a forked worker holds the same objects at the same places)
+_SOLVABLE: weakref.WeakValueDictionary[int, CycleNLP] = weakref.WeakValueDictionary()
+
+
+def _solve_there(nlp_id: int, args: tuple) -> NLPResult:
+    """In the worker: ``CycleNLP.solve(*args)`` of the NLP ``nlp_id`` (a ``KeyError`` where the worker was forked
+    before it was built: the call is then made by the search itself)."""
+    return _SOLVABLE[nlp_id].solve(*args)
+
+
+class StartsAhead:
+    """The first IPOPT solves of a multi-start's coming starts, made in one forked worker (``planning.solver.ahead``)
+    while this process runs the start before: the same call on the same inputs, so the same result to the last bit
+    (and the same answers); a start takes its solve when its turn comes (:meth:`take`). Where the worker cannot fork
+    (one core, threads running, a daemon process: a sweep's or the web page's workers, whose cores are busy), or the
+    worker lacks the NLP, nothing is made ahead: the search solves as before. The worker is stopped by
+    :meth:`close` (a start the search never reached is dropped there)."""
+
+    def __init__(self) -> None:
+        self._ahead: Ahead | None = None
+        self._forked_with: frozenset[int] = frozenset()  # the NLPs the worker holds
+        self._calls: list[tuple[CycleNLP, tuple, Call]] = []
+
+    def start(self, nlp: CycleNLP, args: tuple) -> None:
+        """``nlp.solve(*args)`` begun in the worker (forked now where it does not hold ``nlp``; nothing where it
+        was begun already)."""
+        if any(other is nlp and _same_call(begun, args) for other, begun, _ in self._calls):
+            return
+        _SOLVABLE[id(nlp)] = nlp
+        if self._ahead is None or id(nlp) not in self._forked_with:
+            self.close()
+            self._ahead, self._forked_with = Ahead(), frozenset(_SOLVABLE.keys())
+        self._calls.append((nlp, args, self._ahead.start(_solve_there, id(nlp), args)))
+
+    def take(self, nlp: CycleNLP, args: tuple) -> NLPResult | None:
+        """The result of ``nlp.solve(*args)`` where it was begun ahead (made here where the worker failed), else
+        None."""
+        for k, (other, begun, call) in enumerate(self._calls):
+            if other is nlp and _same_call(begun, args):
+                del self._calls[k]
+                return call.take()
+        return None
+
+    def close(self) -> None:
+        """Stop the worker (a solve under way there is dropped)."""
+        if self._ahead is not None:
+            self._ahead.close()
+        self._ahead, self._calls = None, []
+
+
+def _same_call(a: tuple, b: tuple) -> bool:
+    """Two argument tuples of ``CycleNLP.solve`` the same to the last bit (arrays, dicts of floats, the rest)."""
+    if len(a) != len(b):
+        return False
+    for x, y in zip(a, b, strict=True):
+        if isinstance(x, np.ndarray) or isinstance(y, np.ndarray):
+            if not (isinstance(x, np.ndarray) and isinstance(y, np.ndarray) and np.array_equal(x, y)):
+                return False
+        elif x != y:
+            return False
+    return True
 
 
 def _same_key(a: tuple, b: tuple) -> bool:
