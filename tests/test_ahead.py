@@ -177,3 +177,57 @@ def test_bound_makes_its_time_optimal_bound_in_the_brackets_worker_and_says_its_
     monkeypatch.setattr(bound_module, "time_optimal_bound", _failing_bound)
     with pytest.raises(Infeasible, match=f"the bound's own error in {os.getpid()}$"):
         cli._bound_and_bracket(None, 720, 0.05)
+
+
+def _station_pid(seconds: float) -> tuple[float, int]:
+    time.sleep(seconds)
+    return seconds, os.getpid()
+
+
+def _station_raises(name: str) -> None:
+    raise ValueError(f"station {name} in {os.getpid()}")
+
+
+@forking
+def test_a_lines_stations_solve_side_by_side_each_result_in_its_place_the_first_error_its_own():
+    """``planning.solver.line._side_by_side`` on stand-ins: the calls run at once in two workers (four of 0.3 s in
+    about 0.6 s), each result in its station's place; the first station that fails raises here, its own error."""
+    from planning.solver.line import _side_by_side
+
+    t0 = time.perf_counter()
+    results = _side_by_side(_station_pid, [(0.3,), (0.3,), (0.3,), (0.0,)])
+    assert time.perf_counter() - t0 < 1.0
+    assert [r[0] for r in results] == [0.3, 0.3, 0.3, 0.0]
+    assert len({r[1] for r in results}) == 2 and os.getpid() not in {r[1] for r in results}
+    assert _side_by_side(_station_pid, [(0.0,)])[0][1] == os.getpid()  # one station: solved here
+    with pytest.raises(ValueError, match=f"station b in {os.getpid()}$"):
+        _side_by_side(_station_raises, [("b",), ("c",)])
+
+
+@pytest.mark.slow  # 12 s: a line of two presses with robots, twice
+@forking
+def test_a_lines_stations_solved_side_by_side_give_the_line_solved_in_turn(monkeypatch):
+    from planning.model.line_file import read_line
+    from planning.solver import line as line_module
+    from tests.conftest import ROOT
+
+    path = ROOT / "tests" / "data" / "line" / "fast.yaml"
+    made_there: list[bool] = []
+    take = ahead_module.Call.take
+
+    def taken(call):  # noqa: ANN001, ANN202
+        made_there.append(call.future is not None and call.future.result()[0])
+        return take(call)
+
+    with monkeypatch.context() as m:
+        m.setattr(ahead_module.Call, "take", taken)
+        line_module._ALONE.clear()
+        side_by_side = line_module.solve_line(read_line(path))
+    assert len(made_there) == 4 and all(made_there)  # two stations alone, two at the line's period
+    with monkeypatch.context() as m:
+        m.setattr(ahead_module, "_can_fork", lambda: False)
+        line_module._ALONE.clear()
+        in_turn = line_module.solve_line(read_line(path))
+    assert side_by_side.period_s == in_turn.period_s and side_by_side.offsets_s == in_turn.offsets_s
+    for a, b in zip(side_by_side.at_line + side_by_side.alone, in_turn.at_line + in_turn.alone, strict=True):
+        assert a.plan.nlp_values == b.plan.nlp_values

@@ -1,7 +1,7 @@
 """Worker processes, and calls made ahead in one while this process goes on: the bracket's next upper bound while
 its verified motion is refined (``planning.solver.bracket``; ``pressplan bound``'s time-optimal bound before them),
 a multi-start's next start (``planning.solver.search.StartsAhead``), so that their time is the longer side's, not
-their sum.
+their sum; and a line's presses side by side in two workers (``planning.solver.line``).
 
 A :class:`WorkerProcess` is one worker (spawned or forked) running one function at a time: the bracket's, and the
 web page's (``planning.web.workers``: its bounds and its edits' cold solves).
@@ -76,12 +76,13 @@ def _stop(pool: ProcessPoolExecutor) -> None:
 
 
 class WorkerProcess:
-    """One worker process running one function at a time, started on first use (with :func:`signals_held`, under
-    :func:`worker_signals`) and by ``method``: ``"spawn"`` (a fresh interpreter: for a process running threads, such
-    as the web server) or ``"fork"`` (a copy of this one, its imports done)."""
+    """One worker process running one function at a time (``workers`` of them, each taking the next call), started on
+    first use (with :func:`signals_held`, under :func:`worker_signals`) and by ``method``: ``"spawn"`` (a fresh
+    interpreter: for a process running threads, such as the web server) or ``"fork"`` (a copy of this one, its
+    imports done)."""
 
-    def __init__(self, method: str = "spawn") -> None:
-        self.method = method
+    def __init__(self, method: str = "spawn", workers: int = 1) -> None:
+        self.method, self.workers = method, workers
         self._pool: ProcessPoolExecutor | None = None
         self._lock = threading.Lock()
         self._closed = False
@@ -99,7 +100,9 @@ class WorkerProcess:
                     raise RuntimeError("the worker process is closed")
                 if self._pool is None:
                     context = multiprocessing.get_context(self.method)
-                    self._pool = ProcessPoolExecutor(max_workers=1, mp_context=context, initializer=worker_signals)
+                    self._pool = ProcessPoolExecutor(
+                        max_workers=self.workers, mp_context=context, initializer=worker_signals
+                    )
                 try:
                     with signals_held():  # the process starts here: no Ctrl-C before it ignores it
                         return self._pool.submit(function, *args)
@@ -117,10 +120,11 @@ class WorkerProcess:
 
 
 class Ahead:
-    """One forked worker making calls ahead (module docstring)."""
+    """One forked worker making calls ahead (module docstring); ``workers``: that many, each taking the next call
+    (the calls then run side by side, not in order: for independent calls this process only waits for)."""
 
-    def __init__(self) -> None:
-        self._worker = WorkerProcess("fork") if _can_fork() else None
+    def __init__(self, workers: int = 1) -> None:
+        self._worker = WorkerProcess("fork", workers) if _can_fork() else None
 
     def start(self, function: Callable[..., Any], *args: Any) -> Call:
         """``function(*args)`` started in the worker (or, where there is none, made when taken)."""

@@ -11,14 +11,17 @@ exit's loops within the period).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
+from planning.model.case import Case
 from planning.model.limits.base import Check
 from planning.model.line import Line, LineRobot, Station, occupancy_s, phase_offsets_s, tool
 from planning.model.outcome import Outcome
 from planning.model.pendulum import STROKES_PER_CYCLE, PendulumPlan
+from planning.solver.ahead import Ahead, Call
 from planning.solver.objectives import solve_at_period, solve_fastest
 from planning.solver.outcomes import Infeasible, PlanningError
 from planning.solver.pendulum_line import fastest_swings, line_period_s, line_starts_s, shifts_s, swings_at_period
@@ -91,14 +94,13 @@ class LineSolution:
 
 def solve_line(line: Line) -> LineSolution:
     """The line's fastest verified plan (module docstring); raises a :class:`PlanningError` without one."""
-    alone = tuple(_alone(station) for station in line.stations)
+    alone = _alone_all(line.stations)
     loops = tuple(robot.loop_s(line.stations) for robot in line.robots)
     bottleneck = _bottleneck(line, alone, loops)
     period_s = bottleneck.period_s
     _check_slow_enough(line, bottleneck)
-    at_line = tuple(
-        _at_period(station, period_s, fastest) for station, fastest in zip(line.stations, alone, strict=True)
-    )
+    pairs = zip(line.stations, alone, strict=True)
+    at_line = _side_by_side(_at_period, [(station, period_s, fastest) for station, fastest in pairs])
     starts = [station_starts_s(solution) for solution in at_line]
     offsets = phase_offsets_s(period_s, line.robots, line.stations, starts)
     schedules = tuple(_schedule(robot, line, period_s, offsets, starts) for robot in line.robots)
@@ -165,21 +167,48 @@ def _check_slow_enough(line: Line, bottleneck: Bottleneck) -> None:
 
 _ALONE: dict[str, Solution] = {}  # each case's fastest plan, once per process (a line sweep's points share them)
 ALONE_KEPT = 64  # the most kept
+LINE_WORKERS = 2  # the stations' solves side by side in this many forked workers (each solve as it would be here)
 
 
-def _alone(station: Station) -> Solution:
-    """The station's fastest verified plan (solved once per process for the same case)."""
-    case = station.case.with_objective("max-spm")  # a line plans for its rate: the case's objective not read
-    key = case.model_dump_json()
-    if key not in _ALONE:
-        try:
-            solution = fastest_swings(case) if case.pendulum else solve_fastest(case, case.planner.placement)
-        except PlanningError as exc:
-            raise StationError(station, exc, "alone") from None
+def _side_by_side(function: Callable[..., Solution], calls: list[tuple]) -> tuple[Solution, ...]:
+    """``function(*args)`` of every one of ``calls``, side by side in :data:`LINE_WORKERS` forked workers where two
+    cores are free (``planning.solver.ahead``: the same solves, so the same plans), taken in order: the first call
+    that raises raises here, as in turn (and one call alone is made here)."""
+    ahead = Ahead(LINE_WORKERS) if len(calls) > 1 else None
+    try:
+        started = [ahead.start(function, *args) if ahead else Call(function, args, None) for args in calls]
+        return tuple(call.take() for call in started)
+    finally:
+        if ahead is not None:
+            ahead.close()
+
+
+def _key(station: Station) -> str:
+    return _planned_alone(station).model_dump_json()
+
+
+def _planned_alone(station: Station) -> Case:
+    return station.case.with_objective("max-spm")  # a line plans for its rate: the case's objective not read
+
+
+def _alone_all(stations: tuple[Station, ...]) -> tuple[Solution, ...]:
+    """Each station's fastest verified plan (solved once per process for the same case; the new ones side by
+    side)."""
+    missing = {_key(station): station for station in stations if _key(station) not in _ALONE}
+    for key, solution in zip(missing, _side_by_side(_alone, [(s,) for s in missing.values()]), strict=True):
         if len(_ALONE) >= ALONE_KEPT:
             _ALONE.pop(next(iter(_ALONE)))
         _ALONE[key] = solution
-    return _ALONE[key]
+    return tuple(_ALONE[_key(station)] for station in stations)
+
+
+def _alone(station: Station) -> Solution:
+    """The station's fastest verified plan."""
+    case = _planned_alone(station)
+    try:
+        return fastest_swings(case) if case.pendulum else solve_fastest(case, case.planner.placement)
+    except PlanningError as exc:
+        raise StationError(station, exc, "alone") from None
 
 
 def _at_period(station: Station, period_s: float, fastest: Solution) -> Solution:
