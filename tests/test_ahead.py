@@ -8,6 +8,7 @@ import os
 import time
 from types import SimpleNamespace
 
+import numpy as np
 import pytest
 
 from planning.solver import ahead as ahead_module
@@ -189,10 +190,11 @@ def _station_raises(name: str) -> None:
 
 
 @forking
-def test_a_lines_stations_solve_side_by_side_each_result_in_its_place_the_first_error_its_own():
-    """``planning.solver.line._side_by_side`` on stand-ins: the calls run at once in two workers (four of 0.3 s in
-    about 0.6 s), each result in its station's place; the first station that fails raises here, its own error."""
-    from planning.solver.line import _side_by_side
+def test_calls_side_by_side_run_at_once_each_result_in_its_place_the_first_error_its_own():
+    """``planning.solver.ahead.side_by_side`` (a line's stations, the laws) on stand-ins: the calls run at once in
+    two workers (four of 0.3 s in about 0.6 s), each result in its station's place; the first station that fails
+    raises here, its own error."""
+    _side_by_side = ahead_module.side_by_side
 
     t0 = time.perf_counter()
     results = _side_by_side(_station_pid, [(0.3,), (0.3,), (0.3,), (0.0,)])
@@ -231,3 +233,33 @@ def test_a_lines_stations_solved_side_by_side_give_the_line_solved_in_turn(monke
     assert side_by_side.period_s == in_turn.period_s and side_by_side.offsets_s == in_turn.offsets_s
     for a, b in zip(side_by_side.at_line + side_by_side.alone, in_turn.at_line + in_turn.alone, strict=True):
         assert a.plan.nlp_values == b.plan.nlp_values
+
+
+@forking
+def test_the_laws_compared_side_by_side_give_the_comparison_made_in_turn(monkeypatch):
+    """``compare_laws``: the bounds and the laws' solves made in the workers (each taken was made there), the
+    optimal law under the improved S-curve's peak jerk after its row; the same table as made in turn."""
+    from planning.model.case_file import read_case
+    from planning.reports.law_comparison import compare_laws
+    from tests.conftest import PUBLISHED_CASE
+
+    case = read_case(PUBLISHED_CASE)
+    laws = ("improved-s-curve", "quintic", "optimal")
+    made_there: list[bool] = []
+    take = ahead_module.Call.take
+
+    def taken(call):  # noqa: ANN001, ANN202
+        made_there.append(call.future is not None and call.future.result()[0])
+        return take(call)
+
+    with monkeypatch.context() as m:
+        m.setattr(ahead_module.Call, "take", taken)
+        side_by_side, tables = compare_laws(case, laws)
+    assert len(made_there) == 5 and all(made_there)  # two bounds, three laws
+    with monkeypatch.context() as m:
+        m.setattr(ahead_module, "_can_fork", lambda: False)
+        in_turn, tables_in_turn = compare_laws(case, laws)
+    for data in (side_by_side, in_turn):  # the bounds' times aside
+        data["bound"].pop("wall_time_s"), data["upper_bound"].pop("wall_time_s")
+    assert side_by_side == in_turn  # every other number, the optimal law's jerk limit among them
+    assert all(np.array_equal(tables[law], tables_in_turn[law]) for law in laws)

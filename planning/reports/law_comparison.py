@@ -22,6 +22,7 @@ from planning.model.laws import LAWS
 from planning.model.outcome import Outcome
 from planning.model.profile import max_abs_jerk
 from planning.reports.report import MAX_ROWS, TRAJECTORY_COLUMNS, binding, trajectory
+from planning.solver.ahead import SIDE_BY_SIDE_WORKERS, Ahead, Call
 from planning.solver.bound import Bound, time_optimal_bound
 from planning.solver.optimize import solve
 from planning.solver.outcomes import PlanningError
@@ -100,43 +101,23 @@ def compare_laws(case: Case, laws: tuple[str, ...] = tuple(LAWS)) -> tuple[dict[
     plan, its trajectory (columns :data:`planning.reports.report.TRAJECTORY_COLUMNS`).
 
     A law without a verified plan gets a row with its ``status`` (the outcome) and ``message`` and no numbers;
-    when the bound has no answer the laws are still compared (``bound`` None, ``bound_failure`` says why)."""
+    when the bound has no answer the laws are still compared (``bound`` None, ``bound_failure`` says why). The
+    bounds and the laws' solves are independent: on two cores they are made side by side in two forked workers
+    (``planning.solver.ahead``: the same solves, the same numbers), taken in order; the optimal law's after the
+    improved S-curve's row, whose peak jerk it may plan under."""
+    ahead = Ahead(SIDE_BY_SIDE_WORKERS)
     try:
-        bound, bound_failure = time_optimal_bound(case), None
-    except PlanningError as exc:
-        bound, bound_failure = None, str(exc)
-    try:
-        upper = upper_bound(case, LAWS_UPPER_POINTS, LAWS_UPPER_PIECES)
-    except PlanningError:
-        upper = None
-    rows, tables = [], {}
-    for law in laws:
-        note = {}
-        if LAWS[law].needs_jerk_limit:  # the optimal law plans under a jerk limit: the case's, or the S-curve's own
-            try:
-                variant, note = _jerk_limited(case, law, rows)
-            except (CaseError, CaseFileError) as exc:  # e.g. an objective at a rate, which it does not plan
-                variant, note = None, {"reason": str(exc)}
-        else:
-            try:
-                variant = case.with_law(law)
-            except CaseError as exc:  # a law that cannot plan the case's draw (a draw at constant slide speed)
-                variant, note = None, {"reason": str(exc)}
-        outcome, message = Outcome.VERIFIED, ""
-        if variant is None:
-            outcome, message = Outcome.BAD_INPUT, note.pop("reason")
-        else:
-            try:
-                sol = solve(variant)
-            except PlanningError as exc:
-                outcome, message = exc.outcome, str(exc)
-        if not outcome.succeeded:
-            row = {"law": law, "status": outcome, "message": message, "continuity": LAWS[law].continuity}
-            rows.append({**row, **note})
-            continue
-        columns = trajectory(sol, variant)
-        tables[law] = np.column_stack([columns[name] for name in TRAJECTORY_COLUMNS])
-        rows.append({**law_row(law, sol, variant, bound, upper), **note})
+        bound_call = ahead.start(time_optimal_bound, case)
+        upper_call = ahead.start(upper_bound, case, LAWS_UPPER_POINTS, LAWS_UPPER_PIECES)
+        plain = {law: _start_law(ahead, law, *_variant(case, law)) for law in laws if not LAWS[law].needs_jerk_limit}
+        bound, bound_failure = _taken(bound_call)
+        upper, _ = _taken(upper_call)
+        rows, tables = [], {}
+        for law in laws:
+            variant, note, call = plain.get(law) or _start_law(ahead, law, *_jerk_limited_or_why(case, law, rows))
+            rows.append(_row(law, variant, note, call, tables, bound, upper))
+    finally:
+        ahead.close()
     verified = [r for r in rows if Outcome.of(r["status"]).succeeded]
     best = max(verified, key=lambda r: r["spm"]) if verified else None
     bracket = None
@@ -154,6 +135,63 @@ def compare_laws(case: Case, laws: tuple[str, ...] = tuple(LAWS)) -> tuple[dict[
         **({"drive": True} if case.drive is not None else {}),
         "laws": rows,
     }, tables
+
+
+def _taken(call: Call) -> tuple[Any, str | None]:
+    """A bound's value and None, or None and why there is none."""
+    try:
+        return call.take(), None
+    except PlanningError as exc:
+        return None, str(exc)
+
+
+def _variant(case: Case, law: str) -> tuple[Case | None, dict[str, Any]]:
+    """``case`` under ``law``, or None and the reason (a law that cannot plan the case's draw: at constant slide
+    speed)."""
+    try:
+        return case.with_law(law), {}
+    except CaseError as exc:
+        return None, {"reason": str(exc)}
+
+
+def _jerk_limited_or_why(case: Case, law: str, rows: list[dict[str, Any]]) -> tuple[Case | None, dict[str, Any]]:
+    """The optimal law's case (:func:`_jerk_limited`), or None and the reason (e.g. an objective at a rate, which
+    it does not plan)."""
+    try:
+        return _jerk_limited(case, law, rows)
+    except (CaseError, CaseFileError) as exc:
+        return None, {"reason": str(exc)}
+
+
+def _start_law(ahead: Ahead, law: str, variant: Case | None, note: dict) -> tuple[Case | None, dict, Call | None]:
+    """The law's solve started in ``ahead``'s workers (none without a case to solve)."""
+    return variant, note, ahead.start(solve, variant) if variant is not None else None
+
+
+def _row(
+    law: str,
+    variant: Case | None,
+    note: dict[str, Any],
+    call: Call | None,
+    tables: dict[str, np.ndarray],
+    bound: Bound | None,
+    upper: UpperBound | None,
+) -> dict[str, Any]:
+    """The law's row from its solve ``call`` (its trajectory into ``tables``), or its outcome and message."""
+    note = dict(note)
+    outcome, message = Outcome.VERIFIED, ""
+    if variant is None:
+        outcome, message = Outcome.BAD_INPUT, note.pop("reason")
+    else:
+        try:
+            sol = call.take()
+        except PlanningError as exc:
+            outcome, message = exc.outcome, str(exc)
+    if not outcome.succeeded:
+        return {"law": law, "status": outcome, "message": message, "continuity": LAWS[law].continuity, **note}
+    columns = trajectory(sol, variant)
+    tables[law] = np.column_stack([columns[name] for name in TRAJECTORY_COLUMNS])
+    return {**law_row(law, sol, variant, bound, upper), **note}
 
 
 def _jerk_limited(case: Case, law: str, rows: list[dict[str, Any]]) -> tuple[Case | None, dict[str, Any]]:

@@ -162,6 +162,22 @@ class Call:
         return self.function(*self.args)
 
 
+SIDE_BY_SIDE_WORKERS = 2  # independent calls made side by side in this many forked workers
+
+
+def side_by_side(function: Callable[..., Any], calls: list[tuple]) -> list[Any]:
+    """``function(*args)`` for each of ``calls``, made side by side in :data:`SIDE_BY_SIDE_WORKERS` forked workers
+    (where :class:`Ahead` can fork; one call alone, or none can: made here in turn), taken in order: the values in
+    the calls' order, and where a call raises, the first such call raises here (its own exception)."""
+    ahead = Ahead(SIDE_BY_SIDE_WORKERS) if len(calls) > 1 else None
+    try:
+        started = [ahead.start(function, *args) if ahead else Call(function, args, None) for args in calls]
+        return [call.take() for call in started]
+    finally:
+        if ahead is not None:
+            ahead.close()
+
+
 _FAILED = (False, None)
 
 

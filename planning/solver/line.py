@@ -11,7 +11,6 @@ exit's loops within the period).
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,7 +20,7 @@ from planning.model.limits.base import Check
 from planning.model.line import Line, LineRobot, Station, occupancy_s, phase_offsets_s, tool
 from planning.model.outcome import Outcome
 from planning.model.pendulum import STROKES_PER_CYCLE, PendulumPlan
-from planning.solver.ahead import Ahead, Call
+from planning.solver.ahead import side_by_side
 from planning.solver.objectives import solve_at_period, solve_fastest
 from planning.solver.outcomes import Infeasible, PlanningError
 from planning.solver.pendulum_line import fastest_swings, line_period_s, line_starts_s, shifts_s, swings_at_period
@@ -100,7 +99,7 @@ def solve_line(line: Line) -> LineSolution:
     period_s = bottleneck.period_s
     _check_slow_enough(line, bottleneck)
     pairs = zip(line.stations, alone, strict=True)
-    at_line = _side_by_side(_at_period, [(station, period_s, fastest) for station, fastest in pairs])
+    at_line = tuple(side_by_side(_at_period, [(station, period_s, fastest) for station, fastest in pairs]))
     starts = [station_starts_s(solution) for solution in at_line]
     offsets = phase_offsets_s(period_s, line.robots, line.stations, starts)
     schedules = tuple(_schedule(robot, line, period_s, offsets, starts) for robot in line.robots)
@@ -167,20 +166,6 @@ def _check_slow_enough(line: Line, bottleneck: Bottleneck) -> None:
 
 _ALONE: dict[str, Solution] = {}  # each case's fastest plan, once per process (a line sweep's points share them)
 ALONE_KEPT = 64  # the most kept
-LINE_WORKERS = 2  # the stations' solves side by side in this many forked workers (each solve as it would be here)
-
-
-def _side_by_side(function: Callable[..., Solution], calls: list[tuple]) -> tuple[Solution, ...]:
-    """``function(*args)`` of every one of ``calls``, side by side in :data:`LINE_WORKERS` forked workers where two
-    cores are free (``planning.solver.ahead``: the same solves, so the same plans), taken in order: the first call
-    that raises raises here, as in turn (and one call alone is made here)."""
-    ahead = Ahead(LINE_WORKERS) if len(calls) > 1 else None
-    try:
-        started = [ahead.start(function, *args) if ahead else Call(function, args, None) for args in calls]
-        return tuple(call.take() for call in started)
-    finally:
-        if ahead is not None:
-            ahead.close()
 
 
 def _key(station: Station) -> str:
@@ -195,7 +180,7 @@ def _alone_all(stations: tuple[Station, ...]) -> tuple[Solution, ...]:
     """Each station's fastest verified plan (solved once per process for the same case; the new ones side by
     side)."""
     missing = {_key(station): station for station in stations if _key(station) not in _ALONE}
-    for key, solution in zip(missing, _side_by_side(_alone, [(s,) for s in missing.values()]), strict=True):
+    for key, solution in zip(missing, side_by_side(_alone, [(s,) for s in missing.values()]), strict=True):
         if len(_ALONE) >= ALONE_KEPT:
             _ALONE.pop(next(iter(_ALONE)))
         _ALONE[key] = solution
