@@ -75,6 +75,21 @@ def test_compiled_derivatives_are_the_interpreted_ones_and_a_later_solver_loads_
     assert not misfit.compiled and not any(cache.glob(f"{wider_key}*"))
 
 
+def test_a_problems_key_is_made_only_where_the_cache_holds_a_library(cache, monkeypatch):
+    """The key (a serialization of the problem: 0.2 s on a linkage's) is not made to look into a cache without any
+    library; asked for, it is the problem's; with a library there, it is made to look for its own."""
+    import planning.solver.ipopt as ipopt_module
+
+    made: list[str] = []
+    monkeypatch.setattr(ipopt_module, "problem_key", lambda *args: made.append("key") or compiled.problem_key(*args))
+    solver = NLPSolver("toy", _problem())
+    assert made == [] and not solver.compiled
+    assert solver.key == compiled.problem_key(_problem()) and made == ["key"]
+    cache.mkdir(parents=True)
+    (cache / "kanother_nlp_jac_g.so").write_bytes(b"")
+    assert not NLPSolver("toy", _problem()).compiled and made == ["key", "key"]
+
+
 def test_without_a_cache_or_a_compiler_the_functions_stay_interpreted_said_once(tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(compiled, "_said", set())
     monkeypatch.setenv(compiled.CACHE_ENV, "off")

@@ -78,6 +78,15 @@ def problem_key(problem: dict, lift: Lift | None = None) -> str:
     return "k" + digest.hexdigest()[:32]
 
 
+def any_compiled() -> bool:
+    """Whether the cache holds any compiled library (a problem's key need not be made to look for it otherwise)."""
+    folder = cache_dir()
+    try:
+        return folder is not None and folder.is_dir() and any(folder.glob("*.so"))
+    except OSError:  # unreadable: as without a cache
+        return False
+
+
 def cached_functions(key: str) -> dict[str, ca.Function] | None:
     """The compiled derivative functions of the problem of ``key`` (nlpsol's options) where the cache holds them,
     else None: also where the cache cannot be read or a library is damaged (its SHA-256 is not the one written

@@ -36,6 +36,7 @@ import numpy as np
 from planning.solver.compiled import (
     COMPILED_FUNCTIONS,
     Cancel,
+    any_compiled,
     cached_functions,
     compile_into_cache,
     discard,
@@ -140,19 +141,30 @@ class NLPSolver:
         # an SX problem's derivatives (a lifted one's too) compiled to machine code where the cache holds them
         # (``compiled``): found by the problem's key
         self.compilable = isinstance(problem, dict) and not isinstance(problem["x"], ca.MX)
-        self.key = problem_key(problem, lift) if self.compilable else None
+        # its cache key (a serialization of the problem: 0.2 s on a linkage's lifted one) made when first needed:
+        # where the cache holds compiled libraries, when compiled
+        self._key_of: tuple | None = (problem, lift) if self.compilable else None
+        self._key: str | None = None
         if lift is not None:  # the mechanism's quantities lifted out of the derivatives (``lifting``)
             problem, derivatives = lifted_problem(problem, lift)
             self.options.update(derivatives)
         self.problem = problem  # a dict of expressions, or (lifted) a function of x and p
         self.warm_options = {**WARM_START_OPTIONS, **(warm_options or {})}
         self.compiled = False
-        self._cold = self._solver_with(cached_functions(self.key) if self.key is not None else None)
+        self._cold = self._solver_with(cached_functions(self.key) if self.compilable and any_compiled() else None)
         self._warm: ca.Function | None = None
         if self.compilable:
             BUILT.add(self)
             for kept in _KEPT:
                 kept.append(self)
+
+    @property
+    def key(self) -> str | None:
+        """The problem's key in the compiled cache (``planning.solver.compiled.problem_key``); None for an MX
+        problem."""
+        if self._key is None and self._key_of is not None:
+            self._key = problem_key(*self._key_of)
+        return self._key
 
     def compile(self, niceness: int = 0, cancel: Cancel | None = None) -> float | None:
         """Compile this problem's derivative functions into the cache (``planning.solver.compiled``; the
