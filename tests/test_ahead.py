@@ -263,3 +263,23 @@ def test_the_laws_compared_side_by_side_give_the_comparison_made_in_turn(monkeyp
         data["bound"].pop("wall_time_s"), data["upper_bound"].pop("wall_time_s")
     assert side_by_side == in_turn  # every other number, the optimal law's jerk limit among them
     assert all(np.array_equal(tables[law], tables_in_turn[law]) for law in laws)
+
+
+def _fake_certified(case, points: int) -> SimpleNamespace:  # noqa: ANN001 - a Case
+    return SimpleNamespace(points=points, pid=os.getpid())
+
+
+@forking
+def test_bound_certified_makes_its_upper_bound_in_a_worker_and_says_the_time_optimal_bounds_error_first(monkeypatch):
+    from planning import cli
+    from planning.solver import bound as bound_module
+    from planning.solver import upper_bound as upper_module
+    from planning.solver.outcomes import Infeasible
+
+    monkeypatch.setattr(bound_module, "time_optimal_bound", _fake_bound)
+    monkeypatch.setattr(upper_module, "upper_bound", _fake_certified)
+    bound, upper = cli._bound_and_upper(None, 720, None)
+    assert bound.pid == os.getpid() and upper.pid != os.getpid() and upper.points == upper_module.UPPER_POINTS
+    monkeypatch.setattr(bound_module, "time_optimal_bound", _failing_bound)
+    with pytest.raises(Infeasible, match=f"the bound's own error in {os.getpid()}$"):
+        cli._bound_and_upper(None, 720, 2880)
