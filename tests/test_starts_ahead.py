@@ -103,9 +103,11 @@ def test_a_worker_forked_before_an_nlp_was_built_leaves_its_solve_to_this_proces
     other = _Other()
     ahead = StartsAhead()
     try:
-        search_module._SOLVABLE.pop(id(search.nlp), None)
+        token = search_module._token(search.nlp)
+        search_module._SOLVABLE.pop(token)
         ahead.start(other, ("a start",))  # the worker forked now, holding the other NLP, not this one
-        ahead._forked_with |= {id(search.nlp)}  # ... and believed to hold it
+        ahead._forked_with |= {token}  # ... and believed to hold it
+        search_module._SOLVABLE[token] = search.nlp
         ahead.start(search.nlp, args)
         made = ahead.take(search.nlp, args)
         assert ahead.take(other, ("a start",)) == "other"
@@ -113,3 +115,15 @@ def test_a_worker_forked_before_an_nlp_was_built_leaves_its_solve_to_this_proces
         ahead.close()
     assert made_there == [False, True]  # this NLP's solve raised there (no such NLP): made here; the other's there
     assert np.array_equal(made.x, search.nlp.solve(*args).x)
+
+
+def test_an_nlps_token_is_never_another_ones_even_at_the_same_address():
+    """A worker finds an NLP by its token: an object's id may be taken by a later object (the same address), a
+    token is given once."""
+    seen = set()
+    for _ in range(50):
+        nlp = _Other()
+        token = search_module._token(nlp)
+        assert token not in seen and search_module._token(nlp) == token
+        seen.add(token)
+        del nlp  # the next one may take its address

@@ -19,6 +19,7 @@ rate (``planning.solver.objectives``) all run on it.
 
 from __future__ import annotations
 
+import itertools
 import math
 import time
 import weakref
@@ -358,14 +359,24 @@ class Search:
         return replace(self.best, plan=replace(plan, solver=info))
 
 
-# the NLPs whose solves a worker may make (by id: a forked worker holds the same objects at the same places)
+# the NLPs whose solves a worker may make, by a token of their own (a forked worker holds the same objects under the
+# same tokens; never an object's id, which a later object may take)
 _SOLVABLE: weakref.WeakValueDictionary[int, CycleNLP] = weakref.WeakValueDictionary()
+_TOKENS = itertools.count()
 
 
-def _solve_there(nlp_id: int, args: tuple) -> NLPResult:
-    """In the worker: ``CycleNLP.solve(*args)`` of the NLP ``nlp_id`` (a ``KeyError`` where the worker was forked
+def _token(nlp: CycleNLP) -> int:
+    """``nlp``'s token in :data:`_SOLVABLE` (given on first use, never given again)."""
+    if "_ahead_token" not in vars(nlp):
+        nlp._ahead_token = next(_TOKENS)
+        _SOLVABLE[nlp._ahead_token] = nlp
+    return nlp._ahead_token
+
+
+def _solve_there(token: int, args: tuple) -> NLPResult:
+    """In the worker: ``CycleNLP.solve(*args)`` of the NLP of ``token`` (a ``KeyError`` where the worker was forked
     before it was built: the call is then made by the search itself)."""
-    return _SOLVABLE[nlp_id].solve(*args)
+    return _SOLVABLE[token].solve(*args)
 
 
 class StartsAhead:
@@ -386,11 +397,11 @@ class StartsAhead:
         was begun already)."""
         if any(other is nlp and _same_call(begun, args) for other, begun, _ in self._calls):
             return
-        _SOLVABLE[id(nlp)] = nlp
-        if self._ahead is None or id(nlp) not in self._forked_with:
+        token = _token(nlp)
+        if self._ahead is None or token not in self._forked_with:
             self.close()
             self._ahead, self._forked_with = Ahead(), frozenset(_SOLVABLE.keys())
-        self._calls.append((nlp, args, self._ahead.start(_solve_there, id(nlp), args)))
+        self._calls.append((nlp, args, self._ahead.start(_solve_there, token, args)))
 
     def take(self, nlp: CycleNLP, args: tuple) -> NLPResult | None:
         """The result of ``nlp.solve(*args)`` where it was begun ahead (made here where the worker failed), else
