@@ -876,7 +876,7 @@ def _laws(case, args) -> int:
         data = pendulum_laws(case)
         writers = {"laws.json": lambda p: write_json(p, data)}
         return _write_and_report(out, writers, data, pendulum_laws_text(data), args, LAWS_FILES)
-    data, tables = compare_laws(case)
+    data, tables = compare_laws(case, side_by_side_workers=True)
     if not tables:  # each law's own reason, on the one line
         reasons = "; ".join(f"{r['law']}: {r['message']}" for r in data["laws"])
         raise CommandError(f"{args.case}: no motion law gives a verified plan ({reasons})", EXIT_INFEASIBLE)
@@ -942,7 +942,7 @@ def _line(args) -> int:
     ensure_writable(out)
     if args.vary:
         return _line_sweep(line, sets, args, out)
-    solution = solve_line(line)
+    solution = solve_line(line, side_by_side_workers=True)
     if not args.no_plots:
         _load_plots()
     args.case = args.line  # the file no output replaces

@@ -224,12 +224,12 @@ def test_a_lines_stations_solved_side_by_side_give_the_line_solved_in_turn(monke
     with monkeypatch.context() as m:
         m.setattr(ahead_module.Call, "take", taken)
         line_module._ALONE.clear()
-        side_by_side = line_module.solve_line(read_line(path))
+        side_by_side = line_module.solve_line(read_line(path), side_by_side_workers=True)
     assert len(made_there) == 4 and all(made_there)  # two stations alone, two at the line's period
     with monkeypatch.context() as m:
         m.setattr(ahead_module, "_can_fork", lambda: False)
         line_module._ALONE.clear()
-        in_turn = line_module.solve_line(read_line(path))
+        in_turn = line_module.solve_line(read_line(path), side_by_side_workers=True)
     assert side_by_side.period_s == in_turn.period_s and side_by_side.offsets_s == in_turn.offsets_s
     for a, b in zip(side_by_side.at_line + side_by_side.alone, in_turn.at_line + in_turn.alone, strict=True):
         assert a.plan.nlp_values == b.plan.nlp_values
@@ -254,11 +254,11 @@ def test_the_laws_compared_side_by_side_give_the_comparison_made_in_turn(monkeyp
 
     with monkeypatch.context() as m:
         m.setattr(ahead_module.Call, "take", taken)
-        side_by_side, tables = compare_laws(case, laws)
+        side_by_side, tables = compare_laws(case, laws, side_by_side_workers=True)
     assert len(made_there) == 5 and all(made_there)  # two bounds, three laws
     with monkeypatch.context() as m:
         m.setattr(ahead_module, "_can_fork", lambda: False)
-        in_turn, tables_in_turn = compare_laws(case, laws)
+        in_turn, tables_in_turn = compare_laws(case, laws, side_by_side_workers=True)
     for data in (side_by_side, in_turn):  # the bounds' times aside
         data["bound"].pop("wall_time_s"), data["upper_bound"].pop("wall_time_s")
     assert side_by_side == in_turn  # every other number, the optimal law's jerk limit among them

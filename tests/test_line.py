@@ -490,3 +490,56 @@ def test_a_press_drawing_at_a_slide_speed_keeps_it_at_the_lines_period(tmp_path:
     drawing = (np.degrees(theta) > 145.5) & (np.degrees(theta) < 184.5)  # theta2 .. theta3, the ends left out
     assert np.max(speed[drawing]) <= 60.0 * (1 + 1e-3)  # (finite differences of the 1 ms grid)
     assert np.mean(np.abs(speed[drawing] - 60.0) <= 0.06) > 1 / 3
+
+
+def _stand_in_alone(monkeypatch: pytest.MonkeyPatch, fails: bool = False) -> list[str]:
+    """``planning.solver.line``'s station solve and key on stand-ins (a station's key its case's name); the names
+    of the stations solved."""
+    from types import SimpleNamespace
+
+    from planning.solver import line as line_module
+
+    solved: list[str] = []
+
+    def alone(station):  # noqa: ANN001, ANN202
+        solved.append(station.name)
+        if fails:
+            raise ValueError(f"station {station.name}")
+        line_module._keep(station.case, SimpleNamespace(name=f"plan of {station.case}"))
+        return SimpleNamespace(name=f"plan of {station.case}")
+
+    monkeypatch.setattr(line_module, "_alone", alone)
+    monkeypatch.setattr(line_module, "_key", lambda station: station.case)
+    monkeypatch.setattr(line_module, "_ALONE", {})
+    return solved
+
+
+def test_a_line_keeps_each_press_alone_once_and_a_full_store_loses_none_of_this_lines(monkeypatch):
+    """The presses' plans alone are kept (at most ALONE_KEPT): a line whose new plans push its own known ones
+    out of the store still has them all (a line sweep varying one press over many points once met a KeyError)."""
+    from types import SimpleNamespace
+
+    from planning.solver import ahead
+    from planning.solver import line as line_module
+
+    solved = _stand_in_alone(monkeypatch)
+    monkeypatch.setattr(line_module, "ALONE_KEPT", 2)
+    stations = [SimpleNamespace(name=n, case=c) for n, c in (("draw", "a"), ("trim", "b"), ("flange", "a"))]
+    line_module._ALONE.update({"a": SimpleNamespace(name="plan of a"), "z": SimpleNamespace(name="old")})
+    for _ in range(2):
+        plans = line_module._alone_all(tuple(stations), ahead.in_turn)
+        assert [p.name for p in plans] == ["plan of a", "plan of b", "plan of a"]
+    # b solved once (a known); b pushed a out of the store, so the next line solved a again (its first station)
+    assert solved == ["trim", "draw"]
+
+
+def test_of_presses_sharing_a_case_the_first_is_named_when_it_fails(monkeypatch):
+    from types import SimpleNamespace
+
+    from planning.solver import ahead
+    from planning.solver import line as line_module
+
+    _stand_in_alone(monkeypatch, fails=True)
+    stations = (SimpleNamespace(name="trim", case="trim.yaml"), SimpleNamespace(name="flange", case="trim.yaml"))
+    with pytest.raises(ValueError, match="station trim$"):
+        line_module._alone_all(stations, ahead.in_turn)

@@ -96,16 +96,19 @@ def _columns(data: dict[str, Any]) -> tuple:
     return COLUMNS + (DRIVE_COLUMNS if data.get("drive") else ())
 
 
-def compare_laws(case: Case, laws: tuple[str, ...] = tuple(LAWS)) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
+def compare_laws(
+    case: Case, laws: tuple[str, ...] = tuple(LAWS), side_by_side_workers: bool = False
+) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     """Solve ``case`` under each law; returns the comparison dictionary and, per law with a verified
     plan, its trajectory (columns :data:`planning.reports.report.TRAJECTORY_COLUMNS`).
 
     A law without a verified plan gets a row with its ``status`` (the outcome) and ``message`` and no numbers;
     when the bound has no answer the laws are still compared (``bound`` None, ``bound_failure`` says why). The
-    bounds and the laws' solves are independent: on two cores they are made side by side in two forked workers
-    (``planning.solver.ahead``: the same solves, the same numbers), taken in order; the optimal law's after the
-    improved S-curve's row, whose peak jerk it may plan under."""
-    ahead = Ahead(SIDE_BY_SIDE_WORKERS)
+    bounds and the laws' solves are independent: with ``side_by_side_workers`` (``pressplan laws``), on two cores,
+    they are made side by side in two forked workers (``planning.solver.ahead``: the same solves, the same numbers;
+    their NLPs built there, not kept here), taken in order; the optimal law's after the improved S-curve's row,
+    whose peak jerk it may plan under. Else one after another here."""
+    ahead = Ahead(SIDE_BY_SIDE_WORKERS if side_by_side_workers else 0)
     try:
         bound_call = ahead.start(time_optimal_bound, case)
         upper_call = ahead.start(upper_bound, case, LAWS_UPPER_POINTS, LAWS_UPPER_PIECES)

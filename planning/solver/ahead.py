@@ -1,16 +1,19 @@
-"""Worker processes, and calls made ahead in one while this process goes on: the bracket's next upper bound while
-its verified motion is refined (``planning.solver.bracket``; ``pressplan bound``'s time-optimal bound before them),
-a multi-start's next start (``planning.solver.search.StartsAhead``), so that their time is the longer side's, not
-their sum; and a line's presses side by side in two workers (``planning.solver.line``).
+"""Worker processes, and calls made ahead in them while this process goes on, so that the time of two independent
+computations is the longer one's, not their sum: the bracket's next upper bound while its verified motion is refined
+(``planning.solver.bracket``; ``pressplan bound``'s time-optimal bound beside the bracket or the certified upper
+bound), a multi-start's next start (``planning.solver.search.StartsAhead``); and independent calls side by side in two
+workers (:func:`side_by_side`: ``pressplan line``'s presses, ``pressplan laws``' bounds and laws).
 
-A :class:`WorkerProcess` is one worker (spawned or forked) running one function at a time: the bracket's, and the
-web page's (``planning.web.workers``: its bounds and its edits' cold solves).
+A :class:`WorkerProcess` runs one function at a time in each of its worker processes (spawned or forked; one by
+default): the bracket's, the side-by-side calls', and the web page's (``planning.web.workers``: its bounds and its
+edits' cold solves).
 
-:meth:`Ahead.start` hands a call to one forked worker (calls run one after another, in the order started) and
-returns at once; :meth:`Ahead.take` returns its value. A call computed there is the same computation as here (the
-same code and inputs: the same numbers); where it raised, or the worker failed, the call is made again here when
-taken, so the caller sees the value or the exception it would have seen without the worker. Where the machine has
-one core, the process cannot fork (no ``fork``, threads running, a daemon process, which may have no children), calls
+:meth:`Ahead.start` hands a call to a forked worker and returns at once (with one worker, calls run one after another,
+in the order started; with two, side by side); :meth:`Call.take` returns its value. A call computed there is the same
+computation as here (the same code and inputs: the same numbers); where it raised, or the worker failed, the call is
+made again here when taken, so the caller sees the value or the exception it would have seen without the worker
+(a call that fails is made twice). Where the machine has one core, the process cannot fork (no ``fork``, threads
+running, among them a pressplan worker's watch of its parent, a daemon process, which may have no children), calls
 are made here when taken. The worker ignores Ctrl-C (the caller's to handle), is stopped by :meth:`Ahead.close` and
 ends itself when this process is gone (:func:`worker_signals`, which every worker process of pressplan starts with).
 """
@@ -121,10 +124,11 @@ class WorkerProcess:
 
 class Ahead:
     """One forked worker making calls ahead (module docstring); ``workers``: that many, each taking the next call
-    (the calls then run side by side, not in order: for independent calls this process only waits for)."""
+    (the calls then run side by side, not in order: for independent calls this process only waits for); 0: none,
+    every call made here when taken."""
 
     def __init__(self, workers: int = 1) -> None:
-        self._worker = WorkerProcess("fork", workers) if _can_fork() else None
+        self._worker = WorkerProcess("fork", workers) if workers > 0 and _can_fork() else None
 
     def start(self, function: Callable[..., Any], *args: Any) -> Call:
         """``function(*args)`` started in the worker (or, where there is none, made when taken)."""
@@ -176,6 +180,11 @@ def side_by_side(function: Callable[..., Any], calls: list[tuple]) -> list[Any]:
     finally:
         if ahead is not None:
             ahead.close()
+
+
+def in_turn(function: Callable[..., Any], calls: list[tuple]) -> list[Any]:
+    """``function(*args)`` for each of ``calls``, here, one after another (:func:`side_by_side`'s other way)."""
+    return [function(*args) for args in calls]
 
 
 _FAILED = (False, None)

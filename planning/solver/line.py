@@ -11,6 +11,7 @@ exit's loops within the period).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -20,7 +21,7 @@ from planning.model.limits.base import Check
 from planning.model.line import Line, LineRobot, Station, occupancy_s, phase_offsets_s, tool
 from planning.model.outcome import Outcome
 from planning.model.pendulum import STROKES_PER_CYCLE, PendulumPlan
-from planning.solver.ahead import side_by_side
+from planning.solver.ahead import in_turn, side_by_side
 from planning.solver.objectives import solve_at_period, solve_fastest
 from planning.solver.outcomes import Infeasible, PlanningError
 from planning.solver.pendulum_line import fastest_swings, line_period_s, line_starts_s, shifts_s, swings_at_period
@@ -91,15 +92,19 @@ class LineSolution:
         return all(c.passed for c in self.checks)
 
 
-def solve_line(line: Line) -> LineSolution:
-    """The line's fastest verified plan (module docstring); raises a :class:`PlanningError` without one."""
-    alone = _alone_all(line.stations)
+def solve_line(line: Line, side_by_side_workers: bool = False) -> LineSolution:
+    """The line's fastest verified plan (module docstring); raises a :class:`PlanningError` without one.
+    ``side_by_side_workers``: the presses' solves side by side in two forked workers (``planning.solver.ahead``: the
+    same plans in about half the time, for one line: ``pressplan line``); else in turn here, where the NLPs they
+    build stay for the next line (a line sweep's points, a sweep's forked workers)."""
+    solve_each = side_by_side if side_by_side_workers else in_turn
+    alone = _alone_all(line.stations, solve_each)
     loops = tuple(robot.loop_s(line.stations) for robot in line.robots)
     bottleneck = _bottleneck(line, alone, loops)
     period_s = bottleneck.period_s
     _check_slow_enough(line, bottleneck)
     pairs = zip(line.stations, alone, strict=True)
-    at_line = tuple(side_by_side(_at_period, [(station, period_s, fastest) for station, fastest in pairs]))
+    at_line = tuple(solve_each(_at_period, [(station, period_s, fastest) for station, fastest in pairs]))
     starts = [station_starts_s(solution) for solution in at_line]
     offsets = phase_offsets_s(period_s, line.robots, line.stations, starts)
     schedules = tuple(_schedule(robot, line, period_s, offsets, starts) for robot in line.robots)
@@ -176,24 +181,38 @@ def _planned_alone(station: Station) -> Case:
     return station.case.with_objective("max-spm")  # a line plans for its rate: the case's objective not read
 
 
-def _alone_all(stations: tuple[Station, ...]) -> tuple[Solution, ...]:
-    """Each station's fastest verified plan (solved once per process for the same case; the new ones side by
-    side)."""
-    missing = {_key(station): station for station in stations if _key(station) not in _ALONE}
-    for key, solution in zip(missing, side_by_side(_alone, [(s,) for s in missing.values()]), strict=True):
+def _alone_all(stations: tuple[Station, ...], solve_each: Callable) -> tuple[Solution, ...]:
+    """Each station's fastest verified plan, solved once per process for the same case (the first station of a
+    case solves it: its name in an error) by ``solve_each`` (:func:`side_by_side` or :func:`in_turn`)."""
+    keys = [_key(station) for station in stations]
+    known = {key: _ALONE[key] for key in keys if key in _ALONE}  # read before new ones may push them out
+    missing: dict[str, Station] = {}
+    for key, station in zip(keys, stations, strict=True):
+        if key not in known:
+            missing.setdefault(key, station)
+    solved = dict(zip(missing, solve_each(_alone, [(s,) for s in missing.values()]), strict=True))
+    for key, solution in solved.items():  # (kept already where solved here)
+        _keep(key, solution)
+    return tuple({**known, **solved}[key] for key in keys)
+
+
+def _keep(key: str, solution: Solution) -> None:
+    """``solution`` kept as the fastest plan of the case of ``key`` (the oldest dropped beyond :data:`ALONE_KEPT`)."""
+    if key not in _ALONE:
         if len(_ALONE) >= ALONE_KEPT:
             _ALONE.pop(next(iter(_ALONE)))
         _ALONE[key] = solution
-    return tuple(_ALONE[_key(station)] for station in stations)
 
 
 def _alone(station: Station) -> Solution:
-    """The station's fastest verified plan."""
+    """The station's fastest verified plan, kept (:func:`_keep`: by this process, a worker's in its own)."""
     case = _planned_alone(station)
     try:
-        return fastest_swings(case) if case.pendulum else solve_fastest(case, case.planner.placement)
+        solution = fastest_swings(case) if case.pendulum else solve_fastest(case, case.planner.placement)
     except PlanningError as exc:
         raise StationError(station, exc, "alone") from None
+    _keep(_key(station), solution)
+    return solution
 
 
 def _at_period(station: Station, period_s: float, fastest: Solution) -> Solution:

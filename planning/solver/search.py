@@ -290,7 +290,8 @@ class Search:
         is confirmed; ``confirm`` False: until one verifies) or the starts run out; the values of the
         best verified start. ``ran``: starts of this placement already solved (the drive's probe): they
         are not run again, and what they found counts. While a start runs whose result cannot end the
-        search (none found yet), the next one's first solve is begun ahead (:meth:`begin_ahead`)."""
+        search by agreement (none found yet; a check of :attr:`stop_on` still may), the next one's first solve is
+        begun ahead (:meth:`begin_ahead`)."""
         found = sorted((r.found for r in ran if r.found is not None), key=lambda item: item[1])
         tried = [self.key(r.start) for r in ran]
         todo = []
@@ -305,7 +306,7 @@ class Search:
             for i, x0 in enumerate(todo):
                 if self.stopped:
                     break
-                if confirm and not found and i + 1 < len(todo):  # the next start runs whatever this one finds
+                if confirm and not found and i + 1 < len(todo):  # the next start runs (but after a stopping check)
                     self.begin_ahead(todo[i + 1], placement)
                 out = self.attempt(x0, placement)
                 if out is None:
@@ -383,7 +384,7 @@ class StartsAhead:
     """The first IPOPT solves of a multi-start's coming starts, made in one forked worker (``planning.solver.ahead``)
     while this process runs the start before: the same call on the same inputs, so the same result to the last bit
     (and the same answers); a start takes its solve when its turn comes (:meth:`take`). Where the worker cannot fork
-    (one core, threads running, a daemon process: a sweep's or the web page's workers, whose cores are busy), or the
+    (one core, threads running: a sweep's, a trade-off's or the web page's workers, whose cores are busy), or the
     worker lacks the NLP, nothing is made ahead: the search solves as before. The worker is stopped by
     :meth:`close` (a start the search never reached is dropped there)."""
 
