@@ -70,10 +70,9 @@ def test_without_a_worker_the_call_is_made_when_taken(monkeypatch):
     ahead.close()
 
 
-def _bracket_both_ways(case, tolerance_pct: float, monkeypatch):  # noqa: ANN001, ANN202 - a Case; two Brackets
-    """The bracket with its upper bounds made ahead in the worker (each one taken was made there), and made here."""
-    from planning.solver.bracket import bracket
-
+def _both_ways(monkeypatch, compute):  # noqa: ANN001, ANN202 - pytest's monkeypatch, a callable; its two values
+    """``compute()`` with its calls made in workers (whether each one taken was made there recorded), then with none
+    made in a worker (no fork): ``(made_there, the first value, the second)``."""
     made_there: list[bool] = []
     take = ahead_module.Call.take
 
@@ -83,11 +82,19 @@ def _bracket_both_ways(case, tolerance_pct: float, monkeypatch):  # noqa: ANN001
 
     with monkeypatch.context() as m:
         m.setattr(ahead_module.Call, "take", taken)
-        parallel = bracket(case, tolerance_pct)
-    assert made_there and all(made_there), made_there
+        parallel = compute()
     with monkeypatch.context() as m:
         m.setattr(ahead_module, "_can_fork", lambda: False)
-        alone = bracket(case, tolerance_pct)
+        alone = compute()
+    return made_there, parallel, alone
+
+
+def _bracket_both_ways(case, tolerance_pct: float, monkeypatch):  # noqa: ANN001, ANN202 - a Case; two Brackets
+    """The bracket with its upper bounds made ahead in the worker (each one taken was made there), and made here."""
+    from planning.solver.bracket import bracket
+
+    made_there, parallel, alone = _both_ways(monkeypatch, lambda: bracket(case, tolerance_pct))
+    assert made_there and all(made_there), made_there
     return parallel, alone
 
 
@@ -214,22 +221,13 @@ def test_a_lines_stations_solved_side_by_side_give_the_line_solved_in_turn(monke
     from tests.conftest import ROOT
 
     path = ROOT / "tests" / "data" / "line" / "fast.yaml"
-    made_there: list[bool] = []
-    take = ahead_module.Call.take
 
-    def taken(call):  # noqa: ANN001, ANN202
-        made_there.append(call.future is not None and call.future.result()[0])
-        return take(call)
-
-    with monkeypatch.context() as m:
-        m.setattr(ahead_module.Call, "take", taken)
+    def solved():  # noqa: ANN202 - a LineSolution
         line_module._ALONE.clear()
-        side_by_side = line_module.solve_line(read_line(path), side_by_side_workers=True)
+        return line_module.solve_line(read_line(path), side_by_side_workers=True)
+
+    made_there, side_by_side, in_turn = _both_ways(monkeypatch, solved)
     assert len(made_there) == 4 and all(made_there)  # two stations alone, two at the line's period
-    with monkeypatch.context() as m:
-        m.setattr(ahead_module, "_can_fork", lambda: False)
-        line_module._ALONE.clear()
-        in_turn = line_module.solve_line(read_line(path), side_by_side_workers=True)
     assert side_by_side.period_s == in_turn.period_s and side_by_side.offsets_s == in_turn.offsets_s
     for a, b in zip(side_by_side.at_line + side_by_side.alone, in_turn.at_line + in_turn.alone, strict=True):
         assert a.plan.nlp_values == b.plan.nlp_values
@@ -245,20 +243,10 @@ def test_the_laws_compared_side_by_side_give_the_comparison_made_in_turn(monkeyp
 
     case = read_case(PUBLISHED_CASE)
     laws = ("improved-s-curve", "quintic", "optimal")
-    made_there: list[bool] = []
-    take = ahead_module.Call.take
-
-    def taken(call):  # noqa: ANN001, ANN202
-        made_there.append(call.future is not None and call.future.result()[0])
-        return take(call)
-
-    with monkeypatch.context() as m:
-        m.setattr(ahead_module.Call, "take", taken)
-        side_by_side, tables = compare_laws(case, laws, side_by_side_workers=True)
+    made_there, (side_by_side, tables), (in_turn, tables_in_turn) = _both_ways(
+        monkeypatch, lambda: compare_laws(case, laws, side_by_side_workers=True)
+    )
     assert len(made_there) == 5 and all(made_there)  # two bounds, three laws
-    with monkeypatch.context() as m:
-        m.setattr(ahead_module, "_can_fork", lambda: False)
-        in_turn, tables_in_turn = compare_laws(case, laws, side_by_side_workers=True)
     for data in (side_by_side, in_turn):  # the bounds' times aside
         data["bound"].pop("wall_time_s"), data["upper_bound"].pop("wall_time_s")
     assert side_by_side == in_turn  # every other number, the optimal law's jerk limit among them
