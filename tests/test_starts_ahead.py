@@ -19,6 +19,12 @@ CASES = Path(__file__).resolve().parents[1] / "cases"
 forking = pytest.mark.skipif(not ahead_module._can_fork(), reason="no second core or no fork here")
 
 
+@pytest.fixture(autouse=True)
+def _a_core_free(monkeypatch):  # noqa: ANN001, ANN202
+    """As on a quiet machine (a test run's workers hold the cores, so the load says none is free)."""
+    monkeypatch.setattr(search_module, "core_free", lambda: True)
+
+
 def _record_takes(monkeypatch) -> list[bool]:  # noqa: ANN001 - pytest's monkeypatch
     """Whether each solve taken from the worker was made there (not made here after a failure)."""
     made_there: list[bool] = []
@@ -127,3 +133,20 @@ def test_an_nlps_token_is_never_another_ones_even_at_the_same_address():
         assert token not in seen and search_module._token(nlp) == token
         seen.add(token)
         del nlp  # the next one may take its address
+
+
+@forking
+def test_where_no_core_is_free_nothing_is_made_ahead_and_the_answer_is_the_same(monkeypatch):
+    case = read_case(CASES / "wang2023-side-panel.yaml")
+    made_there = _record_takes(monkeypatch)
+    monkeypatch.setattr(search_module, "core_free", lambda: False)
+    busy = solve(case)
+    assert made_there == []  # nothing begun: no worker forked
+    _same_answer(busy, _in_turn(case, "free", monkeypatch))
+
+
+def test_a_core_is_free_where_the_load_leaves_one(monkeypatch):
+    monkeypatch.setattr(ahead_module, "_cores", lambda: 2)
+    for load, free in ((0.2, True), (1.4, True), (1.6, False), (3.0, False)):
+        monkeypatch.setattr(ahead_module.os, "getloadavg", lambda load=load: (load, load, load))
+        assert ahead_module.core_free() is free

@@ -33,6 +33,7 @@ from typing import Any
 
 HELD = {signal.SIGINT, signal.SIGTERM}  # held while a worker process starts (``signals_held``)
 PARENT_WATCH_S = 1.0  # [s] how often a worker looks whether its parent is still there
+LOAD_FREE = 0.5  # a core is free where the 1-minute load average is under the cores less this (``core_free``)
 
 
 @contextlib.contextmanager
@@ -199,9 +200,23 @@ def _guarded(function: Callable[..., Any], args: tuple) -> tuple[bool, Any]:
         return _FAILED
 
 
+def core_free() -> bool:
+    """Whether a core is free for a short call made ahead: the 1-minute load average is under the cores less a half
+    (where other processes hold every core, a test run's or a script's, a forked worker would only take turns with
+    this process and cost its fork; a long call made ahead pays either way)."""
+    try:
+        return os.getloadavg()[0] < _cores() - LOAD_FREE
+    except OSError:  # no load average here: as if free
+        return True
+
+
+def _cores() -> int:
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+
+
 def _can_fork() -> bool:
     """A second core, ``fork``, no other thread running, not a daemon process (which may have no children)."""
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    cores = _cores()
     return (
         cores >= 2
         and "fork" in multiprocessing.get_all_start_methods()

@@ -32,7 +32,7 @@ from planning.model.case import Case, Placement
 from planning.model.limits import BY_ID
 from planning.model.limits.base import Check, Dense
 from planning.model.plan import Plan, SolverInfo
-from planning.solver.ahead import Ahead, Call
+from planning.solver.ahead import Ahead, Call, core_free
 from planning.solver.halves_nlp import halves_nlp_for
 from planning.solver.ipopt import NLPResult, NLPStatus
 from planning.solver.nlp import CycleNLP
@@ -384,8 +384,9 @@ class StartsAhead:
     """The first IPOPT solves of a multi-start's coming starts, made in one forked worker (``planning.solver.ahead``)
     while this process runs the start before: the same call on the same inputs, so the same result to the last bit
     (and the same answers); a start takes its solve when its turn comes (:meth:`take`). Where the worker cannot fork
-    (one core, threads running: a sweep's, a trade-off's or the web page's workers, whose cores are busy), or the
-    worker lacks the NLP, nothing is made ahead: the search solves as before. The worker is stopped by
+    (one core, threads running: a sweep's, a trade-off's or the web page's workers, whose cores are busy), no core is
+    free (``planning.solver.ahead.core_free``: other processes hold them), or the worker lacks the NLP, nothing is
+    made ahead: the search solves as before. The worker is stopped by
     :meth:`close` (a start the search never reached is dropped there)."""
 
     def __init__(self) -> None:
@@ -396,7 +397,7 @@ class StartsAhead:
     def start(self, nlp: CycleNLP, args: tuple) -> None:
         """``nlp.solve(*args)`` begun in the worker (forked now where it does not hold ``nlp``; nothing where it
         was begun already)."""
-        if any(other is nlp and _same_call(begun, args) for other, begun, _ in self._calls):
+        if not core_free() or any(other is nlp and _same_call(begun, args) for other, begun, _ in self._calls):
             return
         token = _token(nlp)
         if self._ahead is None or token not in self._forked_with:
