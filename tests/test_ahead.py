@@ -271,3 +271,30 @@ def test_bound_certified_makes_its_upper_bound_in_a_worker_and_says_the_time_opt
     monkeypatch.setattr(bound_module, "time_optimal_bound", _failing_bound)
     with pytest.raises(Infeasible, match=f"the bound's own error in {os.getpid()}$"):
         cli._bound_and_upper(None, 720, 2880)
+
+
+def _large_after_marking(marker: str, size: int) -> bytes:
+    large = b"x" * size
+    with open(marker, "w") as f:
+        f.write("sending")  # the result is pickled and sent from now on
+    return large
+
+
+@forking
+def test_a_worker_stopped_while_it_sends_a_large_result_does_not_hang_the_stop(tmp_path):
+    """A worker killed halfway through writing its result left part of a message in the pool's result pipe, and
+    the pool's thread waited for the rest for ever: the page's close once hung the test run there."""
+    import threading
+
+    for k, into_sending_s in enumerate((0.3, 0.5)):  # on a quiet machine 300 MB are sent from 0.2 s to 0.6 s on
+        marker = tmp_path / f"marker{k}"
+        worker = ahead_module.WorkerProcess("fork")
+        worker.submit(_large_after_marking, str(marker), 300_000_000)
+        deadline = time.perf_counter() + 30
+        while not marker.exists() and time.perf_counter() < deadline:
+            time.sleep(0.01)
+        time.sleep(into_sending_s)
+        closing = threading.Thread(target=worker.close, daemon=True)
+        closing.start()
+        closing.join(timeout=15)
+        assert not closing.is_alive(), into_sending_s  # the stop returned

@@ -70,12 +70,17 @@ def worker_signals() -> None:
 
 def _stop(pool: ProcessPoolExecutor) -> None:
     """Stop ``pool``'s worker processes now (work under way is dropped) and close its queues (no semaphore left to
-    the resource tracker)."""
+    the resource tracker). A worker killed while it wrote its result leaves part of a message in the result pipe, on
+    which the pool's own thread would wait for ever (this process holds the pipe's other end too): that end is
+    closed once the workers are gone, so the thread reads the pipe's end instead and the shutdown joins it."""
     processes = list(getattr(pool, "_processes", {}).values())  # the executor keeps no public handle
     for process in processes:
         process.terminate()
     for process in processes:
         process.join(timeout=5)
+    results = getattr(pool, "_result_queue", None)
+    if results is not None and not any(process.is_alive() for process in processes):
+        results._writer.close()  # nothing writes there any more (a second close, in shutdown, does nothing)
     pool.shutdown(wait=True, cancel_futures=True)
 
 
