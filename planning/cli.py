@@ -1035,14 +1035,6 @@ def _recipes_folder(name: str | None) -> Path | None:
     return folder.resolve()
 
 
-class _Terminated(BaseException):
-    """SIGTERM, raised in the main thread so that clean-up (worker processes, temporary folders) runs."""
-
-
-def _on_sigterm(signum, frame) -> NoReturn:  # noqa: ANN001 - a signal handler's signature
-    raise _Terminated
-
-
 def run() -> None:
     """Console-script entry point: Ctrl-C ends with one line and exit 130, SIGTERM with exit 143; numpy's
     RuntimeWarnings are never printed (every result is checked for finiteness where it matters). The objects
@@ -1051,32 +1043,21 @@ def run() -> None:
     of the 600 ms a cold solve's process takes); reference counting frees as before, files are closed by then, and
     the clean-up in ``finally`` blocks and at exit runs as before."""
     import gc
-    import signal
     import warnings
 
+    from planning.interrupts import Terminated, install, stop
+
     warnings.simplefilter("ignore", RuntimeWarning)
-    signal.signal(signal.SIGTERM, _on_sigterm)
+    install()  # set already where the run began in planning.__main__ (the console script)
     gc.freeze()  # the modules imported so far live as long as the process: no collection walks them again
     try:
         code = main()
     except KeyboardInterrupt:
-        _stop("pressplan: interrupted", EXIT_INTERRUPTED)
-    except _Terminated:
-        _stop("pressplan: terminated", EXIT_TERMINATED)
+        stop("pressplan: interrupted", EXIT_INTERRUPTED)
+    except Terminated:
+        stop("pressplan: terminated", EXIT_TERMINATED)
     gc.freeze()
     sys.exit(code)
-
-
-def _stop(message: str, code: int) -> NoReturn:
-    """End an interrupted run with one line: the clean-up in ``finally`` blocks has run on the way here;
-    the interpreter's own exit is skipped, since a worker pool's thread torn down mid-read would print
-    a traceback after the line."""
-    import os
-
-    print(message, file=sys.stderr)
-    sys.stdout.flush()
-    sys.stderr.flush()
-    os._exit(code)
 
 
 if __name__ == "__main__":

@@ -23,6 +23,8 @@ LAYERS = (  # module prefix -> layer, the most specific prefix wins
     ("planning.timeline", 3),
     ("planning.web", 3),
     ("planning.cli", 3),
+    ("planning.interrupts", 3),
+    ("planning.__main__", 3),
 )
 
 

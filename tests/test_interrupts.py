@@ -159,3 +159,91 @@ def _deferred_then_raised(signals_held, steps: list[str]) -> None:  # noqa: ANN0
             steps.append("after the signal, inside the block")
         steps.append("after the block")  # not reached: the handler raised on the way out
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # the handler is back
+
+
+class _Number:
+    """A number CasADi converts by trying Python functions in turn; the first attribute it asks for sends ``signum``
+    to this process (the signal's handler then runs inside CasADi's attempt, where an exception is swallowed)."""
+
+    asked = 0
+
+    def __init__(self, signum: int) -> None:
+        self.signum = signum
+
+    def __float__(self) -> float:
+        return 2.0
+
+    def __getattr__(self, name: str):  # noqa: ANN204 - any attribute
+        type(self).asked += 1
+        if type(self).asked == 1:
+            os.kill(os.getpid(), self.signum)
+            sum(range(1000))  # a few bytecodes: the handler runs here
+        raise AttributeError(name)
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="signals")
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM], ids=["Ctrl-C", "SIGTERM"])
+def test_a_signal_inside_casadi_code_is_delivered_after_it(signum):
+    """A Ctrl-C while an NLP was built ended the run with exit 0 after the whole solve: its KeyboardInterrupt was
+    raised inside a Python function CasADi's C++ called to convert an argument, and CasADi took it for "not this
+    type". The command's handler (``planning.interrupts``) delivers such a signal again once that code has returned."""
+    import casadi as ca
+
+    from planning.interrupts import Terminated, on_signal
+
+    expected = KeyboardInterrupt if signum == signal.SIGINT else Terminated
+    numbers = (signal.SIGINT, signal.SIGTERM, signal.SIGALRM)
+    before = {n: signal.getsignal(n) for n in numbers}
+    _Number.asked = 0
+    for n in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(n, on_signal)
+    try:
+        with pytest.raises(expected):
+            ca.times(ca.SX.sym("x"), _Number(signum))  # the signal arrives inside CasADi's conversion
+            deadline = time.monotonic() + 2.0
+            while time.monotonic() < deadline:  # on its way after it
+                time.sleep(0.001)
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        for n, handler in before.items():
+            signal.signal(n, handler)
+    assert _Number.asked >= 1
+
+
+def _status_caught(pid: int) -> int:
+    """The signals process ``pid`` catches (a bit mask, from /proc), 0 where it is gone."""
+    try:
+        lines = Path(f"/proc/{pid}/status").read_text().splitlines()
+    except OSError:
+        return 0
+    return int(next(ln.split()[1] for ln in lines if ln.startswith("SigCgt:")), 16)
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="reads /proc")
+def test_ctrl_c_while_the_command_loads_is_one_line_and_exit_130(tmp_path):
+    """The console script sets its handlers before the command's modules load (``planning.__main__``): a Ctrl-C then
+    (the first few tenths of a second) ends the run as one during a solve does, not with a traceback."""
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "planning", "solve", str(PUBLISHED_CASE), "--no-plots", "--out", str(tmp_path / "o")],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
+    deadline = time.monotonic() + 30
+    while not _status_caught(proc.pid) & (1 << (signal.SIGTERM - 1)) and time.monotonic() < deadline:
+        time.sleep(0.0005)  # until the handlers are set: the command's modules load next
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130
+    assert err.strip().splitlines() == ["pressplan: interrupted"]
+    assert not (tmp_path / "o").exists()
+
+
+def test_the_console_script_sets_its_handlers_before_the_heavy_modules_load():
+    """``planning.__main__`` (the console script's module) loads none of the command's modules before ``run``."""
+    heavy = ("planning.cli", "casadi", "numpy", "pydantic")
+    probe = f"import sys, planning.__main__; print(sorted(m for m in {heavy!r} if m in sys.modules))"
+    out = subprocess.run([sys.executable, "-c", probe], cwd=ROOT, capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
