@@ -183,8 +183,46 @@ def test_bound_makes_its_time_optimal_bound_in_the_brackets_worker_and_says_its_
     with pytest.raises(NoPlanFound, match="the bracket's error"):
         cli._bound_and_bracket(None, 720, 0.05)
     monkeypatch.setattr(bound_module, "time_optimal_bound", _failing_bound)
-    with pytest.raises(Infeasible, match=f"the bound's own error in {os.getpid()}$"):
+    with pytest.raises(Infeasible, match="the bound's own error in ") as raised:
         cli._bound_and_bracket(None, 720, 0.05)
+    assert not raised.value.reason.endswith(f" {os.getpid()}")  # the worker's, raised here as it is (made once)
+
+
+def _no_plan_once(marker: str) -> None:
+    from planning.model.limits.base import Check
+    from planning.solver.outcomes import NoPlanFound, Unverified
+
+    with open(marker, "a") as f:
+        f.write(f"{os.getpid()}\n")
+    if marker.endswith("unverified"):
+        check = Check("slider acceleration", 2.0, 1.0, "m/s^2", "max", False, "slider_accel")
+        raise Unverified(f"checked in {os.getpid()}", check)
+    raise NoPlanFound(f"none in {os.getpid()}", ())
+
+
+@forking
+@pytest.mark.parametrize("kind", ["no-plan", "unverified"])
+def test_a_typed_outcome_raised_in_the_worker_is_raised_here_as_it_is_and_the_call_made_once(tmp_path, kind):
+    """A call that ends without a plan (``planning.solver.outcomes``) in the worker: that exception, its data too, is
+    raised where the call is taken, and the call is not made again here (a law or a press that fails cost twice)."""
+    from planning.solver.outcomes import NoPlanFound, Unverified
+
+    marker = tmp_path / kind
+    ahead = Ahead()
+    try:
+        with pytest.raises((NoPlanFound, Unverified)) as raised:
+            ahead.start(_no_plan_once, str(marker)).take()
+    finally:
+        ahead.close()
+    made_in = marker.read_text().split()
+    assert len(made_in) == 1 and made_in[0] != str(os.getpid())  # once, in the worker
+    error = raised.value
+    assert error.reason == f"{'checked' if kind == 'unverified' else 'none'} in {made_in[0]}"
+    assert str(error) == f"{error.outcome}: {error.reason}"
+    if kind == "unverified":
+        assert isinstance(error, Unverified) and error.check.value == 2.0 and error.check.id == "slider_accel"
+    else:
+        assert isinstance(error, NoPlanFound) and error.attempts == ()
 
 
 def _station_pid(seconds: float) -> tuple[float, int]:

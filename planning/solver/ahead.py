@@ -10,12 +10,14 @@ edits' cold solves).
 
 :meth:`Ahead.start` hands a call to a forked worker and returns at once (with one worker, calls run one after another,
 in the order started; with two, side by side); :meth:`Call.take` returns its value. A call computed there is the same
-computation as here (the same code and inputs: the same numbers); where it raised, or the worker failed, the call is
-made again here when taken, so the caller sees the value or the exception it would have seen without the worker
-(a call that fails is made twice). Where the machine has one core, the process cannot fork (no ``fork``, threads
-running, among them a pressplan worker's watch of its parent, a daemon process, which may have no children), calls
-are made here when taken. The worker ignores Ctrl-C (the caller's to handle), is stopped by :meth:`Ahead.close` and
-ends itself when this process is gone (:func:`worker_signals`, which every worker process of pressplan starts with).
+computation as here (the same code and inputs: the same numbers); a typed outcome it raised there (no plan, none
+verified, infeasible: ``planning.solver.outcomes``) is raised where it is taken, and where it raised anything else, or
+the worker failed, the call is made again here when taken, so the caller sees the value or the exception it would
+have seen without the worker (a fault's traceback its own). Where the machine has one core, the process cannot fork
+(no ``fork``, threads running, among them a pressplan worker's watch of its parent, a daemon process, which may have
+no children), calls are made here when taken. The worker ignores Ctrl-C (the caller's to handle), is stopped by
+:meth:`Ahead.close` and ends itself when this process is gone (:func:`worker_signals`, which every worker process of
+pressplan starts with).
 """
 
 from __future__ import annotations
@@ -30,6 +32,8 @@ from collections.abc import Callable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any
+
+from planning.solver.outcomes import PlanningError
 
 HELD = {signal.SIGINT, signal.SIGTERM}  # held while a worker process starts (``signals_held``)
 PARENT_WATCH_S = 1.0  # [s] how often a worker looks whether its parent is still there
@@ -160,15 +164,18 @@ class Call:
         self.function, self.args, self.future = function, args, future
 
     def take(self) -> Any:
-        """The call's value (waiting for the worker), or, where it raised there or the worker failed, the call made
-        here: its value or its exception."""
+        """The call's value (waiting for the worker), or the typed outcome it raised there (``planning.solver.
+        outcomes``: the same exception, its data too), or, where it raised anything else or the worker failed, the
+        call made here: its value or its exception."""
         if self.future is not None:
             try:
                 done, value = self.future.result()
             except Exception:  # noqa: BLE001 - the worker died or was stopped: made here
-                done = False
+                done, value = False, None
             if done:
                 return value
+            if isinstance(value, PlanningError):
+                raise value
         return self.function(*self.args)
 
 
@@ -197,11 +204,14 @@ _FAILED = (False, None)
 
 
 def _guarded(function: Callable[..., Any], args: tuple) -> tuple[bool, Any]:
-    """In the worker: ``(True, function(*args))``, or :data:`_FAILED` where it raised (made again by the caller,
-    whose exception is then its own)."""
+    """In the worker: ``(True, function(*args))``; where it raised a typed outcome (``planning.solver.outcomes``: no
+    plan, none verified, infeasible), ``(False, that exception)``, raised as it is where it is taken; where it raised
+    anything else (a fault), :data:`_FAILED` (made again by the caller, whose traceback is then its own)."""
     try:
         return True, function(*args)
-    except Exception:  # noqa: BLE001 - raised again where it is taken
+    except PlanningError as error:
+        return False, error
+    except Exception:  # noqa: BLE001 - made again where it is taken
         return _FAILED
 
 

@@ -25,6 +25,19 @@ class PlanningError(Exception):
         self.reason = reason
         super().__init__(f"{self.outcome}: {reason}")
 
+    def __reduce__(self) -> tuple:
+        """Pickled as it is, its data too (a call made in a worker process raises it there: ``planning.solver.ahead``);
+        an exception's default pickling calls the class with its message alone, which a subclass does not take."""
+        return _restored, (type(self), self.args, self.__dict__)
+
+
+def _restored(cls: type[PlanningError], args: tuple, state: dict) -> PlanningError:
+    """A :class:`PlanningError` of ``cls`` with its message ``args`` and data ``state`` (its ``__reduce__``)."""
+    error = cls.__new__(cls)
+    error.args = args
+    error.__dict__.update(state)
+    return error
+
 
 class Infeasible(PlanningError):
     """A limit provably cannot be met (found before or without solving).
