@@ -773,8 +773,7 @@ def _bound_and_bracket(case, points, tolerance):  # noqa: ANN001, ANN202 - a Cas
     from planning.solver.bracket import bracket
     from planning.solver.outcomes import PlanningError
 
-    ahead = Ahead()
-    try:
+    with Ahead() as ahead:
         following = ahead.start(time_optimal_bound, case, points)
         try:
             result = bracket(case, tolerance, ahead)
@@ -782,8 +781,6 @@ def _bound_and_bracket(case, points, tolerance):  # noqa: ANN001, ANN202 - a Cas
             following.take()  # its own error first
             raise
         return following.take(), result
-    finally:
-        ahead.close()
 
 
 def _bound_and_upper(case, points, upper_points):  # noqa: ANN001, ANN202 - a Case, ints; a Bound, an UpperBound
@@ -793,12 +790,9 @@ def _bound_and_upper(case, points, upper_points):  # noqa: ANN001, ANN202 - a Ca
     from planning.solver.bound import time_optimal_bound
     from planning.solver.upper_bound import UPPER_POINTS, upper_bound
 
-    ahead = Ahead()
-    try:
+    with Ahead() as ahead:
         following = ahead.start(upper_bound, case, upper_points or UPPER_POINTS)
         return time_optimal_bound(case, points), following.take()
-    finally:
-        ahead.close()
 
 
 def _pendulum_bound(case, args) -> int:

@@ -108,8 +108,7 @@ def compare_laws(
     they are made side by side in two forked workers (``planning.solver.ahead``: the same solves, the same numbers;
     their NLPs built there, not kept here), taken in order; the optimal law's after the improved S-curve's row,
     whose peak jerk it may plan under. Else one after another here."""
-    ahead = Ahead(SIDE_BY_SIDE_WORKERS if side_by_side_workers else 0)
-    try:
+    with Ahead(SIDE_BY_SIDE_WORKERS if side_by_side_workers else 0) as ahead:
         bound_call = ahead.start(time_optimal_bound, case)
         upper_call = ahead.start(upper_bound, case, LAWS_UPPER_POINTS, LAWS_UPPER_PIECES)
         plain = {law: _start_law(ahead, law, *_variant(case, law)) for law in laws if not LAWS[law].needs_jerk_limit}
@@ -119,8 +118,6 @@ def compare_laws(
         for law in laws:
             variant, note, call = plain.get(law) or _start_law(ahead, law, *_jerk_limited_or_why(case, law, rows))
             rows.append(_row(law, variant, note, call, tables, bound, upper))
-    finally:
-        ahead.close()
     verified = [r for r in rows if Outcome.of(r["status"]).succeeded]
     best = max(verified, key=lambda r: r["spm"]) if verified else None
     bracket = None

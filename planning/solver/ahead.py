@@ -156,6 +156,13 @@ class Ahead:
         if worker is not None:
             worker.close()
 
+    def __enter__(self) -> Ahead:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        """The block's end, however it ends: :meth:`close`."""
+        self.close()
+
 
 class Call:
     """A call started by :meth:`Ahead.start`."""
@@ -186,13 +193,9 @@ def side_by_side(function: Callable[..., Any], calls: list[tuple]) -> list[Any]:
     """``function(*args)`` for each of ``calls``, made side by side in :data:`SIDE_BY_SIDE_WORKERS` forked workers
     (where :class:`Ahead` can fork; one call alone, or none can: made here in turn), taken in order: the values in
     the calls' order, and where a call raises, the first such call raises here (its own exception)."""
-    ahead = Ahead(SIDE_BY_SIDE_WORKERS) if len(calls) > 1 else None
-    try:
-        started = [ahead.start(function, *args) if ahead else Call(function, args, None) for args in calls]
+    with Ahead(SIDE_BY_SIDE_WORKERS if len(calls) > 1 else 0) as ahead:
+        started = [ahead.start(function, *args) for args in calls]
         return [call.take() for call in started]
-    finally:
-        if ahead is not None:
-            ahead.close()
 
 
 def in_turn(function: Callable[..., Any], calls: list[tuple]) -> list[Any]:

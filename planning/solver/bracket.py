@@ -21,6 +21,7 @@ that passes, stalls its side (the motion found before stays). A verified motion 
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 from dataclasses import dataclass
@@ -112,13 +113,10 @@ def bracket(case: Case, tolerance_pct: float = BRACKET_TOL_PCT, ahead: Ahead | N
         planned = planned.model_copy(update={"limits": limits})
     planned = planned.with_law(OptimalLaw.name)
     fastest = case.with_objective("max-spm")  # the bracket is about the most strokes, whatever the objective
-    own = ahead is None  # each upper bound computed in a worker while the motion is planned (``planning.solver.ahead``)
-    ahead = ahead or Ahead()
-    try:
-        verified, upper, rounds = _refined(case, planned, fastest, tolerance_pct, ahead)
-    finally:
-        if own:
-            ahead.close()
+    # each upper bound computed in a worker while the motion is planned (``planning.solver.ahead``): the caller's, or
+    # one of the bracket's own, closed here
+    with contextlib.nullcontext(ahead) if ahead is not None else Ahead() as worker:
+        verified, upper, rounds = _refined(case, planned, fastest, tolerance_pct, worker)
     gap = rounds[-1].gap_pct
     if gap < -CROSSED_PCT:
         raise NoPlanFound(
