@@ -11,8 +11,9 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from planning.model.case_file import read_case
-from planning.reports.plots import laws_figure, plot_files, sweep_figure, tradeoff_figure
+from planning.reports.plots import laws_figure, plot_files, rendered, sweep_figure, tradeoff_figure
 from planning.reports.report import result_dict, trajectory
+from planning.solver import ahead as ahead_module
 from tests.conftest import solved
 
 CASES = sorted((Path(__file__).resolve().parents[1] / "cases").glob("*.yaml"))
@@ -148,3 +149,49 @@ def test_the_laws_overlay_keeps_its_legend_off_the_curves():
         for k, law in enumerate(("a", "b", "c"))
     }
     assert not legend_overlaps(laws_figure(curves, "laws"))
+
+
+DRAWN_IN = "PRESSPLAN_TEST_DRAWN_IN"  # a file where the test's drawing notes the process that drew each figure
+
+
+def _rendered_noting(name, result, traj, published, fmt):  # noqa: ANN001, ANN202 - as plots.rendered
+    import os
+
+    with open(os.environ[DRAWN_IN], "a") as f:
+        f.write(f"{os.getpid()}\n")
+    return rendered(name, result, traj, published, fmt)
+
+
+@pytest.mark.skipif(not ahead_module._can_fork(), reason="no second core or no fork here")
+@pytest.mark.parametrize("plot_format", ["png", "svg"])
+def test_figures_drawn_side_by_side_are_the_files_drawn_in_turn(monkeypatch, tmp_path, plot_format):
+    """``pressplan solve`` draws its figures in two forked workers at once: the same files, byte for byte (an SVG's
+    date aside), as drawn one after another here."""
+    import os
+    import re
+
+    import matplotlib
+
+    from planning.reports import plots
+    from planning.reports.outputs import Written
+    from planning.reports.outputs.figures import OUTPUT
+
+    path = next(p for p in CASES if p.stem == "wang2023-side-panel-drive")
+    written = Written(solved(path), read_case(path), {"plot_format": plot_format})
+    monkeypatch.setattr(plots, "rendered", _rendered_noting)
+    monkeypatch.setenv(DRAWN_IN, str(tmp_path / "drawn_in"))
+    monkeypatch.setitem(matplotlib.rcParams, "svg.hashsalt", "fixed")  # else an SVG's ids differ from run to run
+    files = {}
+    for way in ("side by side", "in turn"):
+        if way == "in turn":
+            monkeypatch.setattr(ahead_module, "_can_fork", lambda: False)
+        for name, write in OUTPUT.writers(written).items():
+            write(tmp_path / name)
+            files[way, name] = re.sub(rb"<dc:date>[^<]*</dc:date>", b"", (tmp_path / name).read_bytes())
+    names = [f"{n}.{plot_format}" for n in ("motion_vs_time", "motion_vs_angle", "drive")]  # three: two workers
+    assert sorted(name for way, name in files if way == "in turn") == sorted(names)
+    for name in names:
+        assert files["side by side", name] == files["in turn", name], name
+    drawn_in = (tmp_path / "drawn_in").read_text().split()
+    assert len(drawn_in) == 2 * len(names)
+    assert str(os.getpid()) not in drawn_in[: len(names)] and set(drawn_in[len(names) :]) == {str(os.getpid())}

@@ -7,6 +7,7 @@ the panels, so they never hide a curve."""
 
 from __future__ import annotations
 
+import io
 import warnings
 from pathlib import Path
 from typing import Any
@@ -257,18 +258,37 @@ def _zeros_on_one_line(ax, values: np.ndarray, limit: float | None) -> None:  # 
 def plot_files(
     result: dict[str, Any], traj: dict[str, np.ndarray], published: dict[str, np.ndarray] | None, fmt: str = "png"
 ) -> dict[str, Figure]:
-    """The figures by file name (``motion_vs_time.<fmt>``, ``motion_vs_angle.<fmt>``, and ``drive.<fmt>``
-    when the result has a drive)."""
-    out = {f"{name}.{fmt}": _figure(result, traj, published, name.split("_")[-1]) for name in FIGURES}
-    if "drive" in result:
-        out[f"drive.{fmt}"] = drive_figure(result, traj)
-    if "power" in result:
-        out[f"energy.{fmt}"] = energy_figure(result, traj)
-    if "capacity" in result:
-        out[f"capacity.{fmt}"] = capacity_figure(result, traj)
-    if "robots" in result:
-        out[f"interference.{fmt}"] = interference_figure(result, traj)
-    return out
+    """The figures by file name (``motion_vs_time.<fmt>``, ``motion_vs_angle.<fmt>``, and those of
+    :func:`figure_names` the result has: ``drive.<fmt>`` with a drive, ...)."""
+    return {f"{name}.{fmt}": figure_of(name, result, traj, published) for name in figure_names(result)}
+
+
+OPTIONAL_FIGURES = {"drive": "drive", "energy": "power", "capacity": "capacity", "interference": "robots"}  # the
+# figures a result has where it holds that key
+
+
+def figure_names(result: dict[str, Any]) -> tuple[str, ...]:
+    """The names of ``result``'s figures (file names without the format), in order."""
+    return FIGURES + tuple(name for name, key in OPTIONAL_FIGURES.items() if key in result)
+
+
+def figure_of(
+    name: str, result: dict[str, Any], traj: dict[str, np.ndarray], published: dict[str, np.ndarray] | None
+) -> Figure:
+    """The figure ``name`` (one of :func:`figure_names`) of ``result`` and its trajectory ``traj``."""
+    if name in FIGURES:
+        return _figure(result, traj, published, name.split("_")[-1])
+    drawn = {"drive": drive_figure, "energy": energy_figure, "capacity": capacity_figure}
+    return drawn.get(name, interference_figure)(result, traj)
+
+
+def rendered(
+    name: str, result: dict[str, Any], traj: dict[str, np.ndarray], published: dict[str, np.ndarray] | None, fmt: str
+) -> bytes:
+    """The file of the figure ``name`` (:func:`figure_of`) in the format ``fmt``, as :func:`save` writes it."""
+    buffer = io.BytesIO()
+    figure_of(name, result, traj, published).savefig(buffer, format=fmt)
+    return buffer.getvalue()
 
 
 ROBOT_COLOURS = {"unloader": "#d62728", "loader": "#2ca02c"}  # matplotlib's tab:red and tab:green

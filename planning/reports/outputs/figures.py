@@ -9,6 +9,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
+
 from planning.reports.folder import OutputError
 from planning.reports.outputs import Option, Output, Writer, Written
 
@@ -21,18 +23,34 @@ NO_PLOTS = Option("--no-plots", {"dest": "no_plots", "action": "store_true", "he
 
 
 def _writers(w: Written) -> dict[str, Writer]:
-    from planning.reports.plots import plot_files, save
     from planning.reports.report import TRAJECTORY_COLUMNS
 
     published = w.published
     pub_cols = dict(zip(TRAJECTORY_COLUMNS, published.T, strict=True)) if published is not None else None
-    figures = plot_files(w.result, w.columns, pub_cols, w.option("plot_format"))
-    return {name: (lambda p, fig=fig: save(fig, p)) for name, fig in figures.items()}
+    return _drawn(w.result, w.columns, pub_cols, w.option("plot_format"))
+
+
+def _drawn(
+    result: dict, traj: dict[str, np.ndarray], published: dict[str, np.ndarray] | None, plot_format: str
+) -> dict[str, Writer]:
+    """The writers of the figures of ``result``: drawn now, side by side in two forked workers where this process
+    can fork (``planning.solver.ahead.side_by_side``: the same files, byte for byte; a figure takes a few tenths of a
+    second to draw and save), else here in turn."""
+    from planning.reports.plots import figure_names, rendered
+    from planning.solver.ahead import side_by_side
+
+    names = figure_names(result)
+    files = side_by_side(rendered, [(name, result, traj, published, plot_format) for name in names])
+    return {f"{name}.{plot_format}": _bytes_writer(data) for name, data in zip(names, files, strict=True)}
+
+
+def _bytes_writer(data: bytes) -> Writer:
+    return lambda path: path.write_bytes(data)
 
 
 def redraw(folder: Path, plot_format: str = "png") -> dict[str, Writer]:
     """The figures redrawn from a finished output folder's result.json and trajectory.csv (``pressplan plot``)."""
-    from planning.reports.plots import plot_files, read_table, save
+    from planning.reports.plots import read_table, save
 
     try:
         result = json.loads((folder / "result.json").read_text(encoding="utf-8"))
@@ -42,13 +60,12 @@ def redraw(folder: Path, plot_format: str = "png") -> dict[str, Writer]:
         if result.get("mode") == "pendulum":  # a pendulum plan's own figure (``planning.reports.pendulum``)
             from planning.reports.plots import swing_figure
 
-            figures = {f"swing.{plot_format}": swing_figure(result, traj)}
-        else:
-            figures = plot_files(result, traj, published, plot_format)
+            figure = swing_figure(result, traj)
+            return {f"swing.{plot_format}": lambda p: save(figure, p)}
+        return _drawn(result, traj, published, plot_format)
     except (OSError, ValueError, KeyError, IndexError, TypeError, AttributeError) as exc:
         reason = " ".join(str(exc).split())[:120] or type(exc).__name__
         raise OutputError(f"{folder}: not a finished pressplan output folder ({reason})") from None
-    return {name: (lambda p, fig=fig: save(fig, p)) for name, fig in figures.items()}
 
 
 OUTPUT = Output(
