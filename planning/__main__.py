@@ -4,18 +4,18 @@ second) ends the run as one during a solve does, with one line and exit 130, not
 
 from __future__ import annotations
 
-from planning.interrupts import EXIT_INTERRUPTED, EXIT_TERMINATED, Terminated, install, stop
+from planning.interrupts import install, stopping
 
 
 def run() -> None:
     """The console script's entry point."""
     install()
-    try:
-        from planning.cli import run as command
-    except KeyboardInterrupt:
-        stop("pressplan: interrupted", EXIT_INTERRUPTED)
-    except Terminated:
-        stop("pressplan: terminated", EXIT_TERMINATED)
+    stopping(_command)
+
+
+def _command() -> None:
+    from planning.cli import run as command
+
     command()
 
 

@@ -27,7 +27,6 @@ from planning.tolerances import TINY_RATE
 
 # the exit statuses, from the one outcome type (planning.model.outcome)
 EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = (o.exit_code for o in (Outcome.VERIFIED, Outcome.BAD_INPUT, Outcome.NO_PLAN))
-EXIT_INTERRUPTED, EXIT_TERMINATED = Outcome.INTERRUPTED.exit_code, Outcome.TERMINATED.exit_code  # 128 + signal
 SERVE_FIRST = "wang2023-side-panel.yaml"  # the case the page opens with when none is given
 
 
@@ -422,7 +421,8 @@ def _solve(case, args) -> int:
     figures = not args.no_plots
     if figures:
         _load_plots()  # here, where a signal is held through the import, not inside the writers
-    written = Written(solution, case, {o.kwargs["dest"]: getattr(args, o.kwargs["dest"]) for o in output_options()})
+    options = {o.kwargs["dest"]: getattr(args, o.kwargs["dest"]) for o in output_options()}
+    written = Written(solution, case, options, side_by_side_workers=True)
     writers = writers_of(written, figures)
     text = summary_text(written.result)
     if written.cam is not None:
@@ -989,7 +989,7 @@ def _plot(args) -> int:
     folder = Path(args.folder)
     if not (folder / "result.json").is_file():
         raise CommandError(f"{folder}: no result.json here (run `pressplan solve` first)")
-    files = write_atomic(folder, redraw(folder, args.format))
+    files = write_atomic(folder, redraw(folder, args.format, side_by_side_workers=True))
     print(f"wrote {', '.join(str(f) for f in files)}")
     return EXIT_OK
 
@@ -1030,28 +1030,30 @@ def _recipes_folder(name: str | None) -> Path | None:
 
 
 def run() -> None:
-    """Console-script entry point: Ctrl-C ends with one line and exit 130, SIGTERM with exit 143; numpy's
+    """The command (``planning.__main__``, the console script, sets the signals' handlers before this module loads):
+    Ctrl-C ends with one line and exit 130, SIGTERM with exit 143 (``planning.interrupts``); numpy's
     RuntimeWarnings are never printed (every result is checked for finiteness where it matters). The objects
     made by the imports, and those left at the end, are frozen out of the cyclic garbage collector's sight
     (``gc.freeze``): its collections during the run and the interpreter's exit do not walk them (together about 50
     of the 600 ms a cold solve's process takes); reference counting frees as before, files are closed by then, and
     the clean-up in ``finally`` blocks and at exit runs as before."""
-    import gc
     import warnings
 
-    from planning.interrupts import Terminated, install, stop
+    from planning.interrupts import install, stopping
 
     warnings.simplefilter("ignore", RuntimeWarning)
-    install()  # set already where the run began in planning.__main__ (the console script)
+    install()  # set already where the run began in planning.__main__; here for ``python -m planning.cli``
+    sys.exit(stopping(_frozen_main))
+
+
+def _frozen_main() -> int:
+    """:func:`main` between two ``gc.freeze`` (:func:`run`)."""
+    import gc
+
     gc.freeze()  # the modules imported so far live as long as the process: no collection walks them again
-    try:
-        code = main()
-    except KeyboardInterrupt:
-        stop("pressplan: interrupted", EXIT_INTERRUPTED)
-    except Terminated:
-        stop("pressplan: terminated", EXIT_TERMINATED)
+    code = main()
     gc.freeze()
-    sys.exit(code)
+    return code
 
 
 if __name__ == "__main__":

@@ -208,12 +208,8 @@ def test_a_typed_outcome_raised_in_the_worker_is_raised_here_as_it_is_and_the_ca
     from planning.solver.outcomes import NoPlanFound, Unverified
 
     marker = tmp_path / kind
-    ahead = Ahead()
-    try:
-        with pytest.raises((NoPlanFound, Unverified)) as raised:
-            ahead.start(_no_plan_once, str(marker)).take()
-    finally:
-        ahead.close()
+    with Ahead() as ahead, pytest.raises((NoPlanFound, Unverified)) as raised:
+        ahead.start(_no_plan_once, str(marker)).take()
     made_in = marker.read_text().split()
     assert len(made_in) == 1 and made_in[0] != str(os.getpid())  # once, in the worker
     error = raised.value

@@ -263,23 +263,20 @@ def plot_files(
     return {f"{name}.{fmt}": figure_of(name, result, traj, published) for name in figure_names(result)}
 
 
-OPTIONAL_FIGURES = {"drive": "drive", "energy": "power", "capacity": "capacity", "interference": "robots"}  # the
-# figures a result has where it holds that key
-
-
 def figure_names(result: dict[str, Any]) -> tuple[str, ...]:
-    """The names of ``result``'s figures (file names without the format), in order."""
-    return FIGURES + tuple(name for name, key in OPTIONAL_FIGURES.items() if key in result)
+    """The names of ``result``'s figures (file names without the format), in order: :data:`FIGURES`, then those of
+    :data:`OPTIONAL_FIGURES` whose key ``result`` holds."""
+    return FIGURES + tuple(name for name, (key, _) in OPTIONAL_FIGURES.items() if key in result)
 
 
 def figure_of(
     name: str, result: dict[str, Any], traj: dict[str, np.ndarray], published: dict[str, np.ndarray] | None
 ) -> Figure:
-    """The figure ``name`` (one of :func:`figure_names`) of ``result`` and its trajectory ``traj``."""
+    """The figure ``name`` (one of :func:`figure_names`; a ``KeyError`` for another name) of ``result`` and its
+    trajectory ``traj``."""
     if name in FIGURES:
         return _figure(result, traj, published, name.split("_")[-1])
-    drawn = {"drive": drive_figure, "energy": energy_figure, "capacity": capacity_figure}
-    return drawn.get(name, interference_figure)(result, traj)
+    return OPTIONAL_FIGURES[name][1](result, traj)
 
 
 def rendered(
@@ -787,3 +784,12 @@ def swing_figure(result: dict[str, Any], traj: dict[str, np.ndarray]) -> Figure:
         f"{result['case']}: {result['spm']:.3f} strokes/min in pendulum strokes ({result['status']})", fontsize=11
     )
     return fig
+
+
+# the figures a result has where it holds a key: name -> (that key, the function that draws it)
+OPTIONAL_FIGURES = {
+    "drive": ("drive", drive_figure),
+    "energy": ("power", energy_figure),
+    "capacity": ("capacity", capacity_figure),
+    "interference": ("robots", interference_figure),
+}

@@ -54,11 +54,14 @@ class Output:
 class Written:
     """What the outputs of one solution read: the ``solution`` (its evaluation made once), its ``case``,
     the CLI ``options`` by dest (defaults where not given); ``result`` (``result.json``'s data), ``columns``
-    (the trajectory) and ``published`` (the source's solution, rebuilt) are made once, on first use."""
+    (the trajectory) and ``published`` (the source's solution, rebuilt) are made once, on first use.
+    ``side_by_side_workers``: the figures drawn in two forked workers at once (``pressplan solve`` asks; a library
+    caller's process is not forked unless it asks)."""
 
     solution: Solution
     case: Case
     options: dict[str, Any] = field(default_factory=dict)
+    side_by_side_workers: bool = False
 
     @cached_property
     def result(self) -> dict[str, Any]:

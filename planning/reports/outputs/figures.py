@@ -8,11 +8,13 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from planning.reports.folder import OutputError
 from planning.reports.outputs import Option, Output, Writer, Written
+
+if TYPE_CHECKING:
+    import numpy as np
 
 PLOT_FORMATS = ("png", "svg", "pdf")
 FORMAT = Option(
@@ -27,20 +29,25 @@ def _writers(w: Written) -> dict[str, Writer]:
 
     published = w.published
     pub_cols = dict(zip(TRAJECTORY_COLUMNS, published.T, strict=True)) if published is not None else None
-    return _drawn(w.result, w.columns, pub_cols, w.option("plot_format"))
+    return _drawn(w.result, w.columns, pub_cols, w.option("plot_format"), w.side_by_side_workers)
 
 
 def _drawn(
-    result: dict, traj: dict[str, np.ndarray], published: dict[str, np.ndarray] | None, plot_format: str
+    result: dict,
+    traj: dict[str, np.ndarray],
+    published: dict[str, np.ndarray] | None,
+    plot_format: str,
+    side_by_side_workers: bool,
 ) -> dict[str, Writer]:
-    """The writers of the figures of ``result``: drawn now, side by side in two forked workers where this process
-    can fork (``planning.solver.ahead.side_by_side``: the same files, byte for byte; a figure takes a few tenths of a
-    second to draw and save), else here in turn."""
+    """The writers of the figures of ``result``, drawn now: with ``side_by_side_workers``, where a core is free
+    (``planning.solver.ahead.core_free``), in two forked workers at once (``side_by_side``: the same files, byte for
+    byte; a figure takes a few tenths of a second to draw and save), else here in turn."""
     from planning.reports.plots import figure_names, rendered
-    from planning.solver.ahead import side_by_side
+    from planning.solver.ahead import core_free, in_turn, side_by_side
 
     names = figure_names(result)
-    files = side_by_side(rendered, [(name, result, traj, published, plot_format) for name in names])
+    draw = side_by_side if side_by_side_workers and core_free() else in_turn
+    files = draw(rendered, [(name, result, traj, published, plot_format) for name in names])
     return {f"{name}.{plot_format}": _bytes_writer(data) for name, data in zip(names, files, strict=True)}
 
 
@@ -48,8 +55,9 @@ def _bytes_writer(data: bytes) -> Writer:
     return lambda path: path.write_bytes(data)
 
 
-def redraw(folder: Path, plot_format: str = "png") -> dict[str, Writer]:
-    """The figures redrawn from a finished output folder's result.json and trajectory.csv (``pressplan plot``)."""
+def redraw(folder: Path, plot_format: str = "png", side_by_side_workers: bool = False) -> dict[str, Writer]:
+    """The figures redrawn from a finished output folder's result.json and trajectory.csv (``pressplan plot``;
+    ``side_by_side_workers``: as :attr:`Written.side_by_side_workers`)."""
     from planning.reports.plots import read_table, save
 
     try:
@@ -62,7 +70,7 @@ def redraw(folder: Path, plot_format: str = "png") -> dict[str, Writer]:
 
             figure = swing_figure(result, traj)
             return {f"swing.{plot_format}": lambda p: save(figure, p)}
-        return _drawn(result, traj, published, plot_format)
+        return _drawn(result, traj, published, plot_format, side_by_side_workers)
     except (OSError, ValueError, KeyError, IndexError, TypeError, AttributeError) as exc:
         reason = " ".join(str(exc).split())[:120] or type(exc).__name__
         raise OutputError(f"{folder}: not a finished pressplan output folder ({reason})") from None
