@@ -778,7 +778,7 @@ def _bound_and_bracket(case, points, tolerance):  # noqa: ANN001, ANN202 - a Cas
         try:
             result = bracket(case, tolerance, ahead)
         except PlanningError:
-            following.take()  # its own error first
+            following.take()  # the bound's error first
             raise
         return following.take(), result
 

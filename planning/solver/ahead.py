@@ -192,7 +192,7 @@ SIDE_BY_SIDE_WORKERS = 2  # independent calls made side by side in this many for
 def side_by_side(function: Callable[..., Any], calls: list[tuple]) -> list[Any]:
     """``function(*args)`` for each of ``calls``, made side by side in :data:`SIDE_BY_SIDE_WORKERS` forked workers
     (where :class:`Ahead` can fork; one call alone, or none can: made here in turn), taken in order: the values in
-    the calls' order, and where a call raises, the first such call raises here (its own exception)."""
+    the calls' order, and where a call raises, the first such call raises here (as :meth:`Call.take` says)."""
     with Ahead(SIDE_BY_SIDE_WORKERS if len(calls) > 1 else 0) as ahead:
         started = [ahead.start(function, *args) for args in calls]
         return [call.take() for call in started]
